@@ -1,0 +1,149 @@
+"""Canonical positions ⇄ 66-dim frames (thesis §5.2).
+
+A frame holds, in this order:
+
+* ``[0:63]``  the 21 canonical joints' xyz (joint-major: joint ``j`` at ``3j:3j+3``), in metres,
+  relative to the root's ground projection (the Hips' x and z; y stays height above the ground)
+  and rotated about the vertical so that the body faces +Z (+X is the body's left);
+* ``[63:65]`` the root's ground velocity (x, z) in the body's frame, metres per second;
+* ``[65]``    the yaw rate about +Y, radians per second (positive turns +Z towards +X).
+
+Velocities are forward differences: frame ``t`` holds the motion from ``t`` to ``t+1`` expressed in
+frame ``t``'s facing; the last frame repeats the previous one. The inverse integrates the root from
+a start placement, so positions → frames → positions is exact up to float error once the first
+frame's placement and heading are given.
+
+Yaw ``θ`` rotates about +Y: ``x' = x cosθ + z sinθ``, ``z' = −x sinθ + z cosθ``, so the facing
+direction of yaw ``θ`` is ``(sin θ, 0, cos θ)``.
+
+One implementation each: :func:`positions_to_frames` (numpy, data preparation) and
+:func:`frames_to_positions` (torch, differentiable; numpy in, numpy out).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import torch
+from scipy.ndimage import gaussian_filter1d
+
+from stylemotion.skeleton import CJ
+
+FRAME_DIM = 66
+JOINT_DIMS = slice(0, 63)
+VELOCITY_DIMS = slice(63, 65)
+YAW_RATE_DIM = 65
+ROOT_JOINT = CJ["Hips"]
+
+
+def facing_yaw(positions: np.ndarray, fps: float, smooth_seconds: float = 0.15) -> np.ndarray:
+    """Facing angle per frame from hips and shoulders, smoothed in time.
+
+    Args:
+        positions: ``(..., frames, 21, 3)`` canonical positions, metres, Y up.
+        fps: frames per second (sets the smoothing width).
+        smooth_seconds: standard deviation of the Gaussian smoothing of the facing vector,
+            seconds; 0 disables smoothing.
+
+    Returns:
+        ``(..., frames)`` yaw in radians; the body faces ``(sin yaw, 0, cos yaw)``.
+    """
+    across = (positions[..., CJ["UpperLeg_L"], :] - positions[..., CJ["UpperLeg_R"], :]) + (
+        positions[..., CJ["UpperArm_L"], :] - positions[..., CJ["UpperArm_R"], :]
+    )
+    # forward = across × up = (-a_z, 0, a_x)
+    forward = np.stack([-across[..., 2], across[..., 0]], axis=-1)
+    sigma = smooth_seconds * fps
+    if sigma > 0 and forward.shape[-2] > 1:
+        forward = gaussian_filter1d(forward, sigma, axis=-2, mode="nearest")
+    return np.arctan2(forward[..., 0], forward[..., 1])
+
+
+def _rotate_y(vectors: np.ndarray, yaw: np.ndarray) -> np.ndarray:
+    """Rotate ``(..., 3)`` vectors by ``yaw`` (broadcast over leading dims) about +Y."""
+    c, s = np.cos(yaw), np.sin(yaw)
+    x, y, z = vectors[..., 0], vectors[..., 1], vectors[..., 2]
+    return np.stack([c * x + s * z, y, -s * x + c * z], axis=-1)
+
+
+def wrap_angle(angle: np.ndarray) -> np.ndarray:
+    """Angles wrapped to ``[-π, π)``."""
+    return (angle + np.pi) % (2 * np.pi) - np.pi
+
+
+def positions_to_frames(
+    positions: np.ndarray, fps: float, smooth_seconds: float = 0.15
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """66-dim frames of a take.
+
+    Args:
+        positions: ``(frames, 21, 3)`` canonical global positions, metres, Y up; frames ≥ 2.
+        fps: frames per second of ``positions``.
+        smooth_seconds: facing smoothing (see :func:`facing_yaw`).
+
+    Returns:
+        ``frames`` ``(frames, 66)`` float32, and the first frame's root placement ``(2,)`` (x, z)
+        and heading (yaw, radians) — what :func:`frames_to_positions` needs to put the take back
+        where it was.
+    """
+    positions = np.asarray(positions, dtype=np.float64)
+    if positions.ndim != 3 or positions.shape[1:] != (21, 3):
+        raise ValueError(f"positions must be (frames, 21, 3), got {positions.shape}")
+    n = positions.shape[0]
+    if n < 2:
+        raise ValueError(f"a take needs at least 2 frames for velocities, got {n}")
+    yaw = facing_yaw(positions, fps, smooth_seconds)
+    root = positions[:, ROOT_JOINT, :].copy()
+    root[:, 1] = 0.0
+    local = _rotate_y(positions - root[:, None, :], -yaw[:, None])
+    step = _rotate_y(root[1:] - root[:-1], -yaw[:-1]) * fps
+    velocity = np.concatenate([step[:, [0, 2]], step[-1:, [0, 2]]], axis=0)
+    turn = wrap_angle(np.diff(yaw)) * fps
+    yaw_rate = np.concatenate([turn, turn[-1:]])
+    frames = np.concatenate([local.reshape(n, 63), velocity, yaw_rate[:, None]], axis=1)
+    return frames.astype(np.float32), root[0, [0, 2]].copy(), float(yaw[0])
+
+
+def frames_to_positions(
+    frames: np.ndarray | torch.Tensor,
+    fps: float,
+    start_xz: np.ndarray | torch.Tensor | None = None,
+    start_yaw: float | np.ndarray | torch.Tensor = 0.0,
+) -> np.ndarray | torch.Tensor:
+    """Global positions from 66-dim frames by integrating the root (differentiable in torch).
+
+    Args:
+        frames: ``(..., frames, 66)``; numpy in gives numpy out, torch in gives torch out.
+        fps: frames per second of ``frames``.
+        start_xz: ``(..., 2)`` root ground position of the first frame, metres (default origin).
+        start_yaw: ``(...)`` heading of the first frame, radians (default 0: facing +Z).
+
+    Returns:
+        ``(..., frames, 21, 3)`` global positions, metres, Y up.
+    """
+    as_numpy = isinstance(frames, np.ndarray)
+    f = torch.as_tensor(frames) if as_numpy else frames
+    if f.shape[-1] != FRAME_DIM:
+        raise ValueError(f"frames must end in {FRAME_DIM} values, got shape {tuple(f.shape)}")
+    dtype = f.dtype if f.is_floating_point() else torch.float32
+    if as_numpy:
+        dtype = torch.float64  # integrate in double precision for numpy callers
+    f = f.to(dtype)
+    lead = f.shape[:-2]
+    yaw0 = torch.as_tensor(start_yaw, dtype=dtype, device=f.device).expand(lead)
+    xz0 = (torch.zeros(lead + (2,), dtype=dtype, device=f.device) if start_xz is None
+           else torch.as_tensor(start_xz, dtype=dtype, device=f.device).expand(lead + (2,)))
+    turn = f[..., :-1, YAW_RATE_DIM] / fps
+    yaw = torch.cat([yaw0.unsqueeze(-1), yaw0.unsqueeze(-1) + torch.cumsum(turn, dim=-1)], dim=-1)
+    cos, sin = torch.cos(yaw), torch.sin(yaw)
+    vx, vz = f[..., :-1, VELOCITY_DIMS.start] / fps, f[..., :-1, VELOCITY_DIMS.start + 1] / fps
+    # world step = R_y(yaw) (vx, 0, vz)
+    dx = cos[..., :-1] * vx + sin[..., :-1] * vz
+    dz = -sin[..., :-1] * vx + cos[..., :-1] * vz
+    root_x = torch.cat([xz0[..., :1], xz0[..., :1] + torch.cumsum(dx, dim=-1)], dim=-1)
+    root_z = torch.cat([xz0[..., 1:], xz0[..., 1:] + torch.cumsum(dz, dim=-1)], dim=-1)
+    local = f[..., JOINT_DIMS].reshape(f.shape[:-1] + (21, 3))
+    c, s = cos.unsqueeze(-1), sin.unsqueeze(-1)
+    x = c * local[..., 0] + s * local[..., 2] + root_x.unsqueeze(-1)
+    z = -s * local[..., 0] + c * local[..., 2] + root_z.unsqueeze(-1)
+    positions = torch.stack([x, local[..., 1], z], dim=-1)
+    return positions.numpy() if as_numpy else positions
