@@ -1,0 +1,8 @@
+"""Datasets: every source becomes a :class:`TakeSet` of canonical takes."""
+
+from stylemotion.datasets.base import Take, TakeSet
+from stylemotion.datasets.loading import ConversionSettings, DatasetBuildError
+from stylemotion.datasets.registry import DATASETS, build_dataset, load_dataset, register_dataset
+
+__all__ = ["DATASETS", "ConversionSettings", "DatasetBuildError", "Take", "TakeSet", "build_dataset",
+           "load_dataset", "register_dataset"]

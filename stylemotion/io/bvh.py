@@ -11,6 +11,7 @@ import io
 import os
 import re
 import tempfile
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -28,12 +29,15 @@ _TOKEN = re.compile(r"\S+")
 class _Tokens:
     """Whitespace tokens of the hierarchy section, with their line numbers."""
 
-    def __init__(self, text: str, source: str):
+    def __init__(self, text: str, source: str, motion_line: int | None = None):
         self.source = source
         self.items: list[tuple[str, int]] = []
         for lineno, line in enumerate(text.split("\n"), start=1):
             self.items.extend((tok, lineno) for tok in _TOKEN.findall(line))
         self.pos = 0
+        # Line of the MOTION keyword that ends the hierarchy, or None when the file has none.
+        self.motion_line = motion_line
+        self.last_line = text.count("\n") + 1
 
     @property
     def line(self) -> int:
@@ -43,7 +47,11 @@ class _Tokens:
 
     def next(self, expected: str) -> str:
         if self.pos >= len(self.items):
-            raise BvhError(self.source, f"file ends early, expected {expected}", self.line)
+            if self.motion_line is not None:
+                raise BvhError(self.source, f"hierarchy is incomplete: found 'MOTION', expected {expected}",
+                               self.motion_line)
+            raise BvhError(self.source, f"file ends inside the hierarchy, expected {expected}",
+                           self.line)
         tok = self.items[self.pos][0]
         self.pos += 1
         return tok
@@ -89,23 +97,49 @@ def _parse_hierarchy(tokens: _Tokens) -> Skeleton:
         offsets.append(offset(f"joint {name!r}"))
         channels.append([])
         if tokens.pos < len(tokens.items) and tokens.items[tokens.pos][0] == "CHANNELS":
+            chan_line = tokens.line
             tokens.next("CHANNELS")
-            count_line = tokens.line
             count = tokens.number(f"joint {name!r} channel count")
             if count != int(count) or count < 0:
-                raise BvhError(tokens.source, f"joint {name!r}: bad channel count {count}", count_line)
-            for _ in range(int(count)):
+                raise BvhError(tokens.source, f"joint {name!r}: bad channel count {count}, expected a "
+                               "non-negative integer", chan_line)
+            for k in range(int(count)):
                 ch_line = tokens.line
+                if tokens.pos >= len(tokens.items) or ch_line != chan_line:
+                    # The CHANNELS line ran out of names: the count is larger than the list.
+                    raise BvhError(
+                        tokens.source,
+                        f"joint {name!r}: CHANNELS declares {int(count)} channels but lists {k}, "
+                        f"expected {int(count)} channel names on the CHANNELS line",
+                        chan_line,
+                    )
                 ch = tokens.next(f"joint {name!r} channel name")
                 if ch not in _ROTATION_CHANNELS and ch not in _POSITION_CHANNELS:
                     raise BvhError(
                         tokens.source,
                         f"joint {name!r}: channel {ch!r} is not one of "
-                        f"{sorted(_ROTATION_CHANNELS) + sorted(_POSITION_CHANNELS)} "
+                        f"{sorted(_POSITION_CHANNELS) + sorted(_ROTATION_CHANNELS)} "
                         f"(declared {int(count)} channels)",
                         ch_line,
                     )
                 channels[index].append(ch)
+            if tokens.pos < len(tokens.items) and tokens.line == chan_line:
+                raise BvhError(
+                    tokens.source,
+                    f"joint {name!r}: CHANNELS declares {int(count)} channels but lists more "
+                    f"({tokens.items[tokens.pos][0]!r} is extra), expected exactly {int(count)} names",
+                    chan_line,
+                )
+            axes = [_ROTATION_CHANNELS[c] for c in channels[index] if c in _ROTATION_CHANNELS]
+            positions = [c for c in channels[index] if c in _POSITION_CHANNELS]
+            if axes and sorted(axes) != ["X", "Y", "Z"] or len(set(positions)) != len(positions):
+                raise BvhError(
+                    tokens.source,
+                    f"joint {name!r}: channels {' '.join(channels[index])} are not supported, expected "
+                    "no rotation channels or exactly one each of Xrotation, Yrotation, Zrotation "
+                    "(and no repeated position channel)",
+                    chan_line,
+                )
         while True:
             line = tokens.line
             tok = tokens.next(f"JOINT, End Site or '}}' closing joint {name!r}")
@@ -153,18 +187,20 @@ def parse_bvh(data: bytes | str, source: str = "<memory>") -> Motion:
     raw = data.encode() if isinstance(data, str) else data
     match = re.search(rb"^[ \t]*MOTION[ \t\r]*$", raw, flags=re.MULTILINE)
     if match is None:
-        raise BvhError(source, "no MOTION section (file truncated or not a BVH file)",
-                       raw.count(b"\n") + 1)
+        # Parse what there is so that the error says where the file stops making sense.
+        _raise_missing_motion(raw, source)
+    motion_line = raw[: match.start()].count(b"\n") + 1
     try:
         header = raw[: match.start()].decode("utf-8")
     except UnicodeDecodeError as exc:
         raise BvhError(source, f"hierarchy is not text ({exc})") from None
-    tokens = _Tokens(header, source)
+    tokens = _Tokens(header, source, motion_line)
     if not tokens.items:
         raise BvhError(source, "empty hierarchy, expected 'HIERARCHY'", 1)
     skeleton = _parse_hierarchy(tokens)
     if tokens.pos != len(tokens.items):
-        raise BvhError(source, f"unexpected {tokens.items[tokens.pos][0]!r} after the hierarchy", tokens.line)
+        raise BvhError(source, f"unexpected {tokens.items[tokens.pos][0]!r} after the hierarchy, "
+                       "expected 'MOTION'", tokens.line)
 
     # MOTION section: "Frames: n" and "Frame Time: t" lines, then one row per frame.
     first_line = raw[: match.start()].count(b"\n") + 2  # line number after "MOTION"
@@ -202,6 +238,19 @@ def parse_bvh(data: bytes | str, source: str = "<memory>") -> Motion:
     return _motion_from_channels(skeleton, values, snap_fps(1.0 / frame_time), source)
 
 
+def _raise_missing_motion(raw: bytes, source: str) -> None:
+    """Raise the error for a file without a MOTION line, at the line where it was expected."""
+    header = raw.decode("utf-8", "replace")
+    tokens = _Tokens(header, source)
+    if not tokens.items:
+        raise BvhError(source, "empty file, expected 'HIERARCHY'", 1)
+    _parse_hierarchy(tokens)  # raises, naming the line, when the file ends inside the hierarchy
+    if tokens.pos < len(tokens.items):
+        raise BvhError(source, f"expected 'MOTION' after the hierarchy, found {tokens.items[tokens.pos][0]!r}",
+                       tokens.line)
+    raise BvhError(source, "file ends after the hierarchy, expected 'MOTION'", tokens.last_line)
+
+
 def snap_fps(fps: float, tolerance: float = 1e-3) -> float:
     """Round ``fps`` to an integer when it is within ``tolerance`` (relative) of one.
 
@@ -217,9 +266,16 @@ def _parse_rows(body: bytes, num_frames: int, num_channels: int, source: str, bo
     counts = _token_counts_per_line(body)
     nonempty = np.flatnonzero(counts > 0)
     if nonempty.size < num_frames:
-        last = body_line + (int(nonempty[-1]) if nonempty.size else 0)
+        if nonempty.size and counts[nonempty[-1]] != num_channels:
+            # Cut inside the last row: point at that row.
+            last = int(nonempty[-1])
+            raise BvhError(source, f"file is truncated inside frame row {nonempty.size}: it has "
+                           f"{int(counts[last])} values, expected {num_channels}; header says "
+                           f"{num_frames} frames", body_line + last)
+        # Whole rows missing: point at the line where the next row was expected.
+        missing = body_line + (int(nonempty[-1]) + 1 if nonempty.size else 0)
         raise BvhError(source, f"file is truncated: header says {num_frames} frames, found "
-                       f"{nonempty.size} frame rows", last)
+                       f"{nonempty.size} frame rows; expected frame row {nonempty.size + 1}", missing)
     if nonempty.size > num_frames:
         extra = body_line + int(nonempty[num_frames])
         raise BvhError(source, f"found {nonempty.size} frame rows, header says {num_frames}", extra)
@@ -229,7 +285,10 @@ def _parse_rows(body: bytes, num_frames: int, num_channels: int, source: str, bo
         raise BvhError(source, f"frame row has {int(counts[line])} values, expected {num_channels} "
                        f"(the hierarchy declares {num_channels} channels)", body_line + line)
     try:
-        values = np.fromstring(body, dtype=np.float64, sep=" ")  # noqa: NPY201 - text mode is supported
+        with warnings.catch_warnings():
+            # numpy warns (DeprecationWarning) and stops at an unparsable token; we report it below.
+            warnings.simplefilter("ignore", DeprecationWarning)
+            values = np.fromstring(body, dtype=np.float64, sep=" ")  # noqa: NPY201 - text mode is supported
         ok = values.size == num_frames * num_channels
     except ValueError:
         ok = False

@@ -1,0 +1,113 @@
+"""The Bandai-Namco Research Motion dataset (folder or ``data.zip``).
+
+File names are ``dataset-2_{content}_{style}_{take}.bvh`` with a ``.json`` label file beside each
+(``{"content": i, "style": j}``), whose indices refer to ``cfg/content_label.txt`` and
+``cfg/style_label.txt`` (lines like ``dataset-2_walk``). Both must agree; a disagreement is an
+error naming the file and the key.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+from pathlib import Path
+
+from stylemotion.datasets.base import TakeSet
+from stylemotion.datasets.loading import ConversionSettings, TakeSpec, build_takeset
+from stylemotion.io.errors import MotionDataError
+from stylemotion.io.sources import FileSource, list_sources
+
+FILE_NAME = re.compile(r"^(?P<prefix>dataset-\d+)_(?P<content>[a-z-]+)_(?P<style>[a-z]+)_(?P<take>\d+)$")
+
+
+def find_label_tables(root: Path, label_dir: str | os.PathLike | None = None) -> tuple[list[str], list[str]]:
+    """Content and style label tables (index → name without the ``dataset-N_`` prefix)."""
+    candidates = [Path(label_dir)] if label_dir else [
+        root / "cfg", root.parent / "cfg", root.parent.parent / "cfg"]
+    for folder in candidates:
+        content, style = folder / "content_label.txt", folder / "style_label.txt"
+        if content.is_file() and style.is_file():
+            return _read_table(content), _read_table(style)
+    raise MotionDataError(str(root), "label tables content_label.txt and style_label.txt not found in "
+                          + ", ".join(str(c) for c in candidates) + " (set data.label_dir)")
+
+
+def _read_table(path: Path) -> list[str]:
+    names = []
+    for lineno, line in enumerate(path.read_text().splitlines(), start=1):
+        line = line.strip()
+        if not line:
+            continue
+        match = re.fullmatch(r"dataset-\d+_(\S+)", line)
+        if match is None:
+            raise MotionDataError(str(path), f"expected a label like 'dataset-2_walk', found {line!r}", lineno)
+        names.append(match.group(1))
+    return names
+
+
+def bandai_labels(source: FileSource, contents: list[str], styles: list[str]) -> dict[str, str]:
+    """Labels of one file from its name, checked against its JSON label file."""
+    match = FILE_NAME.match(source.stem)
+    if match is None:
+        raise MotionDataError(source.name, "file name does not follow dataset-N_{content}_{style}_{take}.bvh")
+    labels = {"content": match["content"], "style": match["style"], "take": match["take"]}
+    json_source = source.sibling(".json")
+    if not json_source.exists():
+        raise MotionDataError(json_source.name, "label file missing")
+    try:
+        data = json.loads(json_source.read_bytes())
+    except json.JSONDecodeError as exc:
+        raise MotionDataError(json_source.name, f"label file is not valid JSON ({exc.msg})", exc.lineno) from None
+    for key, table in (("content", contents), ("style", styles)):
+        if key not in data:
+            raise MotionDataError(json_source.name, f"key {key!r} missing")
+        index = data[key]
+        if not isinstance(index, int) or not 0 <= index < len(table):
+            raise MotionDataError(json_source.name, f"key {key!r} = {index!r} is not an index into the "
+                                  f"{len(table)} {key} labels")
+        if table[index] != labels[key]:
+            raise MotionDataError(json_source.name, f"key {key!r} = {index} means {table[index]!r} but the "
+                                  f"file name says {labels[key]!r}")
+    return labels
+
+
+def load_bandai(
+    root: str | os.PathLike,
+    label_dir: str | os.PathLike | None = None,
+    contents: list[str] | None = None,
+    styles: list[str] | None = None,
+    settings: ConversionSettings | None = None,
+    skip_broken: bool = False,
+    cache_dir: str | os.PathLike | None = None,
+    use_cache: bool = True,
+    workers: int | None = None,
+) -> TakeSet:
+    """All (or the selected contents'/styles') takes of the Bandai dataset.
+
+    Args:
+        root: the dataset folder or its ``data.zip``.
+        label_dir: folder with the label tables (default: ``cfg`` beside or above ``root``).
+        contents, styles: keep only these labels (None keeps all).
+        settings: conversion settings (default 30 fps, detected units and joint map).
+        skip_broken, cache_dir, use_cache, workers: see :func:`build_takeset`.
+    """
+    root = Path(root)
+    content_table, style_table = find_label_tables(root if root.is_dir() else root.parent, label_dir)
+    for key, wanted, table in (("content", contents, content_table), ("style", styles, style_table)):
+        unknown = sorted(set(wanted or []) - set(table))
+        if unknown:
+            raise MotionDataError(str(root), f"unknown {key} {unknown}; the dataset has {table}")
+    specs: list[TakeSpec] = []
+    failures: list[tuple[str, str]] = []
+    for source in list_sources(root, "*.bvh"):
+        try:
+            labels = bandai_labels(source, content_table, style_table)
+        except MotionDataError as exc:
+            failures.append((source.name, str(exc)))
+            continue
+        if (contents and labels["content"] not in contents) or (styles and labels["style"] not in styles):
+            continue
+        specs.append(TakeSpec(source.stem, source, labels))
+    return build_takeset("bandai", specs, settings or ConversionSettings(), failures, skip_broken,
+                         cache_dir, use_cache, workers)

@@ -1,0 +1,130 @@
+"""Takes and take collections: what every dataset produces.
+
+A *take* is one continuous recording converted to canonical positions (metres, Y up, canonical
+21-joint order) at the dataset's fps, with string labels (``content``, ``style``, ``take`` and
+whatever else the source knows).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from functools import cached_property
+
+import numpy as np
+
+from stylemotion.representation import positions_to_frames
+
+
+@dataclass
+class Take:
+    """One recording on the canonical skeleton.
+
+    Attributes:
+        name: unique id within its dataset (e.g. the file stem).
+        positions: ``(frames, 21, 3)`` float32 global positions, metres, Y up.
+        fps: frames per second.
+        labels: at least ``content`` and ``style``; ``take`` identifies the recording.
+        source: file path or ``zip::member`` it came from.
+    """
+
+    name: str
+    positions: np.ndarray
+    fps: float
+    labels: dict[str, str] = field(default_factory=dict)
+    source: str = ""
+
+    @property
+    def num_frames(self) -> int:
+        return int(self.positions.shape[0])
+
+    @property
+    def content(self) -> str:
+        return self.labels.get("content", "")
+
+    @property
+    def style(self) -> str:
+        return self.labels.get("style", "")
+
+    @cached_property
+    def frames(self) -> np.ndarray:
+        """``(frames, 66)`` float32 frame representation (see :mod:`stylemotion.representation`)."""
+        return positions_to_frames(self.positions, self.fps)[0]
+
+
+@dataclass
+class TakeSet:
+    """The takes of a dataset plus its deterministic split into train/val/test by take.
+
+    Attributes:
+        name: dataset name (``bandai``, ``bvh_folder``, ``synthetic``).
+        takes: all takes, sorted by name.
+        fps: the common frame rate of all takes.
+        skipped: ``[(source, reason)]`` for inputs that were skipped (only with skip_broken).
+    """
+
+    name: str
+    takes: list[Take]
+    fps: float
+    skipped: list[tuple[str, str]] = field(default_factory=list)
+
+    def __len__(self) -> int:
+        return len(self.takes)
+
+    @property
+    def num_frames(self) -> int:
+        return sum(t.num_frames for t in self.takes)
+
+    def filter(self, **labels: str | list[str] | tuple[str, ...]) -> list[Take]:
+        """Takes whose labels match, e.g. ``filter(content="walk", style=["normal", "elderly"])``."""
+        def ok(take: Take) -> bool:
+            for key, want in labels.items():
+                allowed = [want] if isinstance(want, str) else list(want)
+                if take.labels.get(key) not in allowed:
+                    return False
+            return True
+
+        return [t for t in self.takes if ok(t)]
+
+    def label_values(self, key: str) -> list[str]:
+        """Sorted distinct values of label ``key``."""
+        return sorted({t.labels.get(key, "") for t in self.takes})
+
+    def split(
+        self, seed: int = 0, val_fraction: float = 0.1, test_fraction: float = 0.1,
+        group_by: tuple[str, ...] = ("content", "style"),
+    ) -> dict[str, list[Take]]:
+        """Seeded split by take: each take is wholly in one of ``train``, ``val``, ``test``.
+
+        Takes are shuffled within each group of equal ``group_by`` labels so that every group
+        contributes to every split in proportion (a group of n takes gives
+        ``round(n·fraction)`` to val and test, at least one each when n ≥ 3).
+        """
+        if not 0 <= val_fraction < 1 or not 0 <= test_fraction < 1 or val_fraction + test_fraction >= 1:
+            raise ValueError(f"split fractions must be in [0, 1) and sum below 1, got val={val_fraction}, "
+                             f"test={test_fraction}")
+        rng = np.random.default_rng(seed)
+        groups: dict[tuple[str, ...], list[Take]] = {}
+        for take in self.takes:
+            groups.setdefault(tuple(take.labels.get(k, "") for k in group_by), []).append(take)
+        out: dict[str, list[Take]] = {"train": [], "val": [], "test": []}
+        for key in sorted(groups):
+            members = groups[key]
+            order = rng.permutation(len(members))
+            n = len(members)
+            n_val = _share(n, val_fraction)
+            n_test = _share(n, test_fraction)
+            if n_val + n_test >= n:  # always keep at least one take for training
+                n_val, n_test = (min(n_val, max(n - 1, 0)), 0) if n < 3 else (n_val, n - 1 - n_val)
+            picks = [members[i] for i in order]
+            out["val"].extend(picks[:n_val])
+            out["test"].extend(picks[n_val:n_val + n_test])
+            out["train"].extend(picks[n_val + n_test:])
+        for part in out.values():
+            part.sort(key=lambda t: t.name)
+        return out
+
+
+def _share(n: int, fraction: float) -> int:
+    if fraction <= 0:
+        return 0
+    return max(1, round(n * fraction)) if n >= 3 else 0

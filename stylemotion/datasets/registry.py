@@ -1,0 +1,87 @@
+"""One registry of datasets, addressed by name from the Hydra config group ``data/``."""
+
+from __future__ import annotations
+
+import inspect
+from typing import Any, Callable, Mapping
+
+from stylemotion.datasets.base import Take, TakeSet
+from stylemotion.datasets.bandai import load_bandai
+from stylemotion.datasets.bvh_folder import load_bvh_folder
+from stylemotion.datasets.loading import ConversionSettings
+
+DatasetLoader = Callable[..., TakeSet]
+DATASETS: dict[str, DatasetLoader] = {}
+
+#: Keys of a data config that are conversion settings rather than loader arguments.
+_CONVERSION_KEYS = ("fps", "joint_map", "unit_scale", "up_axis")
+#: Keys of a data config used by the data modules, not by the loaders.
+_MODULE_KEYS = ("name", "split")
+
+
+def register_dataset(name: str) -> Callable[[DatasetLoader], DatasetLoader]:
+    """Decorator adding a loader ``f(**options) -> TakeSet`` under ``name``."""
+    def add(loader: DatasetLoader) -> DatasetLoader:
+        if name in DATASETS:
+            raise ValueError(f"dataset {name!r} is registered twice")
+        DATASETS[name] = loader
+        return loader
+    return add
+
+
+register_dataset("bandai")(load_bandai)
+register_dataset("bvh_folder")(load_bvh_folder)
+
+
+@register_dataset("synthetic")
+def load_synthetic(
+    takes_per_pair: int = 4, seed: int = 0, fps: float = 30.0, duration_s: float = 8.0,
+    styles: list[str] | None = None, contents: list[str] | None = None,
+) -> TakeSet:
+    """The procedural stylized-locomotion dataset (see :mod:`stylemotion.datasets.synthetic`)."""
+    from stylemotion.datasets.synthetic import generate_takes
+
+    generated = generate_takes(takes_per_pair=takes_per_pair, seed=seed, fps=fps, duration_s=duration_s,
+                               styles=styles, contents=contents)
+    takes = [Take(g.name, g.positions, g.fps, dict(g.labels), source=f"synthetic(seed={seed})")
+             for g in sorted(generated, key=lambda g: g.name)]
+    return TakeSet("synthetic", takes, fps)
+
+
+def load_dataset(name: str, **options: Any) -> TakeSet:
+    """Build dataset ``name`` with loader ``options``; unknown names or keys get a clear error.
+
+    Conversion keys (``fps``, ``joint_map``, ``unit_scale``, ``up_axis``) are gathered into a
+    :class:`ConversionSettings` for the loaders that convert files.
+    """
+    if name not in DATASETS:
+        raise KeyError(f"unknown dataset {name!r}; registered: {sorted(DATASETS)}")
+    loader = DATASETS[name]
+    params = inspect.signature(loader).parameters
+    if "settings" in params:
+        conv = {k: options.pop(k) for k in _CONVERSION_KEYS if k in options}
+        options["settings"] = ConversionSettings(**conv)
+    unknown = sorted(set(options) - set(params))
+    if unknown:
+        valid = sorted(set(params) - {"settings"} | (set(_CONVERSION_KEYS) if "settings" in params else set()))
+        raise KeyError(f"dataset {name!r} has no option(s) {unknown}; valid options: {valid}")
+    return loader(**options)
+
+
+def build_dataset(cfg: Mapping[str, Any]) -> TakeSet:
+    """Build the dataset described by a ``data`` config node (``name`` plus options)."""
+    options = {k: _plain(v) for k, v in dict(cfg).items() if k not in _MODULE_KEYS}
+    if "name" not in cfg:
+        raise KeyError(f"data config needs a 'name' (one of {sorted(DATASETS)})")
+    return load_dataset(str(cfg["name"]), **options)
+
+
+def _plain(value: Any) -> Any:
+    """OmegaConf containers to plain Python values."""
+    try:
+        from omegaconf import DictConfig, ListConfig, OmegaConf
+    except ImportError:  # pragma: no cover - hydra-core is a dependency
+        return value
+    if isinstance(value, (DictConfig, ListConfig)):
+        return OmegaConf.to_container(value, resolve=True)
+    return value
