@@ -60,7 +60,8 @@ class Motion:
         if fps <= 0:
             raise ValueError(f"{self.source}: target fps must be positive, got {fps}")
         if abs(fps - self.fps) < 1e-9 * fps or self.num_frames < 2:
-            return replace(self, fps=float(fps)) if self.num_frames >= 2 else self
+            # Same rate, or a single pose (nothing to interpolate): only the stated fps changes.
+            return replace(self, fps=float(fps))
         times = np.arange(self.num_frames) / self.fps
         n_new = int(np.floor(self.duration * fps + 1e-6)) + 1
         new_times = np.minimum(np.arange(n_new) / fps, times[-1])

@@ -150,14 +150,16 @@ def forward_kinematics_torch(
     Returns:
         ``(..., joints, 3)`` global positions.
     """
+    lead = torch.broadcast_shapes(rotations.shape[:-3], translations.shape[:-2])
     global_rot: list[torch.Tensor] = []
     global_pos: list[torch.Tensor] = []
     for j, p in enumerate(parents):
         r_local = rotations[..., j, :, :]
         t_local = translations[..., j, :]
         if p < 0:
-            global_rot.append(r_local)
-            global_pos.append(t_local.expand(r_local.shape[:-2] + (3,)))
+            # Broadcast like the numpy FK: either input may carry the batch dimensions.
+            global_rot.append(r_local.expand(lead + (3, 3)))
+            global_pos.append(t_local.expand(lead + (3,)))
         else:
             global_rot.append(global_rot[p] @ r_local)
             global_pos.append(global_pos[p] + (global_rot[p] @ t_local.unsqueeze(-1)).squeeze(-1))

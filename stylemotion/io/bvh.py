@@ -105,16 +105,18 @@ def _parse_hierarchy(tokens: _Tokens) -> Skeleton:
                                "non-negative integer", chan_line)
             for k in range(int(count)):
                 ch_line = tokens.line
-                if tokens.pos >= len(tokens.items) or ch_line != chan_line:
-                    # The CHANNELS line ran out of names: the count is larger than the list.
+                ch = tokens.items[tokens.pos][0] if tokens.pos < len(tokens.items) else None
+                valid = ch in _ROTATION_CHANNELS or ch in _POSITION_CHANNELS
+                if not valid and (ch is None or ch_line != chan_line):
+                    # The channel list ran out of names: the count is larger than the list.
                     raise BvhError(
                         tokens.source,
                         f"joint {name!r}: CHANNELS declares {int(count)} channels but lists {k}, "
-                        f"expected {int(count)} channel names on the CHANNELS line",
+                        f"expected {int(count)} channel names",
                         chan_line,
                     )
-                ch = tokens.next(f"joint {name!r} channel name")
-                if ch not in _ROTATION_CHANNELS and ch not in _POSITION_CHANNELS:
+                tokens.next(f"joint {name!r} channel name")
+                if not valid:
                     raise BvhError(
                         tokens.source,
                         f"joint {name!r}: channel {ch!r} is not one of "
@@ -123,7 +125,10 @@ def _parse_hierarchy(tokens: _Tokens) -> Skeleton:
                         ch_line,
                     )
                 channels[index].append(ch)
-            if tokens.pos < len(tokens.items) and tokens.line == chan_line:
+            if tokens.pos < len(tokens.items) and (
+                tokens.items[tokens.pos][0] in _ROTATION_CHANNELS
+                or tokens.items[tokens.pos][0] in _POSITION_CHANNELS
+            ):
                 raise BvhError(
                     tokens.source,
                     f"joint {name!r}: CHANNELS declares {int(count)} channels but lists more "
@@ -132,7 +137,7 @@ def _parse_hierarchy(tokens: _Tokens) -> Skeleton:
                 )
             axes = [_ROTATION_CHANNELS[c] for c in channels[index] if c in _ROTATION_CHANNELS]
             positions = [c for c in channels[index] if c in _POSITION_CHANNELS]
-            if axes and sorted(axes) != ["X", "Y", "Z"] or len(set(positions)) != len(positions):
+            if (axes and sorted(axes) != ["X", "Y", "Z"]) or len(set(positions)) != len(positions):
                 raise BvhError(
                     tokens.source,
                     f"joint {name!r}: channels {' '.join(channels[index])} are not supported, expected "
@@ -246,8 +251,8 @@ def _raise_missing_motion(raw: bytes, source: str) -> None:
         raise BvhError(source, "empty file, expected 'HIERARCHY'", 1)
     _parse_hierarchy(tokens)  # raises, naming the line, when the file ends inside the hierarchy
     if tokens.pos < len(tokens.items):
-        raise BvhError(source, f"expected 'MOTION' after the hierarchy, found {tokens.items[tokens.pos][0]!r}",
-                       tokens.line)
+        found = tokens.items[tokens.pos][0]
+        raise BvhError(source, f"expected 'MOTION' after the hierarchy, found {found!r}", tokens.line)
     raise BvhError(source, "file ends after the hierarchy, expected 'MOTION'", tokens.last_line)
 
 
@@ -282,8 +287,11 @@ def _parse_rows(body: bytes, num_frames: int, num_channels: int, source: str, bo
     bad = nonempty[counts[nonempty] != num_channels]
     if bad.size:
         line = int(bad[0])
+        cut_short = line == nonempty[-1] and counts[line] < num_channels
+        ends_mid_row = not body.rstrip(b" \t").endswith(b"\n")
+        hint = "; the file looks truncated inside its last row" if cut_short and ends_mid_row else ""
         raise BvhError(source, f"frame row has {int(counts[line])} values, expected {num_channels} "
-                       f"(the hierarchy declares {num_channels} channels)", body_line + line)
+                       f"(the hierarchy declares {num_channels} channels){hint}", body_line + line)
     try:
         with warnings.catch_warnings():
             # numpy warns (DeprecationWarning) and stops at an unparsable token; we report it below.
