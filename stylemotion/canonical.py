@@ -8,10 +8,10 @@ This is the single code path used by the datasets and by ``stylemotion-convert``
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
-from typing import Mapping
 
 import numpy as np
 import yaml
@@ -48,7 +48,8 @@ class JointMap:
                 f"joint map {self.name!r}",
                 (f"missing canonical joints {missing}" if missing else "")
                 + ("; " if missing and unknown else "")
-                + (f"unknown canonical joints {unknown} (canonical: {list(CANONICAL_JOINTS)})" if unknown else ""),
+                + (f"unknown canonical joints {unknown} (canonical: {list(CANONICAL_JOINTS)})"
+                   if unknown else ""),
             )
 
     @classmethod
@@ -93,14 +94,16 @@ def resolve_joint_map(spec: str | Mapping[str, str] | JointMap | None, motion: M
         raise MotionDataError(
             motion.source,
             "no built-in joint map fits this skeleton (built-in: "
-            + ", ".join(f"{k}: missing {[s for s in v.joints.values() if s not in names][:4]}" for k, v in builtin.items())
+            + ", ".join(f"{k}: missing {[s for s in v.joints.values() if s not in names][:4]}"
+                        for k, v in builtin.items())
             + "); pass a joint map YAML with joints: {canonical: source}",
         )
     if spec in builtin:
         return builtin[spec]
     if Path(spec).suffix in (".yaml", ".yml"):
         return JointMap.from_yaml(spec)
-    raise MotionDataError(str(spec), f"unknown joint map; built-in maps are {sorted(builtin)} or give a YAML path")
+    raise MotionDataError(str(spec), f"unknown joint map; built-in maps are {sorted(builtin)} "
+                          "or give a YAML path")
 
 
 def source_indices(motion: Motion, joint_map: JointMap) -> list[int]:
@@ -178,6 +181,9 @@ def to_canonical_positions(
         scale = UNIT_SCALES[unit_scale]
     else:
         scale = detect_unit_scale(motion, jm) if unit_scale is None else float(unit_scale)
+        if not np.isfinite(scale) or scale <= 0:
+            raise MotionDataError(motion.source, f"unit_scale must be a positive number of metres per file "
+                                  f"unit or a unit name ({sorted(UNIT_SCALES)}), got {unit_scale!r}")
     if up_axis not in _UP_TO_Y:
         raise MotionDataError(motion.source, f"up_axis must be one of {sorted(_UP_TO_Y)}, got {up_axis!r}")
     if fps is not None:

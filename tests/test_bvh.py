@@ -218,7 +218,7 @@ def test_hierarchy_unclosed_before_motion(write_text):
 
 
 def test_channel_count_larger_than_list(write_text):
-    text = tiny_bvh_text().replace("CHANNELS 3 Zrotation Xrotation Yrotation", "CHANNELS 4 Zrotation Xrotation Yrotation")
+    text = tiny_bvh_text().replace("CHANNELS 3 Zrotation X", "CHANNELS 4 Zrotation X")
     path = write_text(text)
     _expect_error(path, line_of(text, "CHANNELS 4"), "'Spine'", "declares 4 channels but lists 3")
 
@@ -237,14 +237,14 @@ def test_channel_count_smaller_than_list(write_text):
 
 
 def test_unknown_channel_name(write_text):
-    text = tiny_bvh_text().replace("CHANNELS 3 Zrotation Yrotation Xrotation", "CHANNELS 3 Zrotation Wrotation Xrotation")
+    text = tiny_bvh_text().replace("Zrotation Yrotation Xrotation", "Zrotation Wrotation Xrotation")
     path = write_text(text)
     err = _expect_error(path, line_of(text, "Wrotation"), "'Head'", "'Wrotation'", "Xrotation")
     assert "Yposition" in err.detail  # lists what was expected
 
 
 def test_repeated_rotation_axis(write_text):
-    text = tiny_bvh_text().replace("CHANNELS 3 Xrotation Yrotation Zrotation", "CHANNELS 3 Xrotation Yrotation Xrotation")
+    text = tiny_bvh_text().replace("Xrotation Yrotation Zrotation", "Xrotation Yrotation Xrotation")
     path = write_text(text)
     _expect_error(path, line_of(text, "Xrotation Yrotation Xrotation"), "'LeftLeg'", "exactly one each")
 

@@ -13,10 +13,12 @@ from stylemotion.skeleton import forward_kinematics, forward_kinematics_torch
 
 bvhio = pytest.importorskip("bvhio")
 
-#: bvhio computes in float32 (PyGLM vec3/quat), so its world positions carry a rounding error of a
-#: few float32 ulps of the coordinate's magnitude (Bandai roots sit ~5 m = 500 cm from the origin,
-#: where one ulp is 3e-5 cm). The bound is 1e-4 file units, or 4 float32 ulps of the largest
-#: coordinate when that is larger.
+#: bvhio computes in float32 (PyGLM vec3/quat, a transform per joint), so its world positions carry
+#: rounding errors of a few float32 ulps of the largest coordinates along each chain. Bandai takes sit
+#: up to ~5.5 m (550 cm) from the origin, where one ulp is 3e-5..6e-5 cm, and bvhio's deviation there
+#: reaches ~2e-4 cm (our own FK run in float32 on the same take deviates 6e-5 cm from float64). The
+#: bound is therefore 1e-4 file units, or 8 float32 ulps of the largest coordinate when that is larger
+#: (4.6e-4 cm at 480 cm; still under 5 micrometres). The other conventions are held to 1e-4 file units.
 FLOAT32_EPS = float(np.finfo(np.float32).eps)
 
 
@@ -31,14 +33,14 @@ def _bvhio_world_positions(path, frames):
     return np.array(out, dtype=np.float64), [joint.Name for joint in layout]
 
 
-def _check_against_bvhio(path, motion):
+def _check_against_bvhio(path, motion, float32_bound: bool = False):
     n = motion.num_frames
     rng = np.random.default_rng(0)
     frames = sorted({0, 1, n // 3, n // 2, n - 1, *rng.integers(0, n, 3).tolist()})
     ours = motion.global_positions()[frames]
     ref, names = _bvhio_world_positions(path, frames)
     assert names == motion.skeleton.names
-    tol = max(1e-4, 4 * FLOAT32_EPS * np.abs(ref).max())
+    tol = max(1e-4, 8 * FLOAT32_EPS * np.abs(ref).max()) if float32_bound else 1e-4
     err = np.abs(ours - ref).max()
     assert err <= tol, f"{path}: max FK deviation from bvhio {err:.3g} > {tol:.3g} file units"
     # The comparison is not vacuous: the joints move between the checked frames.
@@ -54,12 +56,12 @@ def test_fk_matches_bvhio_other_conventions(name, other_skeleton_paths):
 
 
 @pytest.mark.realdata
-def test_fk_matches_bvhio_bandai(bandai_zip, tmp_path):
-    member = BANDAI_MEMBERS[0]
+@pytest.mark.parametrize("member", BANDAI_MEMBERS)
+def test_fk_matches_bvhio_bandai(bandai_zip, tmp_path, member):
     path = tmp_path / member
     path.write_bytes(bandai_zip.read(member))  # bvhio reads paths only; the zip stays untouched
     motion = parse_bvh(bandai_zip.read(member), f"{bandai_zip.filename}::{member}")
-    _check_against_bvhio(path, motion)
+    _check_against_bvhio(path, motion, float32_bound=True)
 
 
 @pytest.mark.realdata

@@ -1,0 +1,636 @@
+"""Deterministic procedural stylized locomotion on the canonical 21-joint skeleton.
+
+The embedded default dataset: a fresh clone can train and test on it with no download. It is a
+ground truth for tests (exact foot contacts, known turning direction, styles that differ in known
+ways), never evidence that a method works on real motion.
+
+Everything is built at the position level so that the contacts are exact:
+
+1. **Footsteps** are planned first: alternating left/right footfalls with per-step random step
+   length, width, duration and heading. Turning takes follow a heading curve that turns by about
+   ±90° over the take (``walk-turn-left`` turns left, i.e. positive yaw); straight takes drift a
+   little.
+2. **Feet**: a planted foot (ankle and toes) stays exactly fixed on the ground from its footfall to
+   its lift-off; the swing foot follows a minimum-jerk path with a height bump (knee lift) and a
+   toe-off/heel-strike pitch. Walks overlap stances (double support, about 20% of the cycle); runs
+   have flight phases.
+3. **Pelvis**: a cubic spline through the stance feet (with lateral sway), at a height that is the
+   smooth minimum of a style's carriage height and what both legs can reach, so the inverted
+   pendulum bob of walking comes out of the leg geometry.
+4. **Body**: pelvis, spine, head and arms are posed by rotating a rest skeleton (torso lean, head
+   drop, pelvis twist and list, shoulder counter-rotation, arm swing opposite to the legs) through
+   :func:`stylemotion.skeleton.forward_kinematics`; knees come from an analytic two-bone IK with a
+   forward pole. Every bone keeps its length exactly.
+
+Conventions: positions ``(frames, 21, 3)`` in metres, Y up, ground at ``y = 0``; yaw ``θ`` faces
+``(sin θ, 0, cos θ)`` and the body's left is ``(cos θ, 0, −sin θ)`` (see
+:mod:`stylemotion.representation`). Every take starts with the pelvis above the origin, facing +Z.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.interpolate import CubicSpline
+from scipy.special import logsumexp
+
+from stylemotion.skeleton import CANONICAL_PARENTS, CJ, forward_kinematics
+
+CONTENTS: tuple[str, ...] = ("walk", "walk-turn-left", "walk-turn-right", "run")
+
+# Rest skeleton of a 1.75 m adult, metres, body frame (+X left, +Y up, +Z forward); the offset of
+# each joint from its parent. ``_SIDE`` marks the left (+1) / right (-1) joints mirrored in x.
+_ANKLE_HEIGHT = 0.08  # ankle above the ground with the foot flat
+_TOE_HEIGHT = 0.02  # ball of the foot above the ground with the foot flat
+_THIGH = 0.43
+_SHIN = 0.42
+_PELVIS_DROP = 0.06  # hip joints below the Hips joint
+_FOOT = np.array([0.0, _TOE_HEIGHT - _ANKLE_HEIGHT, 0.14])  # ankle → toes, foot flat
+_SPINE = np.array([0.0, 0.10, 0.0])
+_CHEST = np.array([0.0, 0.18, 0.0])
+_NECK = np.array([0.0, 0.20, 0.0])
+_HEAD = np.array([0.0, 0.08, 0.02])
+_CLAVICLE_BASE = np.array([0.035, 0.16, 0.0])  # chest → shoulder (clavicle start)
+_UPPER_ARM = 0.29
+_FOREARM = 0.26
+
+_SOFTMIN_M = 0.01  # smoothing width of the pelvis height limit, metres
+_REACH = 0.995  # fraction of thigh + shin the hip-ankle distance may reach
+_FEET_CLEARANCE = 0.11  # least lateral ankle distance while the swing foot passes, metres
+# Slack per unit of swing progress, as a fraction of the leg's length, with which a swinging leg's
+# last footfall spot stops limiting the pelvis height after lift-off (fast) and its next spot starts
+# limiting it before the footfall (slowly: the pelvis descends as the leg reaches forward).
+_LIFT_SLACK = 4.0
+_LAND_SLACK = 2.0
+
+
+@dataclass(frozen=True)
+class _Style:
+    """Gait and posture of one style (walking; runs are derived in :func:`_gait_for`).
+
+    Lengths in metres for a 1.75 m body, times in seconds, angles in radians.
+    """
+
+    step_length: float  # distance between consecutive footfalls
+    step_time: float  # time between consecutive footfalls (60 / cadence in steps per minute)
+    step_width: float  # lateral distance between left and right ankle lines (< 0: crossing)
+    stance: float  # stance fraction of a gait cycle (0.6 → 20% double support)
+    run_stance: float  # the same when running (< 0.5: flight phases)
+    lift: float  # swing-foot ankle lift above its planted height
+    carriage: float  # pelvis carriage height as a fraction of thigh + shin (knee bend)
+    bounce: float  # extra vertical bob of the pelvis at midstance
+    sway: float  # lateral pelvis shift towards the stance foot
+    pelvis_twist: float  # pelvis yaw amplitude (leg side forward with its leg)
+    pelvis_list: float  # pelvis roll amplitude (hip drop on the swing side)
+    lean: float  # forward torso lean
+    head_drop: float  # forward head flexion on top of the lean
+    arm_swing: float  # shoulder flexion amplitude, opposite to the legs
+    arm_forward: float  # mean shoulder flexion
+    elbow: float  # mean elbow flexion
+    arm_abduction: float  # arms held away from the body
+    shoulder_droop: float  # clavicles lowered (negative: raised)
+    shoulder_protraction: float  # clavicles rolled forward
+    chest_twist: float  # shoulder-line counter-rotation amplitude
+    toe_out: float  # foot yaw away from the walking direction
+    clavicle: float  # shoulder → upper-arm joint (shoulder width)
+    hip_width: float  # Hips → hip joint, lateral
+
+
+_NORMAL = _Style(
+    step_length=0.66, step_time=0.53, step_width=0.12, stance=0.60, run_stance=0.36, lift=0.10,
+    carriage=0.975, bounce=0.0, sway=0.025, pelvis_twist=0.08, pelvis_list=0.06, lean=0.04,
+    head_drop=0.0, arm_swing=0.30, arm_forward=0.05, elbow=0.25, arm_abduction=0.10,
+    shoulder_droop=0.0, shoulder_protraction=0.0, chest_twist=0.08, toe_out=0.12, clavicle=0.14,
+    hip_width=0.09,
+)  # fmt: skip
+
+_STYLE_TABLE: dict[str, _Style] = {
+    "active": dataclasses.replace(
+        _NORMAL, step_length=0.80, step_time=0.49, run_stance=0.32, lift=0.13, bounce=0.01,
+        pelvis_twist=0.12, pelvis_list=0.05, lean=0.08, arm_swing=0.50, arm_forward=0.08, elbow=0.55,
+        chest_twist=0.12,
+    ),
+    "elderly": dataclasses.replace(
+        _NORMAL, step_length=0.42, step_time=0.60, step_width=0.15, stance=0.64, run_stance=0.43,
+        lift=0.06, carriage=0.93, sway=0.03, pelvis_twist=0.04, pelvis_list=0.04, lean=0.30,
+        head_drop=0.15, arm_swing=0.10, arm_forward=0.15, elbow=0.45, arm_abduction=0.12,
+        shoulder_droop=0.05, shoulder_protraction=0.15, chest_twist=0.03, toe_out=0.20, clavicle=0.13,
+    ),
+    "exhausted": dataclasses.replace(
+        _NORMAL, step_length=0.50, step_time=0.68, step_width=0.13, stance=0.62, run_stance=0.42,
+        lift=0.035, carriage=0.95, sway=0.035, pelvis_twist=0.05, pelvis_list=0.05, lean=0.20,
+        head_drop=0.45, arm_swing=0.12, arm_forward=0.0, elbow=0.10, arm_abduction=0.06,
+        shoulder_droop=0.20, shoulder_protraction=0.15, chest_twist=0.04,
+    ),
+    "feminine": dataclasses.replace(
+        _NORMAL, step_length=0.60, step_time=0.48, step_width=0.01, lift=0.09, carriage=0.98,
+        bounce=0.005, sway=0.05, pelvis_twist=0.14, pelvis_list=0.12, lean=-0.02, head_drop=-0.03,
+        arm_swing=0.25, arm_forward=0.0, elbow=0.35, arm_abduction=0.06, chest_twist=0.05,
+        toe_out=0.05, clavicle=0.125, hip_width=0.10,
+    ),
+    "masculine": dataclasses.replace(
+        _NORMAL, step_length=0.70, step_time=0.55, step_width=0.22, carriage=0.97, sway=0.015,
+        pelvis_twist=0.06, pelvis_list=0.03, lean=0.02, arm_swing=0.35, elbow=0.30,
+        arm_abduction=0.22, shoulder_droop=-0.05, chest_twist=0.20, toe_out=0.25, clavicle=0.165,
+    ),
+    "normal": _NORMAL,
+    "youthful": dataclasses.replace(
+        _NORMAL, step_length=0.70, step_time=0.45, step_width=0.11, run_stance=0.33, lift=0.18,
+        carriage=0.98, bounce=0.025, sway=0.02, pelvis_twist=0.10, lean=0.0, head_drop=-0.05,
+        arm_swing=0.55, arm_forward=0.10, elbow=0.45, arm_abduction=0.12, shoulder_droop=-0.05,
+        chest_twist=0.12, toe_out=0.08,
+    ),
+}  # fmt: skip
+
+#: Style labels, named as in the Bandai-Namco dataset ("normal" is the neutral style).
+STYLES: tuple[str, ...] = tuple(_STYLE_TABLE)
+
+
+@dataclass
+class SyntheticTake:
+    """One generated take.
+
+    Attributes:
+        name: unique id, ``synthetic_{content}_{style}_{index:03d}``.
+        positions: ``(frames, 21, 3)`` float32 canonical global positions, metres, Y up.
+        fps: frames per second.
+        labels: ``content``, ``style``, ``take`` (the zero-padded index) and ``actor``.
+        contacts: ``(frames, 2)`` bool ground-truth foot contact; column 0 left foot, 1 right.
+    """
+
+    name: str
+    positions: np.ndarray
+    fps: float
+    labels: dict[str, str]
+    contacts: np.ndarray
+
+
+@dataclass(frozen=True)
+class _Gait:
+    """What one take does: a style's parameters for its content, varied per take and scaled."""
+
+    style: _Style
+    stance: float  # stance fraction of a cycle
+    lift_peak: float  # swing progress (0..1) at which the ankle is highest
+    toe_pitch: float  # toe-down / toe-up amplitude of the swing foot, radians
+    running: bool
+    scale: float  # body size relative to the 1.75 m rest skeleton
+
+
+@dataclass(frozen=True)
+class _Heading:
+    """Body heading over time: a turn spread over the take plus a slow drift, radians."""
+
+    turn: float  # total turn over the take (positive: left)
+    duration: float  # seconds
+    drift: float  # radians per second
+    wander: float  # amplitude of a slow sinusoidal wander
+    wander_phase: float
+
+    def __call__(self, t: np.ndarray) -> np.ndarray:
+        """Heading ``(n,)`` radians at times ``t`` ``(n,)`` seconds (0 at ``t = 0``)."""
+        u = np.clip(t / self.duration, 0.0, 1.0)
+        turned = self.turn * (u - np.sin(2 * np.pi * u) / (2 * np.pi))
+        wander = self.wander * (np.sin(2 * np.pi * t / 5.0 + self.wander_phase) - np.sin(self.wander_phase))
+        return turned + self.drift * t + wander
+
+
+@dataclass(frozen=True)
+class _Steps:
+    """Planned footfalls, in time order, alternating sides.
+
+    Attributes:
+        times: ``(k,)`` footfall times, seconds.
+        lift_off: ``(k,)`` lift-off times of the same feet, seconds.
+        sides: ``(k,)`` +1 left, -1 right.
+        feet: ``(k, 2)`` planted ankle ground position (x, z), metres.
+        foot_yaw: ``(k,)`` planted foot yaw, radians.
+        pelvis: ``(k, 2)`` pelvis ground position (x, z) at the foot's midstance, metres.
+        midstance: ``(k,)`` midstance times, seconds.
+    """
+
+    times: np.ndarray
+    lift_off: np.ndarray
+    sides: np.ndarray
+    feet: np.ndarray
+    foot_yaw: np.ndarray
+    pelvis: np.ndarray
+    midstance: np.ndarray
+
+
+def _rng(seed: int, content: str, style: str, index: int) -> np.random.Generator:
+    """A generator seeded by a stable hash of the take's identity (not Python's ``hash``)."""
+    key = f"stylemotion.synthetic|{seed}|{content}|{style}|{index}".encode()
+    return np.random.default_rng(int.from_bytes(hashlib.sha256(key).digest()[:16], "little"))
+
+
+def _check(value: str, valid: tuple[str, ...], what: str) -> None:
+    if value not in valid:
+        raise ValueError(f"unknown {what} {value!r}; valid {what}s: {', '.join(valid)}")
+
+
+def _gait_for(style: str, content: str, rng: np.random.Generator) -> _Gait:
+    """A take's gait: the style's parameters for walking or running, with per-take variation."""
+    s = _STYLE_TABLE[style]
+    running = content == "run"
+    if running:
+        s = dataclasses.replace(
+            s, step_length=s.step_length * 1.8, step_time=s.step_time * 0.62,
+            step_width=s.step_width * 0.5, lift=s.lift + 0.15, carriage=s.carriage - 0.04,
+            bounce=s.bounce + 0.03, sway=s.sway * 0.5, lean=s.lean + 0.12, arm_swing=s.arm_swing * 1.3,
+            elbow=s.elbow + 1.1, pelvis_list=s.pelvis_list * 0.5,
+        )  # fmt: skip
+    scale = rng.uniform(0.95, 1.05)
+    jitter = rng.normal(0.0, 1.0, size=5)
+    s = dataclasses.replace(
+        s,
+        step_length=s.step_length * scale * (1 + 0.04 * jitter[0]),
+        step_time=s.step_time * np.sqrt(scale) * (1 + 0.03 * jitter[1]),
+        step_width=s.step_width * scale,
+        lift=s.lift * scale * (1 + 0.08 * jitter[2]),
+        sway=s.sway * scale,
+        arm_swing=s.arm_swing * (1 + 0.08 * jitter[3]),
+        lean=s.lean + 0.02 * jitter[4],
+    )
+    return _Gait(
+        style=s,
+        stance=s.run_stance if running else s.stance,
+        lift_peak=0.3,
+        toe_pitch=0.2 + 1.5 * s.lift,
+        running=running,
+        scale=scale,
+    )
+
+
+def _heading_for(content: str, duration: float, rng: np.random.Generator) -> _Heading:
+    """The take's heading curve: ±90° (±10%) turns for turning takes, small drift otherwise."""
+    turn = {"walk-turn-left": 1.0, "walk-turn-right": -1.0}.get(content, 0.0)
+    return _Heading(
+        turn=turn * np.pi / 2 * (1 + 0.1 * np.clip(rng.standard_normal(), -2, 2)),
+        duration=duration,
+        drift=0.02 * rng.standard_normal(),
+        wander=0.03 * rng.uniform(),
+        wander_phase=rng.uniform(0, 2 * np.pi),
+    )
+
+
+def _forward(yaw: np.ndarray) -> np.ndarray:
+    """Ground direction ``(..., 2)`` (x, z) faced at ``yaw`` ``(...)``."""
+    return np.stack([np.sin(yaw), np.cos(yaw)], axis=-1)
+
+
+def _left(yaw: np.ndarray) -> np.ndarray:
+    """Ground direction ``(..., 2)`` (x, z) of the body's left at ``yaw`` ``(...)``."""
+    return np.stack([np.cos(yaw), -np.sin(yaw)], axis=-1)
+
+
+def _plan_steps(gait: _Gait, heading: _Heading, start: float, end: float, rng: np.random.Generator) -> _Steps:
+    """Footfalls covering ``[start, end]`` seconds with per-step random length, width and timing."""
+    s = gait.style
+    n = int(np.ceil((end - start) / (0.85 * s.step_time))) + 3
+    noise = np.clip(rng.standard_normal((4, n)), -2.5, 2.5)
+    durations = s.step_time * (1 + 0.04 * noise[0])
+    lengths = s.step_length * (1 + 0.05 * noise[1])
+    widths = s.step_width + 0.012 * gait.scale * noise[2]
+    sides = np.where((np.arange(n) + (rng.uniform() < 0.5)) % 2 == 0, 1.0, -1.0)
+    times = start + np.concatenate([[0.0], np.cumsum(durations[:-1])])
+    stance = 2 * gait.stance * durations
+    midstance = times + stance / 2
+    yaw = heading(midstance) + 0.02 * noise[3]
+    advance = lengths[1:, None] * _forward(heading((midstance[:-1] + midstance[1:]) / 2))
+    centre = np.concatenate([np.zeros((1, 2)), np.cumsum(advance, axis=0)])
+    lateral = sides[:, None] * _left(yaw)
+    return _Steps(
+        times=times,
+        lift_off=times + stance,
+        sides=sides,
+        feet=centre + lateral * widths[:, None] / 2,
+        foot_yaw=yaw + sides * s.toe_out,
+        pelvis=centre + lateral * s.sway,
+        midstance=midstance,
+    )
+
+
+def _gait_phase(steps: _Steps, t: np.ndarray) -> np.ndarray:
+    """Gait phase ``(n,)`` in cycles at times ``t``: integer at left footfalls, +0.5 at right ones."""
+    first_left = 0 if steps.sides[0] > 0 else 1
+    return np.interp(t, steps.times, (np.arange(len(steps.times)) - first_left) / 2)
+
+
+def _min_jerk(u: np.ndarray) -> np.ndarray:
+    """Minimum-jerk 0 → 1 profile with zero velocity and acceleration at both ends."""
+    return u**3 * (10 - 15 * u + 6 * u**2)
+
+
+@dataclass(frozen=True)
+class _Foot:
+    """One foot over ``n`` frames.
+
+    Attributes:
+        ankle: ``(n, 3)`` ankle positions, metres.
+        toes: ``(n, 3)`` ball-of-foot positions, metres.
+        yaw: ``(n,)`` foot yaw, radians.
+        contact: ``(n,)`` bool, planted (ankle and toes exactly still on the ground).
+        swing: ``(n,)`` swing progress, 0 at lift-off (and during stance) to 1 at the footfall.
+        spots: ``(2, n, 2)`` ground (x, z) of the ankle's last footfall and of its next one.
+    """
+
+    ankle: np.ndarray
+    toes: np.ndarray
+    yaw: np.ndarray
+    contact: np.ndarray
+    swing: np.ndarray
+    spots: np.ndarray
+
+
+def _foot_track(steps: _Steps, side: float, t: np.ndarray, gait: _Gait) -> _Foot:
+    """One foot at times ``t`` ``(n,)`` seconds; ``side`` +1 left, -1 right.
+
+    The steps must cover ``t`` with a spare footfall of each side before and after.
+    """
+    own = steps.sides == side
+    land, lift, feet, yaw = steps.times[own], steps.lift_off[own], steps.feet[own], steps.foot_yaw[own]
+    j = np.searchsorted(land, t, side="right") - 1
+    u = np.clip((t - lift[j]) / (land[j + 1] - lift[j]), 0.0, 1.0)
+    progress = _min_jerk(u)
+    foot_yaw = yaw[j] + progress * (yaw[j + 1] - yaw[j])
+    clearance = max(0.0, _FEET_CLEARANCE * gait.scale - gait.style.step_width)
+    ground = feet[j] + progress[:, None] * (feet[j + 1] - feet[j])
+    ground += side * clearance * np.sin(np.pi * u)[:, None] * _left(foot_yaw)
+    peak_u = u ** (np.log(0.5) / np.log(gait.lift_peak))  # maps lift_peak to 0.5
+    ankle_y = gait.scale * _ANKLE_HEIGHT + gait.style.lift * 16 * peak_u**2 * (1 - peak_u) ** 2
+    ankle = np.stack([ground[:, 0], ankle_y, ground[:, 1]], axis=-1)
+    toes = _toes(ankle, foot_yaw, u, gait)
+    return _Foot(ankle, toes, foot_yaw, t < lift[j], u, np.stack([feet[j], feet[j + 1]]))
+
+
+def _toes(ankle: np.ndarray, foot_yaw: np.ndarray, swing: np.ndarray, gait: _Gait) -> np.ndarray:
+    """Toe positions ``(n, 3)``: toe-off (toes down) then heel strike (toes up) during the swing.
+
+    The pitch never takes the toes below their height with the foot flat on the ground.
+    """
+    foot = _FOOT * gait.scale
+    length, rest_angle = np.hypot(foot[1], foot[2]), np.arctan2(-foot[1], foot[2])
+    lowest = np.arcsin(np.clip((ankle[:, 1] - gait.scale * _TOE_HEIGHT) / length, -1, 1)) - rest_angle
+    pitch = np.minimum(gait.toe_pitch * np.sin(2 * np.pi * swing), lowest)
+    return ankle + np.einsum("nab,b->na", _rot_y(foot_yaw) @ _rot_x(pitch), foot)
+
+
+def _rot_x(a: np.ndarray) -> np.ndarray:
+    """Rotations ``(..., 3, 3)`` about +X by ``a`` (positive tips +Y towards +Z: leaning forward)."""
+    c, s, o, i = np.cos(a), np.sin(a), np.zeros_like(a), np.ones_like(a)
+    return np.stack([i, o, o, o, c, -s, o, s, c], axis=-1).reshape(np.shape(a) + (3, 3))
+
+
+def _rot_y(a: np.ndarray) -> np.ndarray:
+    """Rotations ``(..., 3, 3)`` about +Y by ``a`` (positive turns +Z towards +X: a left turn)."""
+    c, s, o, i = np.cos(a), np.sin(a), np.zeros_like(a), np.ones_like(a)
+    return np.stack([c, o, s, o, i, o, -s, o, c], axis=-1).reshape(np.shape(a) + (3, 3))
+
+
+def _rot_z(a: np.ndarray) -> np.ndarray:
+    """Rotations ``(..., 3, 3)`` about +Z by ``a`` (positive raises +X: the body's left side)."""
+    c, s, o, i = np.cos(a), np.sin(a), np.zeros_like(a), np.ones_like(a)
+    return np.stack([c, -s, o, s, c, o, o, o, i], axis=-1).reshape(np.shape(a) + (3, 3))
+
+
+def _rest_offsets(gait: _Gait) -> np.ndarray:
+    """``(21, 3)`` rest offsets of each joint from its parent, metres, scaled to the take's body."""
+    s = gait.style
+    offsets = np.zeros((21, 3))
+    for side, suffix in ((1.0, "_L"), (-1.0, "_R")):
+        mirror = np.array([side, 1.0, 1.0])
+        offsets[CJ["Shoulder" + suffix]] = _CLAVICLE_BASE * mirror
+        offsets[CJ["UpperArm" + suffix]] = [side * s.clavicle, 0.0, 0.0]
+        offsets[CJ["LowerArm" + suffix]] = [0.0, -_UPPER_ARM, 0.0]
+        offsets[CJ["Hand" + suffix]] = [0.0, -_FOREARM, 0.0]
+        offsets[CJ["UpperLeg" + suffix]] = [side * s.hip_width, -_PELVIS_DROP, 0.0]
+        offsets[CJ["LowerLeg" + suffix]] = [0.0, -_THIGH, 0.0]
+        offsets[CJ["Foot" + suffix]] = [0.0, -_SHIN, 0.0]
+        offsets[CJ["Toes" + suffix]] = _FOOT
+    offsets[CJ["Spine"]], offsets[CJ["Chest"]] = _SPINE, _CHEST
+    offsets[CJ["Neck"]], offsets[CJ["Head"]] = _NECK, _HEAD
+    return offsets * gait.scale
+
+
+def _global_rotations(gait: _Gait, yaw: np.ndarray, phase: np.ndarray) -> np.ndarray:
+    """Global rotations ``(n, 21, 3, 3)`` of the pelvis, torso, head and arms (legs: the pelvis').
+
+    Args:
+        gait: the take's gait.
+        yaw: ``(n,)`` body heading, radians.
+        phase: ``(n,)`` gait phase in cycles (integer at left footfalls).
+    """
+    s = gait.style
+    cycle = np.cos(2 * np.pi * phase)  # +1 when the left foot lands (left leg forward)
+    pelvis_yaw = yaw - s.pelvis_twist * cycle  # left hip forward with the left leg
+    chest_yaw = yaw + s.chest_twist * cycle  # shoulders counter-rotate
+    pelvis_roll = s.pelvis_list * np.cos(2 * np.pi * (phase - gait.stance / 2))  # swing hip drops
+    rotations = np.empty(yaw.shape + (21, 3, 3))
+    rotations[:, CJ["Hips"]] = _rot_y(pelvis_yaw) @ _rot_z(pelvis_roll) @ _rot_x(0.3 * s.lean)
+    rotations[:, CJ["Spine"]] = _rot_y((pelvis_yaw + chest_yaw) / 2) @ _rot_x(0.5 * s.lean)
+    chest = _rot_y(chest_yaw) @ _rot_z(-0.5 * pelvis_roll) @ _rot_x(s.lean)
+    rotations[:, CJ["Chest"]] = chest
+    rotations[:, CJ["Neck"]] = _rot_y(yaw + 0.3 * s.chest_twist * cycle) @ _rot_x(s.lean + s.head_drop)
+    rotations[:, CJ["Head"]] = rotations[:, CJ["Neck"]]
+    for side, suffix in ((1.0, "_L"), (-1.0, "_R")):
+        shoulder = chest @ _rot_y(-side * s.shoulder_protraction) @ _rot_z(-side * s.shoulder_droop)
+        flexion = s.arm_forward - side * s.arm_swing * cycle  # left arm back when the left leg leads
+        upper = _rot_y(chest_yaw) @ _rot_z(side * s.arm_abduction * np.ones_like(yaw)) @ _rot_x(-flexion)
+        lower = upper @ _rot_x(-(s.elbow + 0.8 * np.maximum(flexion, 0.0)))
+        rotations[:, CJ["Shoulder" + suffix]] = shoulder
+        rotations[:, CJ["UpperArm" + suffix]] = upper
+        rotations[:, CJ["LowerArm" + suffix]] = lower
+        rotations[:, CJ["Hand" + suffix]] = lower
+        for leg in ("UpperLeg", "LowerLeg", "Foot", "Toes"):
+            rotations[:, CJ[leg + suffix]] = rotations[:, CJ["Hips"]]
+    return rotations
+
+
+def _bob(gait: _Gait, phase: np.ndarray) -> np.ndarray:
+    """Vertical pelvis bob ``(n,)`` metres around the carriage height, at gait phase ``phase``.
+
+    Walking: an inverted pendulum, highest at midstance and lowest in double support, by as much as
+    straight legs need to reach feet a step apart. Running: lowest at midstance, highest in flight.
+    """
+    s = gait.style
+    step_phase = 2 * phase  # cycles of single steps: integer at every footfall
+    if gait.running:
+        return s.bounce * np.cos(2 * np.pi * (step_phase - gait.stance - 0.5))
+    legs = (_THIGH + _SHIN) * gait.scale
+    drop = s.carriage * legs - np.sqrt((_REACH * legs) ** 2 - (gait.stance * s.step_length) ** 2)
+    trough = 0.5 + 0.5 * np.cos(2 * np.pi * (step_phase - gait.stance + 0.5))
+    return s.bounce - (max(drop, 0.0) + 2 * s.bounce) * trough
+
+
+def _pelvis_height(
+    gait: _Gait, hips_rot: np.ndarray, pelvis_xz: np.ndarray, feet: list[_Foot], offsets: np.ndarray,
+    phase: np.ndarray,
+) -> np.ndarray:
+    """Pelvis height ``(n,)`` metres: a smooth minimum of the carriage height and the legs' reach.
+
+    A planted leg limits the height to what it reaches with ``_REACH`` of its length. A swinging leg
+    does not (its knee bends), but so that the height stays continuous, the limits of its last and
+    next footfall spots fade out after lift-off and fade in before the footfall.
+
+    Args:
+        gait: the take's gait.
+        hips_rot: ``(n, 3, 3)`` global pelvis rotation.
+        pelvis_xz: ``(n, 2)`` pelvis ground position, metres.
+        feet: the left and right foot tracks.
+        offsets: ``(21, 3)`` rest offsets.
+        phase: ``(n,)`` gait phase in cycles.
+    """
+    legs = (_THIGH + _SHIN) * gait.scale
+    limits = [gait.scale * (_ANKLE_HEIGHT + _PELVIS_DROP) + gait.style.carriage * legs + _bob(gait, phase)]
+    ankle_y = gait.scale * _ANKLE_HEIGHT
+    for foot, joint in zip(feet, ("UpperLeg_L", "UpperLeg_R"), strict=True):
+        hip = np.einsum("nab,b->na", hips_rot, offsets[CJ[joint]])  # hip joint, pelvis at the origin
+        # the leg on its last footfall spot (planted, or just lifted off), then on its next spot
+        # (about to land); a swinging leg has slack that vanishes at lift-off and at the footfall
+        slack = legs * np.stack([_LIFT_SLACK * foot.swing, np.where(foot.contact, np.inf, _LAND_SLACK * (1 - foot.swing))])
+        ground = np.linalg.norm(pelvis_xz + hip[:, [0, 2]] - foot.spots, axis=-1)
+        reach = np.sqrt(np.maximum((_REACH * legs) ** 2 - ground**2, 0.0))
+        limits.extend(ankle_y - hip[:, 1] + reach + slack)
+    return -_SOFTMIN_M * logsumexp(-np.stack(limits) / _SOFTMIN_M, axis=0)
+
+
+def _within_reach(foot: _Foot, hip: np.ndarray, legs: float, gait: _Gait) -> _Foot:
+    """The foot with its swinging ankle pulled towards ``hip`` ``(n, 3)`` where the leg is too short.
+
+    Planted feet are within reach by construction of the pelvis height and are left untouched.
+    """
+    reach = foot.ankle - hip
+    dist = np.linalg.norm(reach, axis=-1, keepdims=True)
+    limit = _REACH * legs
+    ankle = np.where(dist > limit, hip + reach * (limit / dist), foot.ankle)
+    return dataclasses.replace(foot, ankle=ankle, toes=_toes(ankle, foot.yaw, foot.swing, gait))
+
+
+def _two_bone_ik(
+    hip: np.ndarray, ankle: np.ndarray, pole: np.ndarray, upper: float, lower: float
+) -> np.ndarray:
+    """Knee positions ``(n, 3)`` with ``|knee − hip| = upper`` and ``|ankle − knee| = lower``.
+
+    The knee bends towards ``pole`` ``(n, 3)`` (a direction). ``hip`` and ``ankle`` are ``(n, 3)``
+    positions at most ``upper + lower`` apart.
+    """
+    reach = ankle - hip
+    dist = np.linalg.norm(reach, axis=-1, keepdims=True)
+    axis = reach / dist
+    along = (upper**2 - lower**2 + dist**2) / (2 * dist)
+    across = np.sqrt(np.maximum(upper**2 - along**2, 0.0))
+    bend = pole - np.sum(pole * axis, axis=-1, keepdims=True) * axis
+    bend /= np.linalg.norm(bend, axis=-1, keepdims=True)
+    return hip + along * axis + across * bend
+
+
+def _local_rotations(global_rot: np.ndarray) -> np.ndarray:
+    """Local rotations ``(n, 21, 3, 3)`` from global ones on the canonical skeleton."""
+    parents = np.array([max(p, 0) for p in CANONICAL_PARENTS])
+    local = np.swapaxes(global_rot[:, parents], -1, -2) @ global_rot
+    local[:, CJ["Hips"]] = global_rot[:, CJ["Hips"]]
+    return local
+
+
+def _pose_legs(positions: np.ndarray, feet: list[_Foot], gait: _Gait) -> None:
+    """Write knees, ankles and toes into ``positions`` ``(n, 21, 3)`` (hip joints already posed)."""
+    for foot, suffix in zip(feet, ("_L", "_R"), strict=True):
+        hip = positions[:, CJ["UpperLeg" + suffix]]
+        foot = _within_reach(foot, hip, (_THIGH + _SHIN) * gait.scale, gait)
+        pole = np.stack([np.sin(foot.yaw), np.zeros_like(foot.yaw), np.cos(foot.yaw)], axis=-1)
+        positions[:, CJ["LowerLeg" + suffix]] = _two_bone_ik(
+            hip, foot.ankle, pole, _THIGH * gait.scale, _SHIN * gait.scale
+        )
+        positions[:, CJ["Foot" + suffix]] = foot.ankle
+        positions[:, CJ["Toes" + suffix]] = foot.toes
+
+
+def generate_take(
+    content: str, style: str, index: int, seed: int = 0, fps: float = 30.0, duration_s: float = 8.0
+) -> SyntheticTake:
+    """Generate one deterministic take of stylized locomotion.
+
+    Args:
+        content: one of :data:`CONTENTS`.
+        style: one of :data:`STYLES`.
+        index: take number within the (content, style) pair; different indices vary body size
+            (scale 0.95–1.05), gait timing and every step.
+        seed: dataset seed; the same arguments always give bit-identical output.
+        fps: frames per second.
+        duration_s: length of the take, seconds (at least two frames).
+
+    Returns:
+        The take: ``(frames, 21, 3)`` float32 positions (metres, Y up; pelvis above the origin and
+        facing +Z at frame 0) and ``(frames, 2)`` ground-truth foot contacts (left, right).
+
+    Raises:
+        ValueError: on an unknown content or style, or fewer than two frames.
+    """
+    _check(content, CONTENTS, "content")
+    _check(style, STYLES, "style")
+    num_frames = int(round(duration_s * fps))
+    if num_frames < 2:
+        raise ValueError(f"a take needs at least 2 frames, got duration {duration_s} s at {fps} fps")
+    rng = _rng(seed, content, style, index)
+    gait = _gait_for(style, content, rng)
+    heading = _heading_for(content, duration_s, rng)
+    t = np.arange(num_frames) / fps
+    margin = 3 * gait.style.step_time
+    steps = _plan_steps(gait, heading, -margin, t[-1] + margin, rng)
+    phase = _gait_phase(steps, t)
+    feet = [_foot_track(steps, side, t, gait) for side in (1.0, -1.0)]
+    pelvis_xz = CubicSpline(steps.midstance, steps.pelvis)(t)
+    offsets = _rest_offsets(gait)
+    global_rot = _global_rotations(gait, heading(t), phase)
+    height = _pelvis_height(gait, global_rot[:, CJ["Hips"]], pelvis_xz, feet, offsets, phase)
+    translations = np.broadcast_to(offsets, (num_frames, 21, 3)).copy()
+    translations[:, CJ["Hips"]] = np.stack([pelvis_xz[:, 0], height, pelvis_xz[:, 1]], axis=-1)
+    positions = forward_kinematics(_local_rotations(global_rot), translations, CANONICAL_PARENTS)
+    _pose_legs(positions, feet, gait)
+    positions[:, :, [0, 2]] -= positions[0, CJ["Hips"], [0, 2]]
+    return SyntheticTake(
+        name=f"synthetic_{content}_{style}_{index:03d}",
+        positions=positions.astype(np.float32),
+        fps=float(fps),
+        labels={"content": content, "style": style, "take": f"{index:03d}", "actor": "synthetic"},
+        contacts=np.stack([foot.contact for foot in feet], axis=-1),
+    )
+
+
+def generate_takes(
+    takes_per_pair: int = 4, seed: int = 0, fps: float = 30.0, duration_s: float = 8.0,
+    styles: Sequence[str] | None = None, contents: Sequence[str] | None = None,
+) -> list[SyntheticTake]:
+    """Generate ``takes_per_pair`` takes for every (content, style) pair.
+
+    Args:
+        takes_per_pair: takes per (content, style) pair, indices ``0 .. takes_per_pair − 1``.
+        seed: dataset seed (see :func:`generate_take`).
+        fps: frames per second.
+        duration_s: length of each take, seconds.
+        styles: subset of :data:`STYLES` (default all).
+        contents: subset of :data:`CONTENTS` (default all).
+
+    Returns:
+        Takes ordered by content, then style, then index.
+
+    Raises:
+        ValueError: on an unknown style or content.
+    """
+    styles = STYLES if styles is None else tuple(styles)
+    contents = CONTENTS if contents is None else tuple(contents)
+    for style in styles:
+        _check(style, STYLES, "style")
+    for content in contents:
+        _check(content, CONTENTS, "content")
+    return [
+        generate_take(content, style, i, seed=seed, fps=fps, duration_s=duration_s)
+        for content in contents
+        for style in styles
+        for i in range(takes_per_pair)
+    ]

@@ -1,0 +1,285 @@
+"""The convolutional motion autoencoder: the motion manifold of thesis §5.3.1 (eq. 5.1–5.2).
+
+After Holden et al. 2016, one 1D convolution over time:
+
+* encoder ``Φ(X) = Ψ(ReLU(X * W + b))``: Conv1d(66 → 256, kernel 15, same padding), ReLU,
+  pooling ×2 over time (average by default, max as an option);
+* decoder ``Φ'(Y)``: depooling ×2 (each feature step repeated twice), Conv1d(256 → 66, kernel 15).
+
+:class:`ConvAutoencoder` is the plain network (with its normalization buffers);
+:class:`MotionAutoencoder` is the Lightning module that trains it by reconstruction: MSE in the
+normalized space, optionally with input dropout (denoising) and an L1 penalty on the hidden units,
+and logs MPJPE in metres on positions recovered through the inverse representation.
+
+Shapes (``T`` frames at the model's fps, ``H`` hidden units):
+
+* ``encode(frames)``: ``(batch, T, 66)`` raw frames → ``(batch, H, ceil(T / 2))`` features;
+* ``decode(features, num_frames)``: ``(batch, H, T')`` → ``(batch, 2 T', 66)`` raw frames, cut to
+  ``num_frames`` when given (an odd ``T`` pools its last frame alone and is cut back on decode).
+
+Unbatched ``(T, 66)`` / ``(H, T')`` inputs work too. The Gram matrices of §5.3.3 are taken on
+``encode`` output, so ``encode``/``decode`` are the stable API of this module.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import lightning.pytorch as pl
+import torch
+import torch.nn.functional as F
+from torch import nn
+
+from stylemotion.data.normalization import Normalizer
+from stylemotion.data.windows import REPRESENTATION
+from stylemotion.representation import FRAME_DIM, frames_to_positions
+from stylemotion.skeleton import CANONICAL_JOINTS, CANONICAL_PARENTS
+
+POOLING = ("avg", "max")
+
+
+class IncompatibleModelError(ValueError):
+    """A model (or checkpoint) does not fit the data or code it is used with."""
+
+
+class NonFiniteLossError(FloatingPointError):
+    """The training loss became NaN or infinite."""
+
+
+class ConvAutoencoder(nn.Module):
+    """Single-layer convolutional autoencoder over time, working on raw (un-normalized) frames.
+
+    Args:
+        frame_dim: values per frame (66).
+        hidden_units: convolution kernels, i.e. feature channels ``H`` (256 in the thesis).
+        kernel_size: temporal width of both convolutions, frames (15 = a quarter of 60 frames).
+        pooling: ``"avg"`` (thesis) or ``"max"``; depooling always repeats each step twice.
+        input_dropout: probability of zeroing a normalized input value while training
+            (:meth:`corrupt`); 0 disables it.
+    """
+
+    def __init__(self, frame_dim: int = FRAME_DIM, hidden_units: int = 256, kernel_size: int = 15,
+                 pooling: str = "avg", input_dropout: float = 0.0):
+        super().__init__()
+        if pooling not in POOLING:
+            raise ValueError(f"pooling must be one of {POOLING}, got {pooling!r}")
+        for name, value in (("frame_dim", frame_dim), ("hidden_units", hidden_units),
+                            ("kernel_size", kernel_size)):
+            if not isinstance(value, int) or isinstance(value, bool) or value < 1:
+                raise ValueError(f"{name} must be a positive integer, got {value!r}")
+        if not 0.0 <= input_dropout < 1.0:
+            raise ValueError(f"input_dropout must be in [0, 1), got {input_dropout!r}")
+        self.frame_dim, self.hidden_units, self.pooling = frame_dim, hidden_units, pooling
+        self.normalizer = Normalizer(frame_dim)
+        self.encoder = nn.Conv1d(frame_dim, hidden_units, kernel_size, padding="same")
+        self.decoder = nn.Conv1d(hidden_units, frame_dim, kernel_size, padding="same")
+        self.dropout = nn.Dropout(input_dropout)
+
+    # -- normalized space: (batch, T, frame_dim) z-scores
+    def encode_normalized(self, z: torch.Tensor) -> torch.Tensor:
+        """``(batch, T, frame_dim)`` z-scores → ``(batch, H, ceil(T/2))`` features."""
+        hidden = F.relu(self.encoder(z.transpose(-1, -2)))
+        if hidden.shape[-1] % 2:
+            hidden = F.pad(hidden, (0, 1), mode="replicate")
+        pool = F.avg_pool1d if self.pooling == "avg" else F.max_pool1d
+        return pool(hidden, 2)
+
+    def decode_normalized(self, features: torch.Tensor, num_frames: int | None = None) -> torch.Tensor:
+        """``(batch, H, T')`` features → ``(batch, min(2T', num_frames), frame_dim)`` z-scores."""
+        out = self.decoder(features.repeat_interleave(2, dim=-1)).transpose(-1, -2)
+        return out if num_frames is None else out[..., :num_frames, :]
+
+    def corrupt(self, z: torch.Tensor) -> torch.Tensor:
+        """Input dropout on z-scores (identity in eval mode or with ``input_dropout == 0``)."""
+        return self.dropout(z)
+
+    # -- raw frames
+    def encode(self, frames: torch.Tensor) -> torch.Tensor:
+        """``(batch, T, frame_dim)`` or ``(T, frame_dim)`` raw frames → ``(batch, H, ceil(T/2))``."""
+        self._check_frames(frames)
+        z = self.normalizer.normalize(frames)
+        return _unbatched(self.encode_normalized, z, frames.dim() == 2)
+
+    def decode(self, features: torch.Tensor, num_frames: int | None = None) -> torch.Tensor:
+        """``(batch, H, T')`` or ``(H, T')`` features → raw frames ``(batch, T, frame_dim)``.
+
+        ``T = 2 T'``, or ``num_frames`` when given (e.g. the odd length that was encoded).
+        """
+        if features.shape[-2] != self.hidden_units:
+            raise ValueError(f"features must be (batch, {self.hidden_units}, time), got {tuple(features.shape)}")
+        z = _unbatched(lambda f: self.decode_normalized(f, num_frames), features, features.dim() == 2)
+        return self.normalizer.denormalize(z)
+
+    def forward(self, frames: torch.Tensor) -> torch.Tensor:
+        """Reconstruction of raw ``frames`` ``(batch, T, frame_dim)``, same shape."""
+        return self.decode(self.encode(frames), frames.shape[-2])
+
+    def _check_frames(self, frames: torch.Tensor) -> None:
+        if frames.dim() not in (2, 3) or frames.shape[-1] != self.frame_dim:
+            raise ValueError(f"frames must be (batch, time, {self.frame_dim}) or (time, {self.frame_dim}), "
+                             f"got {tuple(frames.shape)}")
+
+
+def _unbatched(fn, x: torch.Tensor, unbatched: bool) -> torch.Tensor:
+    return fn(x.unsqueeze(0)).squeeze(0) if unbatched else fn(x)
+
+
+def mpjpe(pred_frames: torch.Tensor, true_frames: torch.Tensor, fps: float) -> torch.Tensor:
+    """Mean per-joint position error, metres, of two frame sequences ``(..., T, 66)``.
+
+    Both are turned into positions by :func:`stylemotion.representation.frames_to_positions`
+    from the same start (origin, facing +Z), so root drift from velocity errors counts; the mean
+    runs over all leading dims, frames and the 21 joints.
+    """
+    pred = frames_to_positions(pred_frames, fps)
+    true = frames_to_positions(true_frames, fps)
+    return torch.linalg.vector_norm(pred - true, dim=-1).mean()
+
+
+class MotionAutoencoder(pl.LightningModule):
+    """Trains a :class:`ConvAutoencoder` by reconstructing windows of raw frames.
+
+    Batches are raw frames ``(batch, T, 66)``. Logged per split (``train``/``val``/``test``):
+    ``mse`` (normalized space), ``mpjpe`` (metres), and ``train/loss`` (MSE + sparsity term).
+
+    The normalization statistics are taken from the datamodule's train split at the first
+    ``setup`` (``datamodule.normalization``) unless already set (e.g. loaded from a checkpoint).
+
+    Args:
+        hidden_units, kernel_size, pooling, input_dropout: see :class:`ConvAutoencoder`.
+        sparsity: weight of the L1 penalty ``mean(|features|)`` on the hidden units (0 = off).
+        lr: Adam learning rate. weight_decay: Adam's L2 weight decay.
+        fps: frame rate of the frames the model is trained on (velocities are per second).
+        frame_dim: values per frame. representation: frame layout id (see
+            :data:`stylemotion.data.windows.REPRESENTATION`).
+        joint_names, joint_parents: the skeleton the frames describe (canonical 21 joints).
+
+    All arguments are plain values and are saved as hyperparameters, so
+    ``MotionAutoencoder.load_from_checkpoint(path)`` works under ``torch.load(weights_only=True)``.
+    """
+
+    def __init__(
+        self,
+        hidden_units: int = 256,
+        kernel_size: int = 15,
+        pooling: str = "avg",
+        input_dropout: float = 0.0,
+        sparsity: float = 0.0,
+        lr: float = 1e-3,
+        weight_decay: float = 0.0,
+        fps: float = 30.0,
+        frame_dim: int = FRAME_DIM,
+        representation: str = REPRESENTATION,
+        joint_names: Sequence[str] = CANONICAL_JOINTS,
+        joint_parents: Sequence[int] = CANONICAL_PARENTS,
+    ):
+        super().__init__()
+        if representation != REPRESENTATION or frame_dim != FRAME_DIM:
+            raise IncompatibleModelError(
+                f"this model was built for frame representation {representation!r} with {frame_dim} values "
+                f"per frame, but this code computes {REPRESENTATION!r} with {FRAME_DIM}; retrain it on data "
+                "prepared by the current stylemotion.representation"
+            )
+        if list(joint_names) != list(CANONICAL_JOINTS) or list(joint_parents) != list(CANONICAL_PARENTS):
+            raise IncompatibleModelError(
+                f"this model was built for a skeleton with joints {list(joint_names)} (parents "
+                f"{list(joint_parents)}), not the canonical 21-joint skeleton {list(CANONICAL_JOINTS)}"
+            )
+        if not sparsity >= 0 or not lr > 0 or not weight_decay >= 0 or not fps > 0:
+            raise ValueError(f"need sparsity ≥ 0, lr > 0, weight_decay ≥ 0, fps > 0; got {sparsity}, {lr}, "
+                             f"{weight_decay}, {fps}")
+        self.save_hyperparameters({
+            "hidden_units": int(hidden_units), "kernel_size": int(kernel_size), "pooling": str(pooling),
+            "input_dropout": float(input_dropout), "sparsity": float(sparsity), "lr": float(lr),
+            "weight_decay": float(weight_decay), "fps": float(fps), "frame_dim": int(frame_dim),
+            "representation": str(representation), "joint_names": [str(j) for j in joint_names],
+            "joint_parents": [int(p) for p in joint_parents],
+        })
+        self.net = ConvAutoencoder(frame_dim, hidden_units, kernel_size, pooling, input_dropout)
+
+    # -- public API on raw frames
+    def encode(self, frames: torch.Tensor) -> torch.Tensor:
+        """Raw frames ``(batch, T, 66)`` → features ``(batch, H, ceil(T/2))``."""
+        return self.net.encode(frames)
+
+    def decode(self, features: torch.Tensor, num_frames: int | None = None) -> torch.Tensor:
+        """Features ``(batch, H, T')`` → raw frames ``(batch, num_frames or 2T', 66)``."""
+        return self.net.decode(features, num_frames)
+
+    def forward(self, frames: torch.Tensor) -> torch.Tensor:
+        """Reconstruction of raw frames ``(batch, T, 66)``."""
+        return self.net(frames)
+
+    def check_compatible(self, fps: float | None = None, frame_dim: int | None = None,
+                         representation: str | None = None, joint_names: Sequence[str] | None = None) -> None:
+        """Raise :class:`IncompatibleModelError` naming every given property that differs from the model's."""
+        hp = self.hparams
+        wanted = {"fps": fps, "frame_dim": frame_dim, "representation": representation,
+                  "joint_names": None if joint_names is None else list(joint_names)}
+        bad = [f"{k}: model {hp[k]!r}, data {v!r}" for k, v in wanted.items()
+               if v is not None and (abs(float(v) - hp[k]) > 1e-6 if k == "fps" else v != hp[k])]
+        if bad:
+            raise IncompatibleModelError("model and data do not match — " + "; ".join(bad))
+
+    # -- Lightning hooks
+    def setup(self, stage: str) -> None:
+        datamodule = getattr(self.trainer, "datamodule", None) if self._trainer is not None else None
+        if datamodule is not None:
+            self.check_compatible(fps=getattr(datamodule, "fps", None),
+                                  frame_dim=getattr(datamodule, "frame_dim", None),
+                                  representation=getattr(datamodule, "representation", None))
+        if self.net.normalizer.initialized:
+            return
+        if datamodule is None or not hasattr(datamodule, "normalization"):
+            raise RuntimeError("MotionAutoencoder has no normalization statistics: train it with a datamodule "
+                               "that provides `normalization` (e.g. MotionWindowDataModule), or call "
+                               "model.net.normalizer.set_stats(mean, std) first")
+        self.net.normalizer.set_stats(*datamodule.normalization)
+
+    def on_load_checkpoint(self, checkpoint: dict[str, Any]) -> None:
+        saved = checkpoint.get("hyper_parameters", {})
+        keys = ("hidden_units", "kernel_size", "pooling", "fps", "frame_dim", "representation", "joint_names")
+        bad = [f"{k}: checkpoint {saved[k]!r}, model {self.hparams[k]!r}" for k in keys
+               if k in saved and saved[k] != self.hparams[k]]
+        if bad:
+            raise IncompatibleModelError("checkpoint does not match the configured model — " + "; ".join(bad))
+
+    def configure_optimizers(self):
+        return torch.optim.Adam(self.parameters(), lr=self.hparams.lr, weight_decay=self.hparams.weight_decay)
+
+    def _step(self, frames: torch.Tensor, split: str, batch_idx: int) -> torch.Tensor:
+        net = self.net
+        z = net.normalizer.normalize(frames)
+        features = net.encode_normalized(net.corrupt(z) if split == "train" else z)
+        recon = net.decode_normalized(features, frames.shape[-2])
+        mse = F.mse_loss(recon, z)
+        loss = mse + self.hparams.sparsity * features.abs().mean() if self.hparams.sparsity else mse
+        if split == "train" and not torch.isfinite(loss):
+            raise NonFiniteLossError(
+                f"training loss is {loss.item()} at epoch {self.current_epoch}, batch {batch_idx} (global step "
+                f"{self.global_step}); check the data of that batch, or lower the learning rate "
+                f"(lr={self.hparams.lr})"
+            )
+        with torch.no_grad():
+            error = mpjpe(net.normalizer.denormalize(recon.detach()), frames, self.hparams.fps)
+        size = frames.shape[0]
+        sync = split != "train"
+        if split == "train":
+            self.log("train/loss", loss, prog_bar=True, batch_size=size)
+        self.log(f"{split}/mse", mse, batch_size=size, sync_dist=sync, on_epoch=True, on_step=split == "train")
+        self.log(f"{split}/mpjpe", error, batch_size=size, sync_dist=sync, on_epoch=True,
+                 on_step=split == "train", prog_bar=split != "train")
+        return loss
+
+    def training_step(self, batch: torch.Tensor, batch_idx: int) -> torch.Tensor:
+        return self._step(batch, "train", batch_idx)
+
+    def validation_step(self, batch: torch.Tensor, batch_idx: int) -> None:
+        self._step(batch, "val", batch_idx)
+
+    def test_step(self, batch: torch.Tensor, batch_idx: int) -> None:
+        self._step(batch, "test", batch_idx)
+
+    def predict_step(self, batch: torch.Tensor, batch_idx: int) -> torch.Tensor:
+        return self(batch)

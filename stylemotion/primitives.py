@@ -1,0 +1,513 @@
+"""Segmentation of walks and runs into motion primitives at foot-contact keyframes (thesis §4.3,
+§5.2, Fig. 4.5 and 5.1), and canonical timelines (§4.4.1).
+
+Support phases and keyframes
+----------------------------
+From the per-frame contacts of :func:`stylemotion.contacts.foot_contacts` every frame is in one
+support state: left only, right only, both feet (double support, or standing) or none (flight).
+A *single-support phase* is a maximal run of "left only" or "right only" frames; two phases of
+the same foot separated only by double support or flight are one phase (the other foot tapped
+the ground, or the stance foot hopped — the latter is rejected below).
+
+Between a phase of one foot and the next phase of the other foot lies the *support transfer*:
+the double support of a walk (from the new foot's strike to the old foot's lift-off) or the
+flight of a run (from the old foot's lift-off to the new foot's strike). Its **keyframe** is the
+middle frame of that transfer, ``(first + last) // 2`` of the double-support or flight frames,
+so it lies between the two contact-state transitions (strike and lift-off) that bound it.
+Cutting in the middle of the transfer puts each foot's whole support in the middle of its own
+clip, for walks (where the transfer is 2–5 frames of double support at 30 fps) and for runs
+(where it is a flight of similar length) alike.
+
+*Rest* is a run of at least ``min_rest_s`` double-support frames with the root slower than
+``rest_speed`` leg lengths per second (standing).
+
+The six primitives per action
+-----------------------------
+``leftStance``
+    From the keyframe of the transfer onto the left foot to the keyframe of the transfer onto
+    the right foot. The **left foot is planted** (it supports the body); the right foot swings
+    forward (and, in a run, the clip starts and ends in the air).
+``rightStance``
+    The mirror image: right foot planted, left foot swings.
+``beginLeftStance``
+    The first step out of standing: from the last rest frame to the keyframe of the first
+    transfer (onto the right foot). The **left foot stays planted** while the right foot makes
+    the first step.
+``beginRightStance``
+    The mirror image: right foot planted, left foot makes the first step.
+``endLeftStance``
+    The last step into standing: from the keyframe of the transfer onto the left foot to the
+    first rest frame. The **left foot is planted** while the right foot swings and lands beside
+    it.
+``endRightStance``
+    The mirror image: right foot planted, left foot swings to a stop.
+
+Clips contain both end keyframes (source frames ``start`` to ``stop - 1``), so consecutive clips
+share their boundary frame; a clip's duration is ``(frames - 1) / fps`` seconds.
+
+What is not a clip is reported
+------------------------------
+Each single-support phase is a *step*. A step whose incoming or outgoing transfer lies outside
+the take (the take starts or ends inside it or inside the transfer next to it) is a *border*
+step: counted and listed with that reason, but it cannot be cut. Every other step ends up in a
+clip or in :attr:`Segmentation.rejections` with a reason (too short, too long, swing foot never
+lifts, stance foot hops, …). A take with too few frames, no contact, or contacts of one foot
+only is rejected as a whole, with its reason. Takes whose content is not one of the locomotion
+actions are listed in :attr:`Segmentation.ignored`.
+
+Placement and the representation
+--------------------------------
+A clip holds the take's 66-dim frames (:mod:`stylemotion.representation`) of its frame range;
+those are placement-free (joints in the root's facing frame, root velocity in m/s, yaw rate in
+rad/s), and :attr:`Clip.positions` integrates them from the origin facing +Z with
+:func:`~stylemotion.representation.frames_to_positions`: every clip starts at the origin facing
++Z.
+
+Canonical timelines
+-------------------
+:func:`canonical_timelines` gives each (action, primitive) the median clip length in frames;
+:func:`time_normalize` resamples a clip to that length while the clip keeps its real duration.
+Velocity and yaw-rate channels stay in per-second units, so a normalized clip plays back at
+``playback_fps(length, duration_s)`` frames per second and :func:`restore_duration` resamples it
+back to any frame rate.
+"""
+
+from __future__ import annotations
+
+from collections import Counter
+from dataclasses import dataclass, field
+from functools import cached_property
+from typing import Iterable, Sequence
+
+import numpy as np
+
+from stylemotion.contacts import ContactSettings, foot_contacts, leg_length
+from stylemotion.datasets.base import Take
+from stylemotion.representation import ROOT_JOINT, frames_to_positions
+
+#: The six primitives of each locomotion action (DFKI walk graph naming).
+PRIMITIVES: tuple[str, ...] = (
+    "beginLeftStance", "beginRightStance", "leftStance", "rightStance", "endLeftStance", "endRightStance",
+)
+#: Index (0 = left, 1 = right, as in the contact arrays) of the planted foot of each primitive.
+STANCE_FOOT: dict[str, int] = {p: 0 if "Left" in p or p.startswith("left") else 1 for p in PRIMITIVES}
+#: Locomotion actions segmented by default.
+ACTIONS: tuple[str, ...] = ("walk", "run")
+_SIDE = ("Left", "Right")
+_FOOT = ("left", "right")
+
+
+def check_primitive(primitive: str) -> str:
+    """``primitive`` itself, or a ValueError naming the six valid primitives."""
+    if primitive not in PRIMITIVES:
+        raise ValueError(f"unknown motion primitive {primitive!r}; the primitives are {list(PRIMITIVES)}")
+    return primitive
+
+
+def action_of(content: str, actions: Sequence[str] = ACTIONS) -> str | None:
+    """The locomotion action of a content label (``walk-turn-left`` → ``walk``), or None.
+
+    A content belongs to action ``a`` when it is ``a`` or starts with ``a-``.
+    """
+    for action in actions:
+        if content == action or content.startswith(action + "-"):
+            return action
+    return None
+
+
+@dataclass(frozen=True)
+class SegmentSettings:
+    """Parameters of :func:`segment_take`.
+
+    Attributes:
+        contacts: foot contact thresholds.
+        actions: locomotion actions to segment (contents are matched by :func:`action_of`).
+        min_step_s: shortest accepted clip, seconds.
+        max_step_s: longest accepted clip, seconds.
+        min_stance_fraction: share of a clip's frames the planted foot must touch the ground.
+        rest_speed: root ground speed below which double support counts as standing, leg
+            lengths per second.
+        min_rest_s: shortest standing still that counts as rest, seconds.
+    """
+
+    contacts: ContactSettings = field(default_factory=ContactSettings)
+    actions: tuple[str, ...] = ACTIONS
+    min_step_s: float = 0.1
+    max_step_s: float = 1.5
+    min_stance_fraction: float = 0.3
+    rest_speed: float = 0.12
+    min_rest_s: float = 0.3
+
+    @classmethod
+    def from_dict(cls, values: dict | None) -> SegmentSettings:
+        """Settings from plain values (e.g. a Hydra node); ``contacts`` may be a dict."""
+        values = dict(values or {})
+        if isinstance(values.get("contacts"), dict):
+            values["contacts"] = ContactSettings(**values["contacts"])
+        if "actions" in values:
+            values["actions"] = tuple(values["actions"])
+        return cls(**values)
+
+
+@dataclass
+class Clip:
+    """One motion primitive instance.
+
+    Attributes:
+        action: ``walk`` or ``run``.
+        primitive: one of :data:`PRIMITIVES`.
+        style: the take's style label.
+        take: the take's name.
+        content: the take's content label (e.g. ``walk-turn-left``).
+        start: first source frame.
+        stop: one past the last source frame (the clip holds ``stop - start`` frames).
+        fps: frames per second.
+        frames: ``(frames, 66)`` float32 frames of the source range (placement-free).
+        contacts: ``(frames, 2)`` bool foot contacts ``[left, right]`` of the source range.
+    """
+
+    action: str
+    primitive: str
+    style: str
+    take: str
+    content: str
+    start: int
+    stop: int
+    fps: float
+    frames: np.ndarray
+    contacts: np.ndarray
+
+    @property
+    def num_frames(self) -> int:
+        return self.stop - self.start
+
+    @property
+    def duration_s(self) -> float:
+        """Real duration, seconds (first to last frame)."""
+        return (self.num_frames - 1) / self.fps
+
+    @property
+    def stance_foot(self) -> int:
+        """0 if the left foot is planted, 1 if the right."""
+        return STANCE_FOOT[self.primitive]
+
+    @cached_property
+    def positions(self) -> np.ndarray:
+        """``(frames, 21, 3)`` positions, metres, root starting at the origin facing +Z."""
+        return frames_to_positions(self.frames, self.fps).astype(np.float32)
+
+    def describe(self) -> str:
+        return f"{self.action} {self.primitive} {self.style} {self.take}[{self.start}:{self.stop}]"
+
+
+@dataclass(frozen=True)
+class Rejection:
+    """A take or a step that did not become a clip.
+
+    Attributes:
+        take, action, style, content: the take's identity.
+        start, stop: source frame range of the step (None for a whole take).
+        reason: why, in words.
+        kind: ``take`` (the whole take), ``step`` (a step that fits no primitive) or
+            ``border`` (a step cut by the start or end of the take).
+    """
+
+    take: str
+    action: str
+    style: str
+    content: str
+    start: int | None
+    stop: int | None
+    reason: str
+    kind: str
+
+
+@dataclass
+class TakeSegmentation:
+    """The segmentation of one take, with what plots need.
+
+    Attributes:
+        take: the take's name.
+        contacts: ``(frames, 2)`` bool contacts ``[left, right]``.
+        keyframes: sorted source frames of all keyframes (transfers and rest boundaries).
+        phases: ``(foot, start, stop)`` single-support phases (0 = left).
+        rests: ``(start, stop)`` standing-still runs.
+        clips: clips cut from this take.
+        rejections: its rejected and border steps (or the whole take).
+    """
+
+    take: str
+    contacts: np.ndarray
+    keyframes: list[int] = field(default_factory=list)
+    phases: list[tuple[int, int, int]] = field(default_factory=list)
+    rests: list[tuple[int, int]] = field(default_factory=list)
+    clips: list[Clip] = field(default_factory=list)
+    rejections: list[Rejection] = field(default_factory=list)
+
+    @property
+    def complete_steps(self) -> int:
+        """Steps whose both transfers lie in the take: the ones that should become clips."""
+        return len(self.clips) + sum(r.kind == "step" for r in self.rejections)
+
+
+@dataclass
+class Segmentation:
+    """Clips and reports of many takes.
+
+    Attributes:
+        clips: all clips, in take order.
+        rejections: rejected takes, rejected steps and border steps.
+        takes: per-take results (segmented takes only).
+        ignored: ``(take, content)`` of takes whose content is no locomotion action.
+    """
+
+    clips: list[Clip] = field(default_factory=list)
+    rejections: list[Rejection] = field(default_factory=list)
+    takes: list[TakeSegmentation] = field(default_factory=list)
+    ignored: list[tuple[str, str]] = field(default_factory=list)
+
+    @property
+    def complete_steps(self) -> int:
+        return sum(t.complete_steps for t in self.takes)
+
+    def counts(self) -> Counter[tuple[str, str, str]]:
+        """Clip counts per (action, primitive, style)."""
+        return Counter((c.action, c.primitive, c.style) for c in self.clips)
+
+    def select(self, action: str | None = None, primitives: Iterable[str] | None = None,
+               styles: Iterable[str] | None = None) -> list[Clip]:
+        """Clips of one action, some primitives and some styles (None: all)."""
+        prims = None if primitives is None else {check_primitive(p) for p in primitives}
+        styles = None if styles is None else set(styles)
+        return [c for c in self.clips if (action is None or c.action == action)
+                and (prims is None or c.primitive in prims) and (styles is None or c.style in styles)]
+
+
+# ---------------------------------------------------------------------------------------------
+# Segmentation
+
+
+def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
+    """Half-open runs of true values in a ``(frames,)`` bool array."""
+    m = np.asarray(mask, dtype=np.int8)
+    edges = np.diff(np.concatenate([[0], m, [0]]))
+    return list(zip(np.flatnonzero(edges == 1).tolist(), np.flatnonzero(edges == -1).tolist()))
+
+
+def support_phases(contacts: np.ndarray) -> list[tuple[int, int, int]]:
+    """Single-support phases ``(foot, start, stop)`` of ``(frames, 2)`` contacts.
+
+    Consecutive phases of the same foot (separated only by double support or flight) are merged.
+    """
+    left, right = contacts[:, 0], contacts[:, 1]
+    phases = sorted([(a, b, 0) for a, b in _runs(left & ~right)] + [(a, b, 1) for a, b in _runs(right & ~left)])
+    merged: list[tuple[int, int, int]] = []
+    for a, b, foot in phases:
+        if merged and merged[-1][0] == foot:
+            merged[-1] = (foot, merged[-1][1], b)
+        else:
+            merged.append((foot, a, b))
+    return merged
+
+
+def rest_runs(positions: np.ndarray, contacts: np.ndarray, fps: float, settings: SegmentSettings,
+              leg: float) -> list[tuple[int, int]]:
+    """Standing-still runs ``(start, stop)``: both feet down, root slow, long enough."""
+    root = np.asarray(positions, dtype=np.float64)[:, ROOT_JOINT, :][:, [0, 2]]
+    speed = np.linalg.norm(np.gradient(root, axis=0), axis=-1) * fps
+    still = contacts[:, 0] & contacts[:, 1] & (speed < settings.rest_speed * leg)
+    min_len = max(1, int(round(settings.min_rest_s * fps)))
+    return [(a, b) for a, b in _runs(still) if b - a >= min_len]
+
+
+def segment_take(take: Take, settings: SegmentSettings | None = None) -> TakeSegmentation:
+    """Cut one walk or run take into primitive clips (see the module docstring).
+
+    Args:
+        take: a take whose content maps to one of ``settings.actions``.
+        settings: segmentation parameters.
+
+    Returns:
+        The take's clips, its keyframes and phases, and every step that did not become a clip.
+    """
+    settings = settings or SegmentSettings()
+    action = action_of(take.content, settings.actions)
+    if action is None:
+        raise ValueError(f"take {take.name}: content {take.content!r} is none of the locomotion actions "
+                         f"{list(settings.actions)}")
+    fps = float(take.fps)
+    n = take.num_frames
+
+    def reject(reason: str, kind: str, start: int | None = None, stop: int | None = None) -> Rejection:
+        return Rejection(take.name, action, take.style, take.content, start, stop, reason, kind)
+
+    min_frames = int(np.ceil(settings.min_step_s * fps)) + 3
+    if n < min_frames:
+        return TakeSegmentation(take.name, np.zeros((n, 2), bool), rejections=[reject(
+            f"take too short for a step: {n} frames ({n / fps:.2f} s at {fps:g} fps); a step needs at least "
+            f"{min_frames} frames (min_step_s={settings.min_step_s} plus a contact on each side)", "take")])
+    contacts = foot_contacts(take.positions, fps, settings.contacts)
+    result = TakeSegmentation(take.name, contacts)
+    if not contacts.any():
+        result.rejections.append(reject("no foot contact detected in the whole take (feet never low and "
+                                        "slow at once)", "take"))
+        return result
+    for foot in (0, 1):
+        if not contacts[:, foot].any():
+            result.rejections.append(reject(f"only the {_FOOT[1 - foot]} foot touches the ground; the "
+                                            f"{_FOOT[foot]} foot never does", "take"))
+            return result
+    leg = float(leg_length(take.positions))
+    phases = support_phases(contacts)
+    rests = rest_runs(take.positions, contacts, fps, settings, leg)
+    result.phases, result.rests = phases, rests
+    if not phases:
+        result.rejections.append(reject("no single-support phase: the feet never alternate", "take"))
+        return result
+
+    def rest_in(lo: int, hi: int) -> tuple[int, int] | None:
+        for r in rests:
+            if r[0] >= lo and r[1] <= hi:
+                return r
+        return None
+
+    keyframes: set[int] = set()
+    for j, (foot, a, b) in enumerate(phases):
+        side = _SIDE[foot]
+        # incoming boundary: a transfer from the previous phase, a rest, or the take's start
+        before = rest_in(phases[j - 1][2] if j else 0, a)
+        if before is not None:
+            k0, kind0 = before[1] - 1, "begin"
+        elif j > 0:
+            k0, kind0 = (phases[j - 1][2] + a - 1) // 2, "transfer"
+        else:
+            k0, kind0 = None, "border"
+        after = rest_in(b, phases[j + 1][1] if j + 1 < len(phases) else n)
+        if after is not None:
+            k1, kind1 = after[0], "end"
+        elif j + 1 < len(phases):
+            k1, kind1 = (b + phases[j + 1][1] - 1) // 2, "transfer"
+        else:
+            k1, kind1 = None, "border"
+        for k in (k0, k1):
+            if k is not None:
+                keyframes.add(k)
+        lo, hi = (a if k0 is None else k0), (b if k1 is None else k1 + 1)
+        if kind0 == "border" or kind1 == "border":
+            where = "start" if kind0 == "border" else "end"
+            result.rejections.append(reject(
+                f"{_FOOT[foot]} stance cut by the take's {where}: its support transfer is not in the take",
+                "border", lo, hi))
+            continue
+        if kind0 == "begin" and kind1 == "end":
+            result.rejections.append(reject(
+                f"single {_FOOT[foot]}-stance step between two rests fits no primitive (begin and end at once)",
+                "step", lo, hi))
+            continue
+        primitive = {"begin": f"begin{side}Stance", "end": f"end{side}Stance"}.get(
+            kind0 if kind0 == "begin" else kind1, f"{_FOOT[foot]}Stance")
+        reason = _check_step(contacts[lo:hi], foot, fps, settings)
+        if reason is not None:
+            result.rejections.append(reject(f"{primitive}: {reason}", "step", lo, hi))
+            continue
+        result.clips.append(Clip(action, primitive, take.style, take.name, take.content, lo, hi, fps,
+                                 take.frames[lo:hi], contacts[lo:hi]))
+    result.keyframes = sorted(keyframes)
+    return result
+
+
+def _check_step(contacts: np.ndarray, foot: int, fps: float, settings: SegmentSettings) -> str | None:
+    """Why a step's ``(frames, 2)`` contacts fit no primitive, or None if they fit."""
+    duration = (contacts.shape[0] - 1) / fps
+    if duration < settings.min_step_s:
+        return f"too short ({duration:.3f} s < min_step_s {settings.min_step_s} s)"
+    if duration > settings.max_step_s:
+        return (f"too long ({duration:.2f} s > max_step_s {settings.max_step_s} s; a missed contact of the "
+                f"{_FOOT[1 - foot]} foot?)")
+    stance, swing = contacts[:, foot], contacts[:, 1 - foot]
+    if swing.all():
+        return f"the swing foot ({_FOOT[1 - foot]}) never leaves the ground"
+    share = stance.mean()
+    if share < settings.min_stance_fraction:
+        return (f"the planted foot ({_FOOT[foot]}) touches the ground in only {share:.0%} of the frames "
+                f"(< min_stance_fraction {settings.min_stance_fraction:.0%})")
+    if len(_runs(stance)) > 1:
+        return f"the {_FOOT[foot]} foot leaves the ground and lands again with no {_FOOT[1 - foot]}-foot support (hop)"
+    return None
+
+
+def segment_takes(takes: Iterable[Take], settings: SegmentSettings | None = None) -> Segmentation:
+    """Segment every locomotion take; other contents are listed in ``ignored``."""
+    settings = settings or SegmentSettings()
+    out = Segmentation()
+    for take in takes:
+        if action_of(take.content, settings.actions) is None:
+            out.ignored.append((take.name, take.content))
+            continue
+        seg = segment_take(take, settings)
+        out.takes.append(seg)
+        out.clips.extend(seg.clips)
+        out.rejections.extend(seg.rejections)
+    return out
+
+
+# ---------------------------------------------------------------------------------------------
+# Canonical timelines
+
+
+def canonical_timelines(clips: Iterable[Clip], statistic: str = "median") -> dict[tuple[str, str], int]:
+    """Canonical length in frames of each (action, primitive): the median (or mean/max/min) of
+    its clips' lengths, rounded to a whole frame."""
+    funcs = {"median": np.median, "mean": np.mean, "max": np.max, "min": np.min}
+    if statistic not in funcs:
+        raise ValueError(f"unknown timeline statistic {statistic!r}; one of {sorted(funcs)}")
+    lengths: dict[tuple[str, str], list[int]] = {}
+    for c in clips:
+        lengths.setdefault((c.action, c.primitive), []).append(c.num_frames)
+    return {key: int(round(float(funcs[statistic](v)))) for key, v in sorted(lengths.items())}
+
+
+def time_normalize(frames: np.ndarray, length: int) -> np.ndarray:
+    """Resample a clip's frames to ``length`` frames spanning the same first-to-last interval.
+
+    Channels are interpolated linearly in normalized time; the velocity and yaw-rate channels
+    keep their per-second units, so the result plays back at :func:`playback_fps`.
+
+    Args:
+        frames: ``(..., frames, channels)`` with frames ≥ 2 (e.g. 66-dim frames).
+        length: target number of frames, ≥ 2.
+
+    Returns:
+        ``(..., length, channels)`` float32.
+    """
+    frames = np.asarray(frames)
+    n = frames.shape[-2]
+    if n < 2 or length < 2:
+        raise ValueError(f"time normalization needs at least 2 frames in and out, got {n} → {length}")
+    src = np.linspace(0.0, 1.0, n)
+    dst = np.linspace(0.0, 1.0, length)
+    idx = np.clip(np.searchsorted(src, dst, side="right") - 1, 0, n - 2)
+    w = ((dst - src[idx]) / (src[idx + 1] - src[idx]))[:, None]
+    out = frames[..., idx, :] * (1.0 - w) + frames[..., idx + 1, :] * w
+    return out.astype(np.float32)
+
+
+def playback_fps(length: int, duration_s: float) -> float:
+    """Frame rate at which a clip normalized to ``length`` frames lasts ``duration_s`` seconds."""
+    if duration_s <= 0:
+        raise ValueError(f"duration must be positive, got {duration_s}")
+    return (length - 1) / duration_s
+
+
+def restore_duration(frames: np.ndarray, duration_s: float, fps: float) -> np.ndarray:
+    """Resample time-normalized frames to ``fps`` over ``duration_s`` seconds.
+
+    Args:
+        frames: ``(..., length, channels)`` time-normalized frames.
+        duration_s: real (e.g. sampled) duration, seconds.
+        fps: output frame rate.
+
+    Returns:
+        ``(..., round(duration_s·fps) + 1, channels)`` float32.
+    """
+    return time_normalize(frames, max(2, int(round(duration_s * fps)) + 1))
