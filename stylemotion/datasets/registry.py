@@ -3,10 +3,11 @@
 from __future__ import annotations
 
 import inspect
-from typing import Any, Callable, Mapping
+from collections.abc import Callable, Mapping
+from typing import Any
 
-from stylemotion.datasets.base import Take, TakeSet
 from stylemotion.datasets.bandai import load_bandai
+from stylemotion.datasets.base import Take, TakeSet
 from stylemotion.datasets.bvh_folder import load_bvh_folder
 from stylemotion.datasets.loading import ConversionSettings
 
