@@ -12,11 +12,11 @@ Everything is built at the position level so that the contacts are exact:
    little.
 2. **Feet**: a planted foot (ankle and toes) stays exactly fixed on the ground from its footfall to
    its lift-off; the swing foot follows a minimum-jerk path with a height bump (knee lift) and a
-   toe-off/heel-strike pitch. Walks overlap stances (double support, about 20% of the cycle); runs
-   have flight phases.
-3. **Pelvis**: a cubic spline through the stance feet (with lateral sway), at a height that is the
-   smooth minimum of a style's carriage height and what both legs can reach, so the inverted
-   pendulum bob of walking comes out of the leg geometry.
+   toe-off/heel-strike pitch, drawn in towards the hip where the leg could not reach it. Walks
+   overlap stances (double support, about 20% of the cycle); runs have flight phases.
+3. **Pelvis**: a cubic spline through points above the planted feet (with lateral sway), at a
+   height that is a smooth minimum of the style's carriage (with an inverted-pendulum bob when
+   walking) and of what the planted legs reach, so no leg is ever over-stretched.
 4. **Body**: pelvis, spine, head and arms are posed by rotating a rest skeleton (torso lean, head
    drop, pelvis twist and list, shoulder counter-rotation, arm swing opposite to the legs) through
    :func:`stylemotion.skeleton.forward_kinematics`; knees come from an analytic two-bone IK with a
@@ -42,8 +42,8 @@ from stylemotion.skeleton import CANONICAL_PARENTS, CJ, forward_kinematics
 
 CONTENTS: tuple[str, ...] = ("walk", "walk-turn-left", "walk-turn-right", "run")
 
-# Rest skeleton of a 1.75 m adult, metres, body frame (+X left, +Y up, +Z forward); the offset of
-# each joint from its parent. ``_SIDE`` marks the left (+1) / right (-1) joints mirrored in x.
+# Rest skeleton of a 1.75 m adult, metres, body frame (+X left, +Y up, +Z forward): offsets of
+# joints from their parents (left side; the right side mirrors x) and bone lengths.
 _ANKLE_HEIGHT = 0.08  # ankle above the ground with the foot flat
 _TOE_HEIGHT = 0.02  # ball of the foot above the ground with the foot flat
 _THIGH = 0.43
@@ -101,7 +101,7 @@ class _Style:
 
 
 _NORMAL = _Style(
-    step_length=0.66, step_time=0.53, step_width=0.12, stance=0.60, run_stance=0.36, lift=0.10,
+    step_length=0.66, step_time=0.53, step_width=0.12, stance=0.60, run_stance=0.32, lift=0.10,
     carriage=0.975, bounce=0.0, sway=0.025, pelvis_twist=0.08, pelvis_list=0.06, lean=0.04,
     head_drop=0.0, arm_swing=0.30, arm_forward=0.05, elbow=0.25, arm_abduction=0.10,
     shoulder_droop=0.0, shoulder_protraction=0.0, chest_twist=0.08, toe_out=0.12, clavicle=0.14,
@@ -110,18 +110,18 @@ _NORMAL = _Style(
 
 _STYLE_TABLE: dict[str, _Style] = {
     "active": dataclasses.replace(
-        _NORMAL, step_length=0.80, step_time=0.49, run_stance=0.32, lift=0.13, bounce=0.01,
+        _NORMAL, step_length=0.76, step_time=0.47, stance=0.58, run_stance=0.28, lift=0.13, bounce=0.01,
         pelvis_twist=0.12, pelvis_list=0.05, lean=0.08, arm_swing=0.50, arm_forward=0.08, elbow=0.55,
         chest_twist=0.12,
     ),
     "elderly": dataclasses.replace(
-        _NORMAL, step_length=0.42, step_time=0.60, step_width=0.15, stance=0.64, run_stance=0.43,
+        _NORMAL, step_length=0.42, step_time=0.60, step_width=0.15, stance=0.64, run_stance=0.40,
         lift=0.06, carriage=0.93, sway=0.03, pelvis_twist=0.04, pelvis_list=0.04, lean=0.30,
         head_drop=0.15, arm_swing=0.10, arm_forward=0.15, elbow=0.45, arm_abduction=0.12,
         shoulder_droop=0.05, shoulder_protraction=0.15, chest_twist=0.03, toe_out=0.20, clavicle=0.13,
     ),
     "exhausted": dataclasses.replace(
-        _NORMAL, step_length=0.50, step_time=0.68, step_width=0.13, stance=0.62, run_stance=0.42,
+        _NORMAL, step_length=0.50, step_time=0.68, step_width=0.13, stance=0.62, run_stance=0.38,
         lift=0.035, carriage=0.95, sway=0.035, pelvis_twist=0.05, pelvis_list=0.05, lean=0.20,
         head_drop=0.45, arm_swing=0.12, arm_forward=0.0, elbow=0.10, arm_abduction=0.06,
         shoulder_droop=0.20, shoulder_protraction=0.15, chest_twist=0.04,
@@ -139,7 +139,7 @@ _STYLE_TABLE: dict[str, _Style] = {
     ),
     "normal": _NORMAL,
     "youthful": dataclasses.replace(
-        _NORMAL, step_length=0.70, step_time=0.45, step_width=0.11, run_stance=0.33, lift=0.18,
+        _NORMAL, step_length=0.70, step_time=0.45, step_width=0.11, run_stance=0.30, lift=0.18,
         carriage=0.98, bounce=0.025, sway=0.02, pelvis_twist=0.10, lean=0.0, head_drop=-0.05,
         arm_swing=0.55, arm_forward=0.10, elbow=0.45, arm_abduction=0.12, shoulder_droop=-0.05,
         chest_twist=0.12, toe_out=0.08,
@@ -177,6 +177,7 @@ class _Gait:
     stance: float  # stance fraction of a cycle
     lift_peak: float  # swing progress (0..1) at which the ankle is highest
     toe_pitch: float  # toe-down / toe-up amplitude of the swing foot, radians
+    pelvis_over: float  # fraction of a stance at which the pelvis passes over the planted foot
     running: bool
     scale: float  # body size relative to the 1.75 m rest skeleton
 
@@ -209,8 +210,8 @@ class _Steps:
         sides: ``(k,)`` +1 left, -1 right.
         feet: ``(k, 2)`` planted ankle ground position (x, z), metres.
         foot_yaw: ``(k,)`` planted foot yaw, radians.
-        pelvis: ``(k, 2)`` pelvis ground position (x, z) at the foot's midstance, metres.
-        midstance: ``(k,)`` midstance times, seconds.
+        pelvis: ``(k, 2)`` pelvis ground position (x, z) when it passes over the planted foot, metres.
+        pelvis_time: ``(k,)`` times at which it does, seconds.
     """
 
     times: np.ndarray
@@ -219,7 +220,31 @@ class _Steps:
     feet: np.ndarray
     foot_yaw: np.ndarray
     pelvis: np.ndarray
-    midstance: np.ndarray
+    pelvis_time: np.ndarray
+
+
+@dataclass(frozen=True)
+class _PelvisPath:
+    """The pelvis' ground path, gait phase and rotation as functions of time (seconds)."""
+
+    gait: _Gait
+    steps: _Steps
+    heading: _Heading
+    spline: CubicSpline  # pelvis ground (x, z) through the steps' pelvis_time and pelvis
+
+    def ground(self, t: np.ndarray) -> np.ndarray:
+        """Pelvis ground position ``(n, 2)`` (x, z) metres at times ``t`` ``(n,)``."""
+        return self.spline(t)
+
+    def phase(self, t: np.ndarray) -> np.ndarray:
+        """Gait phase ``(n,)`` in cycles: integer at left footfalls, +0.5 at right ones."""
+        steps = self.steps
+        first_left = 0 if steps.sides[0] > 0 else 1
+        return np.interp(t, steps.times, (np.arange(len(steps.times)) - first_left) / 2)
+
+    def rotation(self, t: np.ndarray) -> np.ndarray:
+        """Global pelvis rotation ``(n, 3, 3)`` at times ``t``."""
+        return _pelvis_rotation(self.gait, self.heading(t), self.phase(t))
 
 
 def _rng(seed: int, content: str, style: str, index: int) -> np.random.Generator:
@@ -239,10 +264,10 @@ def _gait_for(style: str, content: str, rng: np.random.Generator) -> _Gait:
     running = content == "run"
     if running:
         s = dataclasses.replace(
-            s, step_length=s.step_length * 1.8, step_time=s.step_time * 0.62,
+            s, step_length=s.step_length * 1.6, step_time=s.step_time * 0.62,
             step_width=s.step_width * 0.5, lift=s.lift + 0.15, carriage=s.carriage - 0.04,
             bounce=s.bounce + 0.03, sway=s.sway * 0.5, lean=s.lean + 0.12, arm_swing=s.arm_swing * 1.3,
-            elbow=s.elbow + 1.1, pelvis_list=s.pelvis_list * 0.5,
+            elbow=1.3 + 0.3 * s.elbow, pelvis_list=s.pelvis_list * 0.5,
         )  # fmt: skip
     scale = rng.uniform(0.95, 1.05)
     jitter = rng.normal(0.0, 1.0, size=5)
@@ -261,6 +286,7 @@ def _gait_for(style: str, content: str, rng: np.random.Generator) -> _Gait:
         stance=s.run_stance if running else s.stance,
         lift_peak=0.3,
         toe_pitch=0.2 + 1.5 * s.lift,
+        pelvis_over=0.42 if running else 0.5,
         running=running,
         scale=scale,
     )
@@ -299,9 +325,9 @@ def _plan_steps(gait: _Gait, heading: _Heading, start: float, end: float, rng: n
     sides = np.where((np.arange(n) + (rng.uniform() < 0.5)) % 2 == 0, 1.0, -1.0)
     times = start + np.concatenate([[0.0], np.cumsum(durations[:-1])])
     stance = 2 * gait.stance * durations
-    midstance = times + stance / 2
-    yaw = heading(midstance) + 0.02 * noise[3]
-    advance = lengths[1:, None] * _forward(heading((midstance[:-1] + midstance[1:]) / 2))
+    over = times + gait.pelvis_over * stance
+    yaw = heading(over) + 0.02 * noise[3]
+    advance = lengths[1:, None] * _forward(heading((over[:-1] + over[1:]) / 2))
     centre = np.concatenate([np.zeros((1, 2)), np.cumsum(advance, axis=0)])
     lateral = sides[:, None] * _left(yaw)
     return _Steps(
@@ -311,14 +337,8 @@ def _plan_steps(gait: _Gait, heading: _Heading, start: float, end: float, rng: n
         feet=centre + lateral * widths[:, None] / 2,
         foot_yaw=yaw + sides * s.toe_out,
         pelvis=centre + lateral * s.sway,
-        midstance=midstance,
+        pelvis_time=over,
     )
-
-
-def _gait_phase(steps: _Steps, t: np.ndarray) -> np.ndarray:
-    """Gait phase ``(n,)`` in cycles at times ``t``: integer at left footfalls, +0.5 at right ones."""
-    first_left = 0 if steps.sides[0] > 0 else 1
-    return np.interp(t, steps.times, (np.arange(len(steps.times)) - first_left) / 2)
 
 
 def _min_jerk(u: np.ndarray) -> np.ndarray:
@@ -337,6 +357,8 @@ class _Foot:
         contact: ``(n,)`` bool, planted (ankle and toes exactly still on the ground).
         swing: ``(n,)`` swing progress, 0 at lift-off (and during stance) to 1 at the footfall.
         spots: ``(2, n, 2)`` ground (x, z) of the ankle's last footfall and of its next one.
+        lift_time: ``(n,)`` time of the last lift-off (or the coming one, while planted), seconds.
+        land_time: ``(n,)`` time of the next footfall, seconds.
     """
 
     ankle: np.ndarray
@@ -345,6 +367,8 @@ class _Foot:
     contact: np.ndarray
     swing: np.ndarray
     spots: np.ndarray
+    lift_time: np.ndarray
+    land_time: np.ndarray
 
 
 def _foot_track(steps: _Steps, side: float, t: np.ndarray, gait: _Gait) -> _Foot:
@@ -365,7 +389,7 @@ def _foot_track(steps: _Steps, side: float, t: np.ndarray, gait: _Gait) -> _Foot
     ankle_y = gait.scale * _ANKLE_HEIGHT + gait.style.lift * 16 * peak_u**2 * (1 - peak_u) ** 2
     ankle = np.stack([ground[:, 0], ankle_y, ground[:, 1]], axis=-1)
     toes = _toes(ankle, foot_yaw, u, gait)
-    return _Foot(ankle, toes, foot_yaw, t < lift[j], u, np.stack([feet[j], feet[j + 1]]))
+    return _Foot(ankle, toes, foot_yaw, t < lift[j], u, np.stack([feet[j], feet[j + 1]]), lift[j], land[j + 1])
 
 
 def _toes(ankle: np.ndarray, foot_yaw: np.ndarray, swing: np.ndarray, gait: _Gait) -> np.ndarray:
@@ -417,6 +441,21 @@ def _rest_offsets(gait: _Gait) -> np.ndarray:
     return offsets * gait.scale
 
 
+def _pelvis_roll(gait: _Gait, phase: np.ndarray) -> np.ndarray:
+    """Pelvis roll ``(n,)`` radians at gait phase ``phase``: the swing side's hip drops."""
+    return gait.style.pelvis_list * np.cos(2 * np.pi * (phase - gait.stance / 2))
+
+
+def _pelvis_rotation(gait: _Gait, yaw: np.ndarray, phase: np.ndarray) -> np.ndarray:
+    """Global pelvis rotations ``(n, 3, 3)`` at heading ``yaw`` and gait phase ``phase`` ``(n,)``.
+
+    The pelvis twists so that each hip goes forward with its leg, rolls (swing hip drops) and tips
+    forward with a third of the torso lean.
+    """
+    twist = -gait.style.pelvis_twist * np.cos(2 * np.pi * phase)  # left hip forward at left footfall
+    return _rot_y(yaw + twist) @ _rot_z(_pelvis_roll(gait, phase)) @ _rot_x(0.3 * gait.style.lean)
+
+
 def _global_rotations(gait: _Gait, yaw: np.ndarray, phase: np.ndarray) -> np.ndarray:
     """Global rotations ``(n, 21, 3, 3)`` of the pelvis, torso, head and arms (legs: the pelvis').
 
@@ -427,12 +466,11 @@ def _global_rotations(gait: _Gait, yaw: np.ndarray, phase: np.ndarray) -> np.nda
     """
     s = gait.style
     cycle = np.cos(2 * np.pi * phase)  # +1 when the left foot lands (left leg forward)
-    pelvis_yaw = yaw - s.pelvis_twist * cycle  # left hip forward with the left leg
     chest_yaw = yaw + s.chest_twist * cycle  # shoulders counter-rotate
-    pelvis_roll = s.pelvis_list * np.cos(2 * np.pi * (phase - gait.stance / 2))  # swing hip drops
     rotations = np.empty(yaw.shape + (21, 3, 3))
-    rotations[:, CJ["Hips"]] = _rot_y(pelvis_yaw) @ _rot_z(pelvis_roll) @ _rot_x(0.3 * s.lean)
-    rotations[:, CJ["Spine"]] = _rot_y((pelvis_yaw + chest_yaw) / 2) @ _rot_x(0.5 * s.lean)
+    rotations[:, CJ["Hips"]] = _pelvis_rotation(gait, yaw, phase)
+    rotations[:, CJ["Spine"]] = _rot_y(yaw + (s.chest_twist - s.pelvis_twist) / 2 * cycle) @ _rot_x(0.5 * s.lean)
+    pelvis_roll = _pelvis_roll(gait, phase)
     chest = _rot_y(chest_yaw) @ _rot_z(-0.5 * pelvis_roll) @ _rot_x(s.lean)
     rotations[:, CJ["Chest"]] = chest
     rotations[:, CJ["Neck"]] = _rot_y(yaw + 0.3 * s.chest_twist * cycle) @ _rot_x(s.lean + s.head_drop)
@@ -441,7 +479,7 @@ def _global_rotations(gait: _Gait, yaw: np.ndarray, phase: np.ndarray) -> np.nda
         shoulder = chest @ _rot_y(-side * s.shoulder_protraction) @ _rot_z(-side * s.shoulder_droop)
         flexion = s.arm_forward - side * s.arm_swing * cycle  # left arm back when the left leg leads
         upper = _rot_y(chest_yaw) @ _rot_z(side * s.arm_abduction * np.ones_like(yaw)) @ _rot_x(-flexion)
-        lower = upper @ _rot_x(-(s.elbow + 0.8 * np.maximum(flexion, 0.0)))
+        lower = upper @ _rot_x(-(s.elbow + 0.5 * np.maximum(flexion, 0.0)))
         rotations[:, CJ["Shoulder" + suffix]] = shoulder
         rotations[:, CJ["UpperArm" + suffix]] = upper
         rotations[:, CJ["LowerArm" + suffix]] = lower
@@ -467,53 +505,65 @@ def _bob(gait: _Gait, phase: np.ndarray) -> np.ndarray:
     return s.bounce - (max(drop, 0.0) + 2 * s.bounce) * trough
 
 
-def _pelvis_height(
-    gait: _Gait, hips_rot: np.ndarray, pelvis_xz: np.ndarray, feet: list[_Foot], offsets: np.ndarray,
-    phase: np.ndarray,
+def _pelvis_limit(
+    gait: _Gait, pelvis: _PelvisPath, times: np.ndarray, hip_offset: np.ndarray, spot: np.ndarray
 ) -> np.ndarray:
-    """Pelvis height ``(n,)`` metres: a smooth minimum of the carriage height and the legs' reach.
-
-    A planted leg limits the height to what it reaches with ``_REACH`` of its length. A swinging leg
-    does not (its knee bends), but so that the height stays continuous, the limits of its last and
-    next footfall spots fade out after lift-off and fade in before the footfall.
+    """Highest pelvis ``(n,)`` metres whose hip joint reaches an ankle planted at ``spot``.
 
     Args:
         gait: the take's gait.
-        hips_rot: ``(n, 3, 3)`` global pelvis rotation.
-        pelvis_xz: ``(n, 2)`` pelvis ground position, metres.
-        feet: the left and right foot tracks.
-        offsets: ``(21, 3)`` rest offsets.
-        phase: ``(n,)`` gait phase in cycles.
+        pelvis: the pelvis' ground path and rotation.
+        times: ``(n,)`` seconds.
+        hip_offset: ``(3,)`` rest offset of the leg's hip joint from the Hips joint, metres.
+        spot: ``(n, 2)`` ground (x, z) of the planted ankle, metres.
     """
     legs = (_THIGH + _SHIN) * gait.scale
-    limits = [gait.scale * (_ANKLE_HEIGHT + _PELVIS_DROP) + gait.style.carriage * legs + _bob(gait, phase)]
-    ankle_y = gait.scale * _ANKLE_HEIGHT
+    hip = np.einsum("nab,b->na", pelvis.rotation(times), hip_offset)  # hip joint, pelvis at the origin
+    ground = np.linalg.norm(pelvis.ground(times) + hip[:, [0, 2]] - spot, axis=-1)
+    reach = np.sqrt(np.maximum((_REACH * legs) ** 2 - ground**2, 0.0))
+    return gait.scale * _ANKLE_HEIGHT - hip[:, 1] + reach
+
+
+def _pelvis_height(
+    gait: _Gait, pelvis: _PelvisPath, t: np.ndarray, feet: list[_Foot], offsets: np.ndarray
+) -> np.ndarray:
+    """Pelvis height ``(n,)`` metres at times ``t``: a smooth minimum of carriage and reach.
+
+    A planted leg limits the height to what it reaches with ``_REACH`` of its length. A swinging
+    leg does not (its knee bends), but so that the height stays smooth, the limit its foot had at
+    lift-off fades out quickly, and the limit it will have at the footfall fades in over the swing
+    (the pelvis descends as the leg reaches forward).
+    """
+    legs = (_THIGH + _SHIN) * gait.scale
+    limits = [
+        gait.scale * (_ANKLE_HEIGHT + _PELVIS_DROP) + gait.style.carriage * legs
+        + _bob(gait, pelvis.phase(t))
+    ]  # fmt: skip
     for foot, joint in zip(feet, ("UpperLeg_L", "UpperLeg_R"), strict=True):
-        hip = np.einsum("nab,b->na", hips_rot, offsets[CJ[joint]])  # hip joint, pelvis at the origin
-        # the leg on its last footfall spot (planted, or just lifted off), then on its next spot
-        # (about to land); a swinging leg has slack that vanishes at lift-off and at the footfall
-        slack = legs * np.stack([_LIFT_SLACK * foot.swing, np.where(foot.contact, np.inf, _LAND_SLACK * (1 - foot.swing))])
-        ground = np.linalg.norm(pelvis_xz + hip[:, [0, 2]] - foot.spots, axis=-1)
-        reach = np.sqrt(np.maximum((_REACH * legs) ** 2 - ground**2, 0.0))
-        limits.extend(ankle_y - hip[:, 1] + reach + slack)
+        offset = offsets[CJ[joint]]
+        planted = _pelvis_limit(gait, pelvis, t, offset, foot.spots[0])
+        lifted = _pelvis_limit(gait, pelvis, foot.lift_time, offset, foot.spots[0])
+        landing = _pelvis_limit(gait, pelvis, foot.land_time, offset, foot.spots[1])
+        limits.append(np.where(foot.contact, planted, lifted + _LIFT_SLACK * legs * foot.swing))
+        limits.append(np.where(foot.contact, np.inf, landing + _LAND_SLACK * legs * (1 - foot.swing)))
     return -_SOFTMIN_M * logsumexp(-np.stack(limits) / _SOFTMIN_M, axis=0)
 
 
 def _within_reach(foot: _Foot, hip: np.ndarray, legs: float, gait: _Gait) -> _Foot:
-    """The foot with its swinging ankle pulled towards ``hip`` ``(n, 3)`` where the leg is too short.
+    """The foot with its swinging ankle drawn towards ``hip`` ``(n, 3)`` where the leg is short.
 
-    Planted feet are within reach by construction of the pelvis height and are left untouched.
+    The hip-ankle distance of a swinging foot becomes a smooth minimum of itself and ``_REACH`` of
+    the leg length (the leg extends as the foot reaches forward, and the foot comes down from above);
+    planted feet are within reach by construction of the pelvis height and stay where they are.
     """
     reach = foot.ankle - hip
     dist = np.linalg.norm(reach, axis=-1, keepdims=True)
-    limit = _REACH * legs
-    ankle = np.where(dist > limit, hip + reach * (limit / dist), foot.ankle)
+    drawn = -_SOFTMIN_M * np.logaddexp(-dist / _SOFTMIN_M, -_REACH * legs / _SOFTMIN_M)
+    ankle = np.where(foot.contact[:, None], foot.ankle, hip + reach * (drawn / dist))
     return dataclasses.replace(foot, ankle=ankle, toes=_toes(ankle, foot.yaw, foot.swing, gait))
 
 
-def _two_bone_ik(
-    hip: np.ndarray, ankle: np.ndarray, pole: np.ndarray, upper: float, lower: float
-) -> np.ndarray:
+def _two_bone_ik(hip: np.ndarray, ankle: np.ndarray, pole: np.ndarray, upper: float, lower: float) -> np.ndarray:
     """Knee positions ``(n, 3)`` with ``|knee − hip| = upper`` and ``|ankle − knee| = lower``.
 
     The knee bends towards ``pole`` ``(n, 3)`` (a direction). ``hip`` and ``ankle`` are ``(n, 3)``
@@ -582,14 +632,14 @@ def generate_take(
     t = np.arange(num_frames) / fps
     margin = 3 * gait.style.step_time
     steps = _plan_steps(gait, heading, -margin, t[-1] + margin, rng)
-    phase = _gait_phase(steps, t)
+    pelvis = _PelvisPath(gait, steps, heading, CubicSpline(steps.pelvis_time, steps.pelvis))
     feet = [_foot_track(steps, side, t, gait) for side in (1.0, -1.0)]
-    pelvis_xz = CubicSpline(steps.midstance, steps.pelvis)(t)
     offsets = _rest_offsets(gait)
-    global_rot = _global_rotations(gait, heading(t), phase)
-    height = _pelvis_height(gait, global_rot[:, CJ["Hips"]], pelvis_xz, feet, offsets, phase)
+    global_rot = _global_rotations(gait, heading(t), pelvis.phase(t))
+    ground = pelvis.ground(t)
+    height = _pelvis_height(gait, pelvis, t, feet, offsets)
     translations = np.broadcast_to(offsets, (num_frames, 21, 3)).copy()
-    translations[:, CJ["Hips"]] = np.stack([pelvis_xz[:, 0], height, pelvis_xz[:, 1]], axis=-1)
+    translations[:, CJ["Hips"]] = np.stack([ground[:, 0], height, ground[:, 1]], axis=-1)
     positions = forward_kinematics(_local_rotations(global_rot), translations, CANONICAL_PARENTS)
     _pose_legs(positions, feet, gait)
     positions[:, :, [0, 2]] -= positions[0, CJ["Hips"], [0, 2]]
@@ -603,8 +653,12 @@ def generate_take(
 
 
 def generate_takes(
-    takes_per_pair: int = 4, seed: int = 0, fps: float = 30.0, duration_s: float = 8.0,
-    styles: Sequence[str] | None = None, contents: Sequence[str] | None = None,
+    takes_per_pair: int = 4,
+    seed: int = 0,
+    fps: float = 30.0,
+    duration_s: float = 8.0,
+    styles: Sequence[str] | None = None,
+    contents: Sequence[str] | None = None,
 ) -> list[SyntheticTake]:
     """Generate ``takes_per_pair`` takes for every (content, style) pair.
 
