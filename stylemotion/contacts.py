@@ -37,9 +37,10 @@ FOOT_POINTS: np.ndarray = np.array([[CJ["Foot_L"], CJ["Toes_L"]], [CJ["Foot_R"],
 class ContactSettings:
     """Thresholds of :func:`foot_contacts`; heights in leg lengths, speeds in leg lengths/second.
 
-    With a leg length of 0.85 m the defaults are: strict 3.4 cm and 0.30 m/s, loose 6.0 cm and
-    0.60 m/s. Swing feet move at 1–4 m/s even in an elderly shuffle, and the ball of a planted
-    foot stays within a centimetre of its resting height.
+    With a leg length of 0.85 m the defaults are: strict 3.4 cm and 0.26 m/s, loose 6.0 cm and
+    0.43 m/s. Swing feet move at 1–4 m/s even in an elderly shuffle, and the ball of a planted
+    foot stays within a centimetre of its resting height. (Tuned on Bandai walks and runs of all
+    seven styles and on the synthetic generator's exact contacts; see ``benchmarks/primitives.md``.)
 
     Attributes:
         height_on: strict height above rest (a contact must contain a frame below it).
@@ -48,14 +49,18 @@ class ContactSettings:
         speed_off: loose horizontal speed (... and slower than this).
         filter_s: width of the median filter on the contact flags, seconds (odd frame count,
             at least 3 frames).
+        fill_gap_s: a gap in one foot's contact of at most this many seconds is filled when a
+            point of the foot stays below the loose height throughout it (a pivot or slide of the
+            planted foot, e.g. turning on the stance foot, not a step), seconds.
         rest_percentile: percentile of a point's height taken as its resting height.
     """
 
     height_on: float = 0.04
-    speed_on: float = 0.35
+    speed_on: float = 0.3
     height_off: float = 0.07
-    speed_off: float = 0.7
+    speed_off: float = 0.5
     filter_s: float = 0.1
+    fill_gap_s: float = 0.1
     rest_percentile: float = 5.0
 
     def __post_init__(self) -> None:
@@ -180,11 +185,15 @@ def contacts_from_signals(sig: FootSignals, fps: float, settings: ContactSetting
     lead, frames = strict.shape[:-2], strict.shape[-2]
     strict2 = np.moveaxis(strict, -2, -1).reshape(-1, frames)  # (sequences·feet, frames)
     loose2 = np.moveaxis(loose, -2, -1).reshape(-1, frames)
+    low = (sig.heights < settings.height_off * scale).any(-1)
+    low2 = np.moveaxis(low, -2, -1).reshape(-1, frames)
     width = max(3, int(round(settings.filter_s * fps)) | 1)
+    max_gap = int(round(settings.fill_gap_s * fps))
     out = np.empty_like(strict2)
     for i in range(strict2.shape[0]):
         grown = _grow(strict2[i], loose2[i])
-        out[i] = median_filter(grown.astype(np.uint8), size=width, mode="nearest").astype(bool)
+        filtered = median_filter(grown.astype(np.uint8), size=width, mode="nearest").astype(bool)
+        out[i] = _fill_low_gaps(filtered, low2[i], max_gap)
     return np.moveaxis(out.reshape(lead + (2, frames)), -1, -2)
 
 
@@ -197,6 +206,18 @@ def _grow(strict: np.ndarray, loose: np.ndarray) -> np.ndarray:
     keep[np.unique(labels[strict])] = True
     keep[0] = False
     return keep[labels]
+
+
+def _fill_low_gaps(contact: np.ndarray, low: np.ndarray, max_gap: int) -> np.ndarray:
+    """``contact`` with interior gaps of at most ``max_gap`` frames filled where ``low`` holds
+    throughout the gap (``(frames,)`` bool each)."""
+    out = contact.copy()
+    if max_gap < 1:
+        return out
+    for a, b in contact_intervals(~contact):
+        if a > 0 and b < len(contact) and b - a <= max_gap and low[a:b].all():
+            out[a:b] = True
+    return out
 
 
 def contact_intervals(contact: np.ndarray) -> list[tuple[int, int]]:

@@ -76,14 +76,14 @@ from __future__ import annotations
 
 from collections import Counter
 from collections.abc import Iterable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from functools import cached_property
 
 import numpy as np
 
-from stylemotion.contacts import ContactSettings, foot_contacts, leg_length
+from stylemotion.contacts import ContactSettings, foot_contacts, leg_length, planted_point_speed
 from stylemotion.datasets.base import Take
-from stylemotion.representation import ROOT_JOINT, frames_to_positions
+from stylemotion.representation import FRAME_DIM, ROOT_JOINT, VELOCITY_DIMS, frames_to_positions
 
 #: The six primitives of each locomotion action (DFKI walk graph naming).
 PRIMITIVES: tuple[str, ...] = (
@@ -134,14 +134,19 @@ class SegmentSettings:
     actions: tuple[str, ...] = ACTIONS
     min_step_s: float = 0.1
     max_step_s: float = 1.5
-    min_stance_fraction: float = 0.3
+    min_stance_fraction: float = 0.15
     rest_speed: float = 0.12
-    min_rest_s: float = 0.3
+    min_rest_s: float = 0.15
 
     @classmethod
     def from_dict(cls, values: dict | None) -> SegmentSettings:
         """Settings from plain values (e.g. a Hydra node); ``contacts`` may be a dict."""
         values = dict(values or {})
+        for keys, where in ((set(values), cls), (set(values.get("contacts") or {}), ContactSettings)):
+            unknown = sorted(keys - {f.name for f in fields(where)})
+            if unknown:
+                raise ValueError(f"unknown {where.__name__} option(s) {unknown}; valid: "
+                                 f"{sorted(f.name for f in fields(where))}")
         if isinstance(values.get("contacts"), dict):
             values["contacts"] = ContactSettings(**values["contacts"])
         if "actions" in values:
@@ -229,6 +234,7 @@ class TakeSegmentation:
     Attributes:
         take: the take's name.
         contacts: ``(frames, 2)`` bool contacts ``[left, right]``.
+        action, style, content: the take's action and labels.
         keyframes: sorted source frames of all keyframes (transfers and rest boundaries).
         phases: ``(foot, start, stop)`` single-support phases (0 = left).
         rests: ``(start, stop)`` standing-still runs.
@@ -238,6 +244,9 @@ class TakeSegmentation:
 
     take: str
     contacts: np.ndarray
+    action: str = ""
+    style: str = ""
+    content: str = ""
     keyframes: list[int] = field(default_factory=list)
     phases: list[tuple[int, int, int]] = field(default_factory=list)
     rests: list[tuple[int, int]] = field(default_factory=list)
@@ -343,11 +352,11 @@ def segment_take(take: Take, settings: SegmentSettings | None = None) -> TakeSeg
 
     min_frames = int(np.ceil(settings.min_step_s * fps)) + 3
     if n < min_frames:
-        return TakeSegmentation(take.name, np.zeros((n, 2), bool), rejections=[reject(
+        return TakeSegmentation(take.name, np.zeros((n, 2), bool), action, take.style, take.content, rejections=[reject(
             f"take too short for a step: {n} frames ({n / fps:.2f} s at {fps:g} fps); a step needs at least "
             f"{min_frames} frames (min_step_s={settings.min_step_s} plus a contact on each side)", "take")])
     contacts = foot_contacts(take.positions, fps, settings.contacts)
-    result = TakeSegmentation(take.name, contacts)
+    result = TakeSegmentation(take.name, contacts, action, take.style, take.content)
     if not contacts.any():
         result.rejections.append(reject("no foot contact detected in the whole take (feet never low and "
                                         "slow at once)", "take"))
@@ -392,7 +401,7 @@ def segment_take(take: Take, settings: SegmentSettings | None = None) -> TakeSeg
         for k in (k0, k1):
             if k is not None:
                 keyframes.add(k)
-        lo, hi = (a if k0 is None else k0), (b if k1 is None else k1 + 1)
+        lo, hi = (0 if k0 is None else k0), (n if k1 is None else k1 + 1)  # borders reach the take's ends
         if kind0 == "border" or kind1 == "border":
             where = "start" if kind0 == "border" else "end"
             result.rejections.append(reject(
@@ -451,6 +460,34 @@ def segment_takes(takes: Iterable[Take], settings: SegmentSettings | None = None
     return out
 
 
+def stance_speeds(positions: np.ndarray, fps: float, stance_foot: int,
+                  contacts: np.ndarray | None = None) -> dict[str, float]:
+    """How still the planted foot is in a stance clip, against the swinging foot.
+
+    Speeds are of each foot's slower point (:func:`stylemotion.contacts.planted_point_speed`).
+
+    Args:
+        positions: ``(frames, 21, 3)`` clip positions, metres.
+        fps: frames per second of the clip.
+        stance_foot: 0 (left planted) or 1 (right planted).
+        contacts: ``(frames, 2)`` bool contacts; gives ``planted_contact`` when given.
+
+    Returns:
+        ``planted_mid`` and ``swing_mid``: mean horizontal speed (m/s) of the planted and the
+        swing foot over the middle half of the clip (frames ``n//4`` to ``n - n//4``);
+        ``planted_contact``: the planted foot's mean speed over its contact frames (NaN if none).
+    """
+    speed = planted_point_speed(positions, fps)
+    n = speed.shape[0]
+    lo, hi = n // 4, max(n - n // 4, n // 4 + 1)
+    out = {"planted_mid": float(speed[lo:hi, stance_foot].mean()),
+           "swing_mid": float(speed[lo:hi, 1 - stance_foot].mean())}
+    if contacts is not None:
+        on = np.asarray(contacts, dtype=bool)[:, stance_foot]
+        out["planted_contact"] = float(speed[on, stance_foot].mean()) if on.any() else float("nan")
+    return out
+
+
 # ---------------------------------------------------------------------------------------------
 # Canonical timelines
 
@@ -467,11 +504,22 @@ def canonical_timelines(clips: Iterable[Clip], statistic: str = "median") -> dic
     return {key: int(round(float(funcs[statistic](v)))) for key, v in sorted(lengths.items())}
 
 
+def _interp(frames: np.ndarray, src: np.ndarray, dst: np.ndarray) -> np.ndarray:
+    """Linear interpolation of ``(..., n, c)`` samples at increasing times ``src`` to ``dst``
+    (clamped to the end values outside ``src``)."""
+    n = src.shape[0]
+    idx = np.clip(np.searchsorted(src, dst, side="right") - 1, 0, n - 2)
+    w = np.clip((dst - src[idx]) / (src[idx + 1] - src[idx]), 0.0, 1.0)[:, None]
+    return frames[..., idx, :] * (1.0 - w) + frames[..., idx + 1, :] * w
+
+
 def time_normalize(frames: np.ndarray, length: int) -> np.ndarray:
     """Resample a clip's frames to ``length`` frames spanning the same first-to-last interval.
 
-    Channels are interpolated linearly in normalized time; the velocity and yaw-rate channels
-    keep their per-second units, so the result plays back at :func:`playback_fps`.
+    Channels are interpolated linearly in normalized time. For 66-dim frames the root velocity
+    and yaw-rate channels (forward differences: frame ``t`` holds the motion from ``t`` to
+    ``t + 1``) are interpolated at the middle of each frame interval, and keep their per-second
+    units, so the result integrated at :func:`playback_fps` follows the original root path.
 
     Args:
         frames: ``(..., frames, channels)`` with frames ≥ 2 (e.g. 66-dim frames).
@@ -480,15 +528,20 @@ def time_normalize(frames: np.ndarray, length: int) -> np.ndarray:
     Returns:
         ``(..., length, channels)`` float32.
     """
-    frames = np.asarray(frames)
+    frames = np.asarray(frames, dtype=np.float64)
     n = frames.shape[-2]
     if n < 2 or length < 2:
         raise ValueError(f"time normalization needs at least 2 frames in and out, got {n} → {length}")
-    src = np.linspace(0.0, 1.0, n)
-    dst = np.linspace(0.0, 1.0, length)
-    idx = np.clip(np.searchsorted(src, dst, side="right") - 1, 0, n - 2)
-    w = ((dst - src[idx]) / (src[idx + 1] - src[idx]))[:, None]
-    out = frames[..., idx, :] * (1.0 - w) + frames[..., idx + 1, :] * w
+    src, dst = np.linspace(0.0, 1.0, n), np.linspace(0.0, 1.0, length)
+    out = _interp(frames, src, dst)
+    if frames.shape[-1] == FRAME_DIM:
+        rates = slice(VELOCITY_DIMS.start, FRAME_DIM)
+        mid_src = (np.arange(n - 1) + 0.5) / (n - 1)
+        mid_dst = (np.arange(length - 1) + 0.5) / (length - 1)
+        moved = _interp(frames[..., :-1, rates], mid_src, mid_dst) if n > 2 else \
+            np.repeat(frames[..., :1, rates], length - 1, axis=-2)
+        out[..., :-1, rates] = moved
+        out[..., -1, rates] = moved[..., -1, :]
     return out.astype(np.float32)
 
 
