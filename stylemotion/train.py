@@ -10,8 +10,8 @@
 The entry point only composes and instantiates: ``cfg.datamodule`` receives the data config
 (``cfg.data``) as ``data=``; ``cfg.model`` is any LightningModule; ``cfg.trainer``, ``cfg.logger``
 and ``cfg.callbacks`` are Lightning objects. Each run writes into one folder (``output_dir``): the
-resolved config (``.hydra/``), ``tensorboard/``, ``checkpoints/{best,last}.ckpt`` and
-``metrics.json`` (test metrics of the best checkpoint).
+config as composed (``.hydra/``) and resolved (``config_resolved.yaml``), ``tensorboard/``,
+``checkpoints/{best,last}.ckpt`` and ``metrics.json`` (test metrics of the best checkpoint).
 """
 
 from __future__ import annotations
@@ -27,6 +27,7 @@ import lightning.pytorch as pl
 import torch
 from hydra.utils import instantiate
 from lightning.pytorch.callbacks import ModelCheckpoint
+from lightning.pytorch.trainer.states import TrainerFn
 from lightning.pytorch.utilities import rank_zero_only
 from omegaconf import DictConfig, OmegaConf
 
@@ -56,8 +57,6 @@ class LastCheckpoint(ModelCheckpoint):
     def _save_now(self, trainer: pl.Trainer) -> None:
         if trainer.sanity_checking or trainer.global_step == self._last_global_step_saved:
             return
-        from lightning.pytorch.trainer.states import TrainerFn
-
         if trainer.state.fn == TrainerFn.FITTING:
             self._save_topk_checkpoint(trainer, self._monitor_candidates(trainer))
 
@@ -86,6 +85,17 @@ def _instantiate_all(node: DictConfig | None) -> list[Any]:
     return [instantiate(v, _convert_="all") for v in node.values() if v is not None and "_target_" in v]
 
 
+def build(cfg: DictConfig) -> tuple[pl.LightningDataModule, pl.LightningModule]:
+    """The DataModule (``cfg.datamodule`` given ``data=cfg.data``) and the LightningModule ``cfg.model``.
+
+    Both receive plain Python values only, so their hyperparameters are checkpoint-safe.
+    """
+    data_cfg = OmegaConf.to_container(cfg.data, resolve=True)
+    datamodule = instantiate(cfg.datamodule, data=data_cfg, _convert_="all")
+    model = instantiate(cfg.model, _convert_="all")
+    return datamodule, model
+
+
 def run(cfg: DictConfig, extra_callbacks: list[pl.Callback] | None = None) -> dict[str, Any]:
     """Train (and test) as ``cfg`` says; returns ``{"trainer", "model", "datamodule", "metrics"}``."""
     output_dir = Path(cfg.output_dir)
@@ -93,27 +103,31 @@ def run(cfg: DictConfig, extra_callbacks: list[pl.Callback] | None = None) -> di
         torch.set_num_threads(int(cfg.threads))
     pl.seed_everything(cfg.seed, workers=True)
 
-    data_cfg = OmegaConf.to_container(cfg.data, resolve=True)
-    datamodule = instantiate(cfg.datamodule, data=data_cfg, _convert_="all")
-    model = instantiate(cfg.model, _convert_="all")
+    datamodule, model = build(cfg)
     callbacks = _instantiate_all(cfg.get("callbacks")) + list(extra_callbacks or [])
     loggers = _instantiate_all(cfg.get("logger"))
     trainer: pl.Trainer = instantiate(cfg.trainer, callbacks=callbacks, logger=loggers or False,
                                       _convert_="all")
     # Same initial weights on every rank (seeded above); from here on each rank draws its own
     # dropout masks and noise. Data order stays in the distributed sampler's hands.
-    torch.manual_seed(int(cfg.seed) + 1_000_003 * trainer.global_rank)
+    rank_seed = int(cfg.seed) + 1_000_003 * trainer.global_rank
+    torch.manual_seed(rank_seed)
+    log.info("rank %d of %d: torch seed %d", trainer.global_rank, trainer.world_size, rank_seed)
 
     ckpt_path = resolve_ckpt_path(cfg.get("ckpt_path"), output_dir)
+    _write_text(output_dir / "config_resolved.yaml", OmegaConf.to_yaml(cfg, resolve=True))
     if cfg.get("train", True):
         trainer.fit(model, datamodule=datamodule, ckpt_path=ckpt_path)
-    metrics: dict[str, Any] = {"global_step": trainer.global_step, "epoch": trainer.current_epoch}
+    metrics: dict[str, Any] = {"global_step": trainer.global_step, "epoch": trainer.current_epoch,
+                               "data": getattr(datamodule, "summary", None)}
     best = _best_checkpoint(trainer)
     if best:
         metrics["best_checkpoint"] = best
         metrics["best_score"] = _plain(_best_score(trainer))
     if cfg.get("test", True):
-        results = trainer.test(model, datamodule=datamodule, ckpt_path=best or None)
+        # the best checkpoint of this fit; with train=false, the checkpoint given as ckpt_path
+        test_ckpt = best or (None if cfg.get("train", True) else ckpt_path)
+        results = trainer.test(model, datamodule=datamodule, ckpt_path=test_ckpt)
         metrics["test"] = {k: _plain(v) for k, v in (results[0] if results else {}).items()}
     _write_metrics(output_dir / "metrics.json", metrics)
     return {"trainer": trainer, "model": model, "datamodule": datamodule, "metrics": metrics}
@@ -143,6 +157,11 @@ def _plain(value: Any) -> Any:
 def _write_metrics(path: Path, metrics: dict[str, Any]) -> None:
     atomic_write_bytes(path, json.dumps(metrics, indent=2).encode())
     log.info("metrics written to %s", path)
+
+
+@rank_zero_only
+def _write_text(path: Path, text: str) -> None:
+    atomic_write_bytes(path, text.encode())
 
 
 def _objective(metrics: dict[str, Any], cfg: DictConfig) -> float | None:

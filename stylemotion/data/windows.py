@@ -106,6 +106,10 @@ class MotionWindowDataModule(pl.LightningDataModule):
         split: split settings (``seed``, ``val_fraction``, ``test_fraction``); None = ``data.split``.
     """
 
+    #: What a model checks the data against (see ``MotionAutoencoder.check_compatible``).
+    representation = REPRESENTATION
+    frame_dim = FRAME_DIM
+
     def __init__(
         self,
         data: Mapping[str, Any] | None = None,
@@ -139,10 +143,6 @@ class MotionWindowDataModule(pl.LightningDataModule):
         self.mean: np.ndarray | None = None
         self.std: np.ndarray | None = None
         self.summary: dict[str, Any] = {}
-
-    # -- what a model checks against (see MotionAutoencoder.check_compatible)
-    representation = REPRESENTATION
-    frame_dim = FRAME_DIM
 
     @property
     def takeset(self) -> TakeSet:

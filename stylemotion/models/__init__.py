@@ -5,7 +5,9 @@ from stylemotion.models.autoencoder import (
     IncompatibleModelError,
     MotionAutoencoder,
     NonFiniteLossError,
+    local_mpjpe,
     mpjpe,
 )
 
-__all__ = ["ConvAutoencoder", "IncompatibleModelError", "MotionAutoencoder", "NonFiniteLossError", "mpjpe"]
+__all__ = ["ConvAutoencoder", "IncompatibleModelError", "MotionAutoencoder", "NonFiniteLossError", "local_mpjpe",
+           "mpjpe"]

@@ -137,11 +137,23 @@ def mpjpe(pred_frames: torch.Tensor, true_frames: torch.Tensor, fps: float) -> t
     return torch.linalg.vector_norm(pred - true, dim=-1).mean()
 
 
+def local_mpjpe(pred_frames: torch.Tensor, true_frames: torch.Tensor) -> torch.Tensor:
+    """Mean per-joint position error, metres, of the root-local poses of ``(..., T, 66)`` frames.
+
+    Joints relative to the root's ground projection, facing +Z (frame values ``[0:63]``): the pose
+    alone, without the root trajectory (so no drift from velocity errors).
+    """
+    diff = (pred_frames[..., :63] - true_frames[..., :63]).contiguous().unflatten(-1, (21, 3))
+    return torch.linalg.vector_norm(diff, dim=-1).mean()
+
+
 class MotionAutoencoder(pl.LightningModule):
     """Trains a :class:`ConvAutoencoder` by reconstructing windows of raw frames.
 
     Batches are raw frames ``(batch, T, 66)``. Logged per split (``train``/``val``/``test``):
-    ``mse`` (normalized space), ``mpjpe`` (metres), and ``train/loss`` (MSE + sparsity term).
+    ``mse`` (normalized space), ``mpjpe`` (metres, positions integrated from the origin, see
+    :func:`mpjpe`), ``mpjpe_local`` (metres, root-local pose only, see :func:`local_mpjpe`), and
+    ``train/loss`` (MSE + sparsity term).
 
     The normalization statistics are taken from the datamodule's train split at the first
     ``setup`` (``datamodule.normalization``) unless already set (e.g. loaded from a checkpoint).
@@ -150,6 +162,7 @@ class MotionAutoencoder(pl.LightningModule):
         hidden_units, kernel_size, pooling, input_dropout: see :class:`ConvAutoencoder`.
         sparsity: weight of the L1 penalty ``mean(|features|)`` on the hidden units (0 = off).
         lr: Adam learning rate. weight_decay: Adam's L2 weight decay.
+        lr_gamma: the learning rate is multiplied by this after every epoch (1 = constant).
         fps: frame rate of the frames the model is trained on (velocities are per second).
         frame_dim: values per frame. representation: frame layout id (see
             :data:`stylemotion.data.windows.REPRESENTATION`).
@@ -168,6 +181,7 @@ class MotionAutoencoder(pl.LightningModule):
         sparsity: float = 0.0,
         lr: float = 1e-3,
         weight_decay: float = 0.0,
+        lr_gamma: float = 1.0,
         fps: float = 30.0,
         frame_dim: int = FRAME_DIM,
         representation: str = REPRESENTATION,
@@ -186,13 +200,14 @@ class MotionAutoencoder(pl.LightningModule):
                 f"this model was built for a skeleton with joints {list(joint_names)} (parents "
                 f"{list(joint_parents)}), not the canonical 21-joint skeleton {list(CANONICAL_JOINTS)}"
             )
-        if not sparsity >= 0 or not lr > 0 or not weight_decay >= 0 or not fps > 0:
-            raise ValueError(f"need sparsity ≥ 0, lr > 0, weight_decay ≥ 0, fps > 0; got {sparsity}, {lr}, "
-                             f"{weight_decay}, {fps}")
+        if not sparsity >= 0 or not lr > 0 or not weight_decay >= 0 or not fps > 0 or not 0 < lr_gamma <= 1:
+            raise ValueError(f"need sparsity ≥ 0, lr > 0, weight_decay ≥ 0, 0 < lr_gamma ≤ 1, fps > 0; got "
+                             f"{sparsity}, {lr}, {weight_decay}, {lr_gamma}, {fps}")
         self.save_hyperparameters({
             "hidden_units": int(hidden_units), "kernel_size": int(kernel_size), "pooling": str(pooling),
             "input_dropout": float(input_dropout), "sparsity": float(sparsity), "lr": float(lr),
-            "weight_decay": float(weight_decay), "fps": float(fps), "frame_dim": int(frame_dim),
+            "weight_decay": float(weight_decay), "lr_gamma": float(lr_gamma), "fps": float(fps),
+            "frame_dim": int(frame_dim),
             "representation": str(representation), "joint_names": [str(j) for j in joint_names],
             "joint_parents": [int(p) for p in joint_parents],
         })
@@ -246,7 +261,11 @@ class MotionAutoencoder(pl.LightningModule):
             raise IncompatibleModelError("checkpoint does not match the configured model — " + "; ".join(bad))
 
     def configure_optimizers(self):
-        return torch.optim.Adam(self.parameters(), lr=self.hparams.lr, weight_decay=self.hparams.weight_decay)
+        optimizer = torch.optim.Adam(self.parameters(), lr=self.hparams.lr, weight_decay=self.hparams.weight_decay)
+        if self.hparams.lr_gamma == 1.0:
+            return optimizer
+        schedule = torch.optim.lr_scheduler.ExponentialLR(optimizer, gamma=self.hparams.lr_gamma)
+        return {"optimizer": optimizer, "lr_scheduler": {"scheduler": schedule, "interval": "epoch"}}
 
     def _step(self, frames: torch.Tensor, split: str, batch_idx: int) -> torch.Tensor:
         net = self.net
@@ -262,14 +281,16 @@ class MotionAutoencoder(pl.LightningModule):
                 f"(lr={self.hparams.lr})"
             )
         with torch.no_grad():
-            error = mpjpe(net.normalizer.denormalize(recon.detach()), frames, self.hparams.fps)
-        size = frames.shape[0]
-        sync = split != "train"
-        if split == "train":
-            self.log("train/loss", loss, prog_bar=True, batch_size=size)
-        self.log(f"{split}/mse", mse, batch_size=size, sync_dist=sync, on_epoch=True, on_step=split == "train")
-        self.log(f"{split}/mpjpe", error, batch_size=size, sync_dist=sync, on_epoch=True,
-                 on_step=split == "train", prog_bar=split != "train")
+            raw = net.normalizer.denormalize(recon.detach().float())  # float32 also under bf16 autocast
+            error, local_error = mpjpe(raw, frames, self.hparams.fps), local_mpjpe(raw, frames)
+        size, train = frames.shape[0], split == "train"
+        if train:
+            self.log("train/loss", loss, prog_bar=True, batch_size=size, sync_dist=True)
+        self.log(f"{split}/mse", mse, batch_size=size, sync_dist=True, on_epoch=True, on_step=train)
+        self.log(f"{split}/mpjpe", error, batch_size=size, sync_dist=True, on_epoch=True, on_step=train,
+                 prog_bar=not train)
+        self.log(f"{split}/mpjpe_local", local_error, batch_size=size, sync_dist=True, on_epoch=True,
+                 on_step=train)
         return loss
 
     def training_step(self, batch: torch.Tensor, batch_idx: int) -> torch.Tensor:
