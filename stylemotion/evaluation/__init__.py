@@ -1,0 +1,34 @@
+"""Evaluation of primitive models: the thesis' Tables 5.1–5.3 and the metrics it lacks.
+
+* :mod:`.tables`: style distance D(m, s) (Table 5.1, eq. 5.12) and pose/speed/step SD (Tables
+  5.2/5.3, eq. 5.13–5.15);
+* :mod:`.classifier`: a style classifier fitted on real clips, whose PCA space hosts the Fréchet
+  distance and the diversity;
+* :mod:`.metrics`: Fréchet distance, diversity, foot skating, nearest-training-clip distance;
+* :mod:`.sources`: what is evaluated (:class:`SampleSource`, :class:`EvalModel`, checkpoints);
+* :mod:`.reference`: the real clips a primitive's models are compared with;
+* :mod:`.pipeline`: one evaluation → plain results; :mod:`.report`: the report folder.
+
+Entry point: ``stylemotion-eval`` (:mod:`stylemotion.evaluate`).
+"""
+
+from stylemotion.evaluation.classifier import StyleClassifier
+from stylemotion.evaluation.metrics import diversity, foot_skating, frechet_distance, nearest_distances
+from stylemotion.evaluation.pipeline import EvalSettings, evaluate_models
+from stylemotion.evaluation.reference import PrimitiveData, primitive_data
+from stylemotion.evaluation.report import ReportExistsError, write_report
+from stylemotion.evaluation.sources import (
+    NEUTRAL,
+    EvalModel,
+    MissingExampleError,
+    MixedAutoencodersError,
+    RealClipSource,
+    SampleSource,
+    load_model,
+)
+from stylemotion.evaluation.tables import diagonal_minima, distance_table, variance_stats
+
+__all__ = ["NEUTRAL", "EvalModel", "EvalSettings", "MissingExampleError", "MixedAutoencodersError", "PrimitiveData",
+           "RealClipSource", "ReportExistsError", "SampleSource", "StyleClassifier", "diagonal_minima",
+           "distance_table", "diversity", "evaluate_models", "foot_skating", "frechet_distance", "load_model",
+           "nearest_distances", "primitive_data", "variance_stats", "write_report"]

@@ -1,0 +1,165 @@
+"""The report folder of an evaluation: ``report.md``, ``report.json``, one CSV per table, PNG figures.
+
+Layout of ``report.json`` (``<p>`` a primitive such as ``walk_leftStance``, ``<m>`` a model row:
+``neutral`` or a style):
+
+* ``table_5_1.<p>.{models, examples, distance, diagonal, samples, example_clips}``: Table 5.1,
+  ``distance[i][j]`` = D(models[i], examples[j]);
+* ``variance.<p>.<row>.{pose_sd, v_sd, step_sd, …}`` for rows ``training_data`` and every model
+  (cm, m/s ⊕ rad/s, cm); ``variance_ratio.<p>.<row>`` the same divided by the training data's;
+  ``variance_real.<p>.<style>`` real clips of every style;
+* ``style_recognition.{classifier_heldout_accuracy, chance, per_model.<m>, per_primitive.<p>,
+  per_model_detail.<p>.<m>}``;
+* ``frechet.<p>.<m>`` and ``frechet_reference.<p>.<m>.{neutral_samples, real_floor, ground_truth_clips}``;
+* ``diversity.<p>.<m>.{samples, real}``;
+* ``foot_skating.<m>`` (ratio pooled over primitives), ``foot_skating_real.<m>`` (the model's real
+  ground truth), ``foot_skating_detail.<p>.<m>.{samples, real}``;
+* ``nearest_training.<p>.<m>``;
+* ``autoencoder.{test_mpjpe_m, test_local_mpjpe_m, …}``;
+* ``meta.{data, seed, samples, checkpoints, autoencoder, git_commit, seconds, command, …}``;
+* ``definitions``: the definition of every number, in words.
+
+The folder is built beside its final place and renamed into it, so a report is never half
+written; an existing folder is refused unless ``force`` (then replaced as a whole).
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import math
+import os
+import shutil
+import tempfile
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from stylemotion.evaluation.figures import write_figures
+from stylemotion.evaluation.markdown import DEFINITIONS, format_markdown
+from stylemotion.evaluation.tables import VARIANCE_KEYS
+
+
+class ReportExistsError(FileExistsError):
+    """The report folder exists and ``force`` is off."""
+
+
+def check_target(out: str | os.PathLike, force: bool = False) -> Path:
+    """``out`` as a Path; a :class:`ReportExistsError` if it exists and ``force`` is off (call it before
+    the evaluation, so a long run does not end in this error)."""
+    out = Path(out)
+    if out.exists() and not force:
+        raise ReportExistsError(f"report folder {out} already exists; choose another out=… or pass force=true to "
+                                "replace it")
+    return out
+
+
+def write_report(results: dict[str, Any], out: str | os.PathLike, force: bool = False) -> Path:
+    """Write the report folder of ``results`` (from :func:`stylemotion.evaluation.pipeline.evaluate_models`
+    plus ``meta``) atomically; returns its path."""
+    out = check_target(out, force)
+    results = {**results, "definitions": DEFINITIONS}
+    out.parent.mkdir(parents=True, exist_ok=True)
+    tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.", dir=out.parent))
+    umask = os.umask(0)
+    os.umask(umask)
+    os.chmod(tmp, 0o777 & ~umask)
+    try:
+        figures = write_figures(results, tmp)
+        tables = write_csvs(results, tmp)
+        (tmp / "report.json").write_text(json.dumps(_plain(results), indent=1, allow_nan=False))
+        (tmp / "report.md").write_text(format_markdown(results, figures, tables))
+        if out.exists():
+            check_target(out, force)  # appeared meanwhile
+            trash = Path(tempfile.mkdtemp(prefix=f".{out.name}.old.", dir=out.parent))
+            out.replace(trash / out.name)
+            tmp.replace(out)
+            shutil.rmtree(trash, ignore_errors=True)
+        else:
+            tmp.replace(out)
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    return out
+
+
+def _plain(value: Any) -> Any:
+    """JSON-safe copy: numpy scalars/arrays to Python, NaN/inf to None."""
+    if isinstance(value, dict):
+        return {str(k): _plain(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_plain(v) for v in value]
+    if isinstance(value, np.ndarray):
+        return _plain(value.tolist())
+    if isinstance(value, (np.integer,)):
+        return int(value)
+    if isinstance(value, (float, np.floating)):
+        return float(value) if math.isfinite(value) else None
+    return value
+
+
+def _csv_text(header: list[str], rows: list[list[Any]]) -> str:
+    buf = io.StringIO()
+    writer = csv.writer(buf, lineterminator="\n")
+    writer.writerow(header)
+    writer.writerows([["" if v is None else v for v in r] for r in rows])
+    return buf.getvalue()
+
+
+# -- CSVs
+
+
+def write_csvs(results: dict[str, Any], folder: Path) -> list[str]:
+    written = []
+
+    def put(name: str, header: list[str], rows: list[list[Any]]) -> None:
+        (folder / name).write_text(_csv_text(header, rows))
+        written.append(name)
+
+    for p, t in results.get("table_5_1", {}).items():
+        put(f"table_5_1_{p}.csv", ["model \\ example"] + t["examples"],
+            [[m] + row for m, row in zip(t["models"], t["distance"])])
+    for p, rows in results.get("variance", {}).items():
+        ratio = results["variance_ratio"][p]
+        body = [["model", r] + [s[k] for k in VARIANCE_KEYS] + [ratio[r][k] for k in VARIANCE_KEYS]
+                + [s["speed_mean_mps"], s["step_mean_cm"], s["motions"]] for r, s in rows.items()]
+        body += [["real", st] + [s[k] for k in VARIANCE_KEYS] + [""] * 3 + [s["speed_mean_mps"], s["step_mean_cm"],
+                                                                            s["motions"]]
+                 for st, s in results.get("variance_real", {}).get(p, {}).items()]
+        put(f"variance_{p}.csv", ["kind", "row", "pose_sd_cm", "v_sd", "step_sd_cm", "pose_sd_ratio", "v_sd_ratio",
+                                  "step_sd_ratio", "speed_mean_mps", "step_mean_cm", "motions"], body)
+    rec = results.get("style_recognition", {})
+    for p, c in rec.get("per_primitive", {}).items():
+        put(f"classifier_confusion_{p}.csv", ["true \\ predicted"] + c["styles"],
+            [[s] + row for s, row in zip(c["styles"], c["confusion"])])
+    rows = []
+    for p, models in rec.get("per_model_detail", {}).items():
+        for m, d in models.items():
+            rows.append([p, m, d["target_style"], d["share"], d["real_share"], d["samples"]]
+                        + [d["predicted"][s] for s in rec["per_primitive"][p]["styles"]])
+    if rows:
+        styles = next(iter(rec["per_primitive"].values()))["styles"]
+        put("style_recognition.csv", ["primitive", "model", "target_style", "share", "real_ground_truth_share",
+                                      "samples"] + [f"predicted_{s}" for s in styles], rows)
+    ref, div = results.get("frechet_reference", {}), results.get("diversity", {})
+    rows = [[p, m, fd, ref[p][m].get("neutral_samples"), ref[p][m].get("real_floor"), ref[p][m]["ground_truth_clips"],
+             div[p][m]["samples"], div[p][m]["real"]]
+            for p, ms in results.get("frechet", {}).items() for m, fd in ms.items()]
+    if rows:
+        put("frechet_diversity.csv", ["primitive", "model", "frechet", "frechet_neutral_samples", "frechet_real_floor",
+                                      "ground_truth_clips", "diversity_samples", "diversity_real"], rows)
+    keys = ["ratio", "contact_share", "no_plant_share", "planted_mid_mps", "motions"]
+    rows = [[p, m, kind] + [d[kind][k] for k in keys]
+            for p, ms in results.get("foot_skating_detail", {}).items() for m, d in ms.items()
+            for kind in ("samples", "real")]
+    if rows:
+        put("foot_skating.csv", ["primitive", "model", "motions_of"] + keys, rows)
+    keys = ["samples_median_m", "heldout_neutral_median_m", "ground_truth_median_m", "to_example_median_m",
+            "ground_truth_to_example_median_m", "training_clips"]
+    rows = [[p, m] + [d.get(k) for k in keys] for p, ms in results.get("nearest_training", {}).items()
+            for m, d in ms.items()]
+    if rows:
+        put("nearest_training.csv", ["primitive", "model"] + keys, rows)
+    return written

@@ -1,0 +1,111 @@
+"""Style CVAE: the primitive VAE deformed towards one style example (thesis §5.3.3, eq. 5.9–5.11).
+
+The network and the content data are those of :class:`~stylemotion.models.vae.PrimitiveVAE` (the
+neutral clips of the primitive); the loss gains a style term::
+
+    loss = recon + kl_weight · KL + α · mean_z ‖Gram(decoder(z)) − Gram(Φ(x_s))‖_F
+
+where ``decoder(z)`` is turned back into raw autoencoder features (de-normalized, duration value
+dropped), ``Gram`` is :func:`stylemotion.models.style.gram` (over time, normalized by the number of
+time steps) and ``Gram(Φ(x_s))`` is the mean Gram of the encoded style example clip(s) — any
+length, any primitive (see :mod:`stylemotion.data.features`).
+
+Which ``z`` (``style_latents``): the thesis writes ``decoder(z)`` next to the reconstruction's
+``z_il = μ(y_i) + σ(y_i) ε_l``. Styling only those (``posterior``) leaves the samples a user draws,
+``z ~ N(0, I)``, unstyled wherever the encoder's posteriors do not cover the prior; ``prior``
+styles as many fresh prior draws instead; ``both`` (default) styles both, so reconstructions and
+samples agree.
+
+α (``style_weight``) is 200 by default, the thesis' value. In our units it is far too strong: on
+Bandai walk stances every sample collapses onto the example (see ``benchmarks/vae.md`` and the
+comment in ``configs/model/style_cvae.yaml``); α of a few units keeps the variation.
+
+One model per (primitive, style). The style, the example clip(s) (take, frame range, primitive,
+duration) and how they were encoded are recorded in ``hparams.spec``; the target Gram matrix is a
+buffer, so the checkpoint is self-contained.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import torch
+
+from stylemotion.models.autoencoder import IncompatibleModelError
+from stylemotion.models.style import feature_style_distance, gram_factor, mean_gram
+from stylemotion.models.vae import PrimitiveVAE
+
+#: Which latent codes the style term decodes (see :class:`StyleCVAE`).
+STYLE_LATENTS = ("posterior", "prior", "both")
+
+
+class StyleCVAE(PrimitiveVAE):
+    """:class:`PrimitiveVAE` plus α·(Gram-matrix distance to a style example); logs ``style``
+    (the mean distance, before α) per split.
+
+    Args:
+        style_weight: α (200).
+        style_latents: ``posterior``, ``prior`` or ``both`` (see the module doc).
+        **kwargs: :class:`PrimitiveVAE` arguments.
+    """
+
+    def __init__(self, style_weight: float = 200.0, style_latents: str = "both", **kwargs: Any):
+        super().__init__(**kwargs)
+        if not style_weight >= 0:
+            raise ValueError(f"style_weight must be ≥ 0, got {style_weight}")
+        if style_latents not in STYLE_LATENTS:
+            raise ValueError(f"style_latents must be one of {STYLE_LATENTS}, got {style_latents!r}")
+        self.save_hyperparameters({**dict(self.hparams), "style_weight": float(style_weight),
+                                   "style_latents": str(style_latents)})
+
+    def _build(self, spec: dict[str, Any]) -> None:
+        super()._build(spec)
+        channels = int(spec["feature_channels"])
+        self.register_buffer("style_gram", torch.zeros(channels, channels))
+
+    def _adapt_spec(self, spec: dict[str, Any]) -> dict[str, Any]:
+        if not spec.get("style"):
+            raise ValueError("StyleCVAE needs a style: set style=<name> (the datamodule's style), e.g. "
+                             "'stylemotion-train experiment=style_cvae style=elderly'")
+        return dict(spec)
+
+    def _check_spec(self, spec: dict[str, Any]) -> None:
+        super()._check_spec(spec)
+        if spec.get("style") != self.spec.get("style"):
+            raise IncompatibleModelError(f"this StyleCVAE models style {self.spec.get('style')!r}, the data "
+                                         f"selects style {spec.get('style')!r}")
+
+    def _install_stats(self, datamodule) -> None:
+        super()._install_stats(datamodule)
+        if not datamodule.style_features:
+            raise ValueError(f"the datamodule has no style example for style {datamodule.style!r}")
+        self.style_gram.copy_(mean_gram(datamodule.style_features))
+
+    @property
+    def style(self) -> str:
+        return self.spec["style"]
+
+    @property
+    def style_examples(self) -> list[dict[str, Any]]:
+        """The example clips the style came from (take, start, stop, primitive, duration, …)."""
+        return list(self.spec["style_examples"])
+
+    def style_distance(self, features: torch.Tensor) -> torch.Tensor:
+        """``‖Gram(features) − Gram(style example)‖_F`` for raw features ``(..., C, T')`` → ``(...)``."""
+        version = (self.style_gram._version, self.style_gram.device, self.style_gram.data_ptr())
+        if getattr(self, "_factor_key", None) != version:  # the factor of the (fixed) target, cached
+            object.__setattr__(self, "_factor", gram_factor(self.style_gram))
+            object.__setattr__(self, "_factor_key", version)
+        return feature_style_distance(features, target_factor=self._factor)
+
+    def _extra_losses(self, recon: torch.Tensor, generator: torch.Generator | None = None
+                      ) -> dict[str, tuple[torch.Tensor, float]]:
+        outputs = []
+        if self.hparams.style_latents in ("posterior", "both"):
+            outputs.append(recon.flatten(0, 1))
+        if self.hparams.style_latents in ("prior", "both"):
+            count = recon.shape[0] * recon.shape[1]
+            z = torch.randn(count, self.hparams.latent_dim, generator=generator, device=recon.device, dtype=recon.dtype)
+            outputs.append(self.net.decode(z))
+        features, _ = self.denormalize(torch.cat(outputs), clamp=False)
+        return {"style": (self.style_distance(features).mean(), self.hparams.style_weight)}
