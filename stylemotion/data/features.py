@@ -223,6 +223,12 @@ class FeatureDataset(Dataset):
                 "positions": self.positions[index], "num_frames": self.num_frames[index]}
 
 
+def _clip_module(**kwargs: Any) -> ClipDataModule:
+    """A ClipDataModule built outside any ``__init__`` (Lightning's ``save_hyperparameters`` would
+    otherwise also record the calling constructor's arguments, the autoencoder among them)."""
+    return ClipDataModule(**kwargs)
+
+
 class FeatureDataModule(pl.LightningDataModule):
     """Autoencoder features of one primitive's clips, plus the style example(s) of one style.
 
@@ -293,7 +299,7 @@ class FeatureDataModule(pl.LightningDataModule):
         self.min_train_clips = min_train_clips
         self.feature_scale = feature_scale
         self.std_floor = std_floor
-        self.clip_data = ClipDataModule(
+        self.clip_data = _clip_module(
             data=data, takeset=takeset, action=self.action, primitives=[self.primitive_name],
             styles=self.content_styles, timeline=timeline, example=self.example_specs[0],
             example_styles=[style] if style else [], segment=segment, split=split, batch_size=batch_size)
@@ -377,7 +383,7 @@ class FeatureDataModule(pl.LightningDataModule):
     def _encode_style_examples(self) -> None:
         clips = []
         for i, spec in enumerate(self.example_specs):
-            source = self.clip_data if i == 0 else ClipDataModule(
+            source = self.clip_data if i == 0 else _clip_module(
                 takeset=self.clip_data.takeset, action=self.action, primitives=[self.primitive_name],
                 styles=self.content_styles, timeline=self.timeline_frames, example=spec,
                 example_styles=[self.style], segment=self.hparams.segment, split=self.clip_data.split_cfg)
