@@ -29,6 +29,7 @@ from typing import Any
 import numpy as np
 import torch
 
+from stylemotion.data.features import encode_examples
 from stylemotion.data.windows import MotionWindowDataModule
 from stylemotion.datasets import TakeSet
 from stylemotion.evaluation.classifier import StyleClassifier, predicted_shares
@@ -51,7 +52,7 @@ from stylemotion.evaluation.sources import (
 )
 from stylemotion.evaluation.tables import diagonal_minima, distance_table, example_gram, mean_motion, variance_stats
 from stylemotion.models.autoencoder import local_mpjpe, mpjpe
-from stylemotion.primitives import time_normalize
+from stylemotion.models.style import mean_gram
 from stylemotion.sampling import MotionSamples
 
 log = logging.getLogger(__name__)
@@ -216,11 +217,9 @@ def _example_gram(autoencoder, data: PrimitiveData, model: EvalModel, clips: lis
     if model.name == NEUTRAL:
         return example_gram(autoencoder, [mean_motion(motions_from_clips(data.training_data(),
                                                                          data.length).normalized_frames.numpy())])
-    frames = []
-    for record, clip in zip(model.examples, clips):
-        length = int(record.get("encoded_frames") or data.length)
-        frames.append(clip.frames if length == clip.num_frames else time_normalize(clip.frames, length))
-    g = example_gram(autoencoder, frames)
+    # encoded exactly as for training: resampled to the canonical length unless recorded "natural"
+    length = None if model.example_length == "natural" else int(model.examples[0].get("encoded_frames") or data.length)
+    g = mean_gram(encode_examples(autoencoder, clips, length)).float()
     if model.target_gram is not None:
         target = model.target_gram.float()
         rel = float(torch.linalg.matrix_norm(g - target) / torch.linalg.matrix_norm(target).clamp_min(1e-12))

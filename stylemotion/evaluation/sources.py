@@ -61,6 +61,8 @@ class EvalModel:
         timeline_frames: the primitive's canonical length, frames.
         target_gram: ``(C, C)`` the model's own record of ``Gram(Φ(example))``, or None.
         dataset: name of the dataset it was trained on, or None.
+        example_length: how its examples were encoded: ``canonical`` (resampled to the timeline,
+            the default) or ``natural`` (as recorded).
     """
 
     name: str
@@ -73,6 +75,7 @@ class EvalModel:
     timeline_frames: int | None = None
     target_gram: torch.Tensor | None = None
     dataset: str | None = None
+    example_length: str | None = "canonical"
 
     @property
     def label(self) -> str:
@@ -117,7 +120,7 @@ def load_model(path: str | Path, neutral_style: str = "normal", autoencoder=None
                      autoencoder=dict(spec["autoencoder"]), checkpoint=str(path),
                      timeline_frames=int(spec["timeline_frames"]),
                      target_gram=model.style_gram.detach().clone() if styled else None,
-                     dataset=spec.get("dataset"))
+                     dataset=spec.get("dataset"), example_length=spec.get("example_length") or "canonical")
 
 
 def check_one_autoencoder(models: Sequence[EvalModel], fingerprint: str | None = None) -> str | None:
