@@ -37,6 +37,7 @@ from pathlib import Path
 from typing import Any
 
 import hydra
+import torch
 from hydra import compose
 from omegaconf import DictConfig, OmegaConf, open_dict
 
@@ -253,6 +254,8 @@ def run(cfg: DictConfig, say=print) -> dict[str, Any]:
     Must be called with Hydra's global config search initialized (inside ``stylemotion-reproduce``,
     or within ``hydra.initialize_config_dir``), since the training stages compose the ``train`` config.
     """
+    if cfg.get("threads"):
+        torch.set_num_threads(int(cfg.threads))  # the evaluation's too, so reruns compute alike
     repro = Reproduction(cfg, say)
     repro.out.mkdir(parents=True, exist_ok=True)
     repro.data_stage()
