@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from stylemotion.datasets.loading import ConversionSettings, load_canonical_positions
-from stylemotion.io.bvh import atomic_write_bytes
+from stylemotion.io.atomic import atomic_write_bytes
 from stylemotion.io.errors import MotionDataError
 from stylemotion.io.sources import FileSource
 from stylemotion.skeleton import CANONICAL_JOINTS

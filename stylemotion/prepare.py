@@ -17,7 +17,7 @@ from omegaconf import DictConfig
 
 from stylemotion.config import config_dir
 from stylemotion.datasets import build_dataset
-from stylemotion.io.bvh import atomic_write_bytes
+from stylemotion.io.atomic import atomic_write_bytes
 from stylemotion.summary import dataset_summary, format_summary
 
 log = logging.getLogger(__name__)

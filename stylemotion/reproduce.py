@@ -46,7 +46,7 @@ from stylemotion.data.features import parse_primitive
 from stylemotion.datasets import build_dataset
 from stylemotion.evaluate import run_evaluation, summary_lines
 from stylemotion.evaluation.report import ReportExistsError
-from stylemotion.io.bvh import atomic_write_bytes
+from stylemotion.io.atomic import atomic_write_bytes
 from stylemotion.primitives import SegmentSettings, action_of, segment_takes
 
 log = logging.getLogger(__name__)

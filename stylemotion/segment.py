@@ -23,10 +23,7 @@ from __future__ import annotations
 import dataclasses
 import json
 import logging
-import os
-import shutil
 import sys
-import tempfile
 from collections import Counter, defaultdict
 from pathlib import Path
 from typing import Any
@@ -37,6 +34,7 @@ from omegaconf import DictConfig, OmegaConf
 
 from stylemotion.config import config_dir
 from stylemotion.datasets import Take, TakeSet, build_dataset
+from stylemotion.io.atomic import atomic_folder
 from stylemotion.primitives import (
     PRIMITIVES,
     Clip,
@@ -290,12 +288,7 @@ def write_report(cfg: DictConfig | dict, out: Path, force: bool = False, command
     takeset = build_dataset(cfg.data)
     seg = segment_takes(takeset.takes, settings)
     report = build_report(takeset, seg, settings, str(cfg.get("timeline", "median")))
-    out.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.", dir=out.parent))
-    umask = os.umask(0)
-    os.umask(umask)
-    os.chmod(tmp, 0o777 & ~umask)  # mkdtemp makes it private; a report folder is not
-    try:
+    with atomic_folder(out) as tmp:
         by_name: dict[str, Take] = {t.name: t for t in takeset.takes}
         seg_by_name = {s.take: s for s in seg.takes}
         plots = []
@@ -314,16 +307,6 @@ def write_report(cfg: DictConfig | dict, out: Path, force: bool = False, command
         report["command"] = command
         (tmp / "report.json").write_text(json.dumps(report, indent=1, default=_json_default))
         (tmp / "report.md").write_text(format_report(report, command, plots, sheets))
-        if out.exists():
-            trash = Path(tempfile.mkdtemp(prefix=f".{out.name}.old.", dir=out.parent))
-            out.replace(trash / out.name)
-            tmp.replace(out)
-            shutil.rmtree(trash, ignore_errors=True)
-        else:
-            tmp.replace(out)
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise
     return report
 
 

@@ -32,7 +32,7 @@ from lightning.pytorch.utilities import rank_zero_only
 from omegaconf import DictConfig, OmegaConf
 
 from stylemotion.config import config_dir
-from stylemotion.io.bvh import atomic_write_bytes
+from stylemotion.io.atomic import atomic_write_bytes
 
 log = logging.getLogger(__name__)
 

@@ -30,8 +30,6 @@ import io
 import json
 import math
 import os
-import shutil
-import tempfile
 from pathlib import Path
 from typing import Any
 
@@ -40,6 +38,7 @@ import numpy as np
 from stylemotion.evaluation.figures import write_figures
 from stylemotion.evaluation.markdown import DEFINITIONS, format_markdown
 from stylemotion.evaluation.tables import VARIANCE_KEYS
+from stylemotion.io.atomic import atomic_folder
 
 
 class ReportExistsError(FileExistsError):
@@ -61,27 +60,12 @@ def write_report(results: dict[str, Any], out: str | os.PathLike, force: bool = 
     plus ``meta``) atomically; returns its path."""
     out = check_target(out, force)
     results = {**results, "definitions": DEFINITIONS}
-    out.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.", dir=out.parent))
-    umask = os.umask(0)
-    os.umask(umask)
-    os.chmod(tmp, 0o777 & ~umask)
-    try:
+    # check_target again at swap time: the folder may have appeared meanwhile
+    with atomic_folder(out, on_exists=lambda: check_target(out, force)) as tmp:
         figures = write_figures(results, tmp)
         tables = write_csvs(results, tmp)
         (tmp / "report.json").write_text(json.dumps(_plain(results), indent=1, allow_nan=False))
         (tmp / "report.md").write_text(format_markdown(results, figures, tables))
-        if out.exists():
-            check_target(out, force)  # appeared meanwhile
-            trash = Path(tempfile.mkdtemp(prefix=f".{out.name}.old.", dir=out.parent))
-            out.replace(trash / out.name)
-            tmp.replace(out)
-            shutil.rmtree(trash, ignore_errors=True)
-        else:
-            tmp.replace(out)
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise
     return out
 
 

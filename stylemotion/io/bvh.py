@@ -10,13 +10,13 @@ from __future__ import annotations
 import io
 import os
 import re
-import tempfile
 import warnings
 from pathlib import Path
 
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from stylemotion.io.atomic import atomic_write_bytes
 from stylemotion.io.errors import BvhError
 from stylemotion.motion import Motion
 from stylemotion.skeleton import Skeleton
@@ -423,17 +423,3 @@ def write_bvh(motion: Motion, path: str | os.PathLike, precision: int = 6) -> No
     path = Path(path)
     text = format_bvh(motion, precision)
     atomic_write_bytes(path, text.encode("utf-8"))
-
-
-def atomic_write_bytes(path: Path, data: bytes) -> None:
-    """Write ``data`` to ``path`` via a temporary file in the same folder and ``os.replace``."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise

@@ -1,0 +1,53 @@
+"""Atomic writes: a file or a whole folder appears complete or not at all."""
+
+from __future__ import annotations
+
+import os
+import shutil
+import tempfile
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from pathlib import Path
+
+
+def atomic_write_bytes(path: Path, data: bytes) -> None:
+    """Write ``data`` to ``path`` via a temporary file in the same folder and ``os.replace``."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(data)
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+
+
+@contextmanager
+def atomic_folder(out: Path, on_exists: Callable[[], None] | None = None) -> Iterator[Path]:
+    """Build a folder in a temporary sibling and swap it into ``out`` when the block succeeds.
+
+    Yields the temporary folder (with the permissions of a normal ``mkdir``). On an exception the
+    temporary folder is removed and ``out`` is untouched. If ``out`` exists at swap time,
+    ``on_exists`` is called first (it may raise to refuse) and the old folder is then replaced.
+    """
+    out.parent.mkdir(parents=True, exist_ok=True)
+    tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.", dir=out.parent))
+    umask = os.umask(0)
+    os.umask(umask)
+    os.chmod(tmp, 0o777 & ~umask)  # mkdtemp makes it private; a result folder is not
+    try:
+        yield tmp
+        if out.exists():
+            if on_exists is not None:
+                on_exists()
+            trash = Path(tempfile.mkdtemp(prefix=f".{out.name}.old.", dir=out.parent))
+            out.replace(trash / out.name)
+            tmp.replace(out)
+            shutil.rmtree(trash, ignore_errors=True)
+        else:
+            tmp.replace(out)
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
