@@ -17,7 +17,8 @@ Yaw ``θ`` rotates about +Y: ``x' = x cosθ + z sinθ``, ``z' = −x sinθ + z c
 direction of yaw ``θ`` is ``(sin θ, 0, cos θ)``.
 
 One implementation each: :func:`positions_to_frames` (numpy, data preparation) and
-:func:`frames_to_positions` (torch, differentiable; numpy in, numpy out).
+:func:`frames_to_positions` (torch, differentiable; numpy in, numpy out), whose root integration
+:func:`integrate_root` is also what synthesis uses to place steps.
 """
 
 from __future__ import annotations
@@ -103,9 +104,43 @@ def positions_to_frames(
     return frames.astype(np.float32), root[0, [0, 2]].copy(), float(yaw[0])
 
 
+def integrate_root(
+    frames: torch.Tensor,
+    fps: float | torch.Tensor,
+    start_xz: np.ndarray | torch.Tensor | None = None,
+    start_yaw: float | np.ndarray | torch.Tensor = 0.0,
+) -> tuple[torch.Tensor, torch.Tensor]:
+    """The root's ground track and heading from 66-dim frames (torch, differentiable).
+
+    Args:
+        frames: ``(..., frames, 66)`` torch tensor.
+        fps: frames per second: a number, or a tensor broadcastable to ``(..., 1)`` (one rate per
+            motion, e.g. a time-normalized clip's playback rate ``(length − 1) / duration``, so the
+            result is differentiable in the duration too).
+        start_xz: ``(..., 2)`` root ground position of the first frame, metres (default origin).
+        start_yaw: ``(...)`` heading of the first frame, radians (default 0: facing +Z).
+
+    Returns:
+        ``root_xz`` ``(..., frames, 2)`` metres and ``yaw`` ``(..., frames)`` radians (not wrapped).
+    """
+    f = frames
+    dtype, lead = f.dtype, f.shape[:-2]
+    yaw0 = torch.as_tensor(start_yaw, dtype=dtype, device=f.device).expand(lead)
+    xz0 = (torch.zeros(lead + (2,), dtype=dtype, device=f.device) if start_xz is None
+           else torch.as_tensor(start_xz, dtype=dtype, device=f.device).expand(lead + (2,)))
+    turn = f[..., :-1, YAW_RATE_DIM] / fps
+    yaw = torch.cat([yaw0.unsqueeze(-1), yaw0.unsqueeze(-1) + torch.cumsum(turn, dim=-1)], dim=-1)
+    cos, sin = torch.cos(yaw[..., :-1]), torch.sin(yaw[..., :-1])
+    vx, vz = f[..., :-1, VELOCITY_DIMS.start] / fps, f[..., :-1, VELOCITY_DIMS.start + 1] / fps
+    # world step = R_y(yaw) (vx, 0, vz)
+    step = torch.stack([cos * vx + sin * vz, -sin * vx + cos * vz], dim=-1)
+    root_xz = torch.cat([xz0.unsqueeze(-2), xz0.unsqueeze(-2) + torch.cumsum(step, dim=-2)], dim=-2)
+    return root_xz, yaw
+
+
 def frames_to_positions(
     frames: np.ndarray | torch.Tensor,
-    fps: float,
+    fps: float | torch.Tensor,
     start_xz: np.ndarray | torch.Tensor | None = None,
     start_yaw: float | np.ndarray | torch.Tensor = 0.0,
 ) -> np.ndarray | torch.Tensor:
@@ -113,7 +148,7 @@ def frames_to_positions(
 
     Args:
         frames: ``(..., frames, 66)``; numpy in gives numpy out, torch in gives torch out.
-        fps: frames per second of ``frames``.
+        fps: frames per second of ``frames`` (a number, or per motion, see :func:`integrate_root`).
         start_xz: ``(..., 2)`` root ground position of the first frame, metres (default origin).
         start_yaw: ``(...)`` heading of the first frame, radians (default 0: facing +Z).
 
@@ -128,22 +163,10 @@ def frames_to_positions(
     if as_numpy:
         dtype = torch.float64  # integrate in double precision for numpy callers
     f = f.to(dtype)
-    lead = f.shape[:-2]
-    yaw0 = torch.as_tensor(start_yaw, dtype=dtype, device=f.device).expand(lead)
-    xz0 = (torch.zeros(lead + (2,), dtype=dtype, device=f.device) if start_xz is None
-           else torch.as_tensor(start_xz, dtype=dtype, device=f.device).expand(lead + (2,)))
-    turn = f[..., :-1, YAW_RATE_DIM] / fps
-    yaw = torch.cat([yaw0.unsqueeze(-1), yaw0.unsqueeze(-1) + torch.cumsum(turn, dim=-1)], dim=-1)
-    cos, sin = torch.cos(yaw), torch.sin(yaw)
-    vx, vz = f[..., :-1, VELOCITY_DIMS.start] / fps, f[..., :-1, VELOCITY_DIMS.start + 1] / fps
-    # world step = R_y(yaw) (vx, 0, vz)
-    dx = cos[..., :-1] * vx + sin[..., :-1] * vz
-    dz = -sin[..., :-1] * vx + cos[..., :-1] * vz
-    root_x = torch.cat([xz0[..., :1], xz0[..., :1] + torch.cumsum(dx, dim=-1)], dim=-1)
-    root_z = torch.cat([xz0[..., 1:], xz0[..., 1:] + torch.cumsum(dz, dim=-1)], dim=-1)
+    root_xz, yaw = integrate_root(f, fps, start_xz, start_yaw)
     local = f[..., JOINT_DIMS].reshape(f.shape[:-1] + (21, 3))
-    c, s = cos.unsqueeze(-1), sin.unsqueeze(-1)
-    x = c * local[..., 0] + s * local[..., 2] + root_x.unsqueeze(-1)
-    z = -s * local[..., 0] + c * local[..., 2] + root_z.unsqueeze(-1)
+    c, s = torch.cos(yaw).unsqueeze(-1), torch.sin(yaw).unsqueeze(-1)
+    x = c * local[..., 0] + s * local[..., 2] + root_xz[..., :1]
+    z = -s * local[..., 0] + c * local[..., 2] + root_xz[..., 1:]
     positions = torch.stack([x, local[..., 1], z], dim=-1)
     return positions.numpy() if as_numpy else positions

@@ -99,7 +99,7 @@ def _save(fig: Figure, path: Path, **kwargs) -> Path:
     return path
 
 
-def _pose_at(sample: np.ndarray, frames: int, index: float) -> np.ndarray:
+def pose_at(sample: np.ndarray, frames: int, index: float) -> np.ndarray:
     """Pose ``(21, 3)`` at fractional frame ``index`` (linear interpolation; held after the end)."""
     index = min(max(index, 0.0), frames - 1.0)
     lo = int(np.floor(index))
@@ -146,7 +146,7 @@ def save_gif(samples: MotionSamples, path: str | Path, count: int = 16, per_row:
             index = k * samples.fps / display_fps
             for (_, _, frames), (scene, sticks) in zip(rows, figures):
                 for stick, sample, n in zip(sticks, scene, frames):
-                    stick.set_pose(_pose_at(sample, int(n), index))
+                    stick.set_pose(pose_at(sample, int(n), index))
             writer.grab_frame()
     tmp.replace(path)
     return path

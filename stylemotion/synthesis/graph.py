@@ -1,0 +1,196 @@
+"""The motion graph of one action and one style (thesis §4.5, §5.4.4): primitives and their transitions.
+
+Nodes are the six primitives of :mod:`stylemotion.primitives` that have a trained model; edges
+follow the foot that carries the body. A clip that ends at the transfer onto the **right** foot
+(``leftStance``, ``beginLeftStance``) is followed by a clip in which the right foot is planted
+(``rightStance`` or ``endRightStance``), and mirrored for the left foot::
+
+    beginLeftStance ─▶ rightStance ─▶ leftStance ─▶ rightStance ─▶ … ─▶ endLeftStance
+    beginRightStance ─▶ leftStance ─▶ …                          … ─▶ endRightStance
+
+``end*`` primitives have no successor. Every node is a generative model: a neutral
+:class:`~stylemotion.models.vae.PrimitiveVAE` or a :class:`~stylemotion.models.cvae.StyleCVAE` of the
+chosen style, all decoding through one autoencoder.
+
+Models come from a ``stylemotion-reproduce`` run folder (its ``report/report.json`` lists every
+evaluated checkpoint with its primitive and style) or from an explicit ``{primitive: checkpoint}``
+mapping.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import torch
+
+from stylemotion.evaluation.sources import NEUTRAL, load_model
+from stylemotion.models.vae import PrimitiveVAE
+from stylemotion.primitives import PRIMITIVES, check_primitive
+
+#: Successors of each primitive (by planted foot: a clip ending on foot f is followed by one planted on f).
+TRANSITIONS: dict[str, tuple[str, ...]] = {
+    "beginLeftStance": ("rightStance", "endRightStance"),
+    "beginRightStance": ("leftStance", "endLeftStance"),
+    "leftStance": ("rightStance", "endRightStance"),
+    "rightStance": ("leftStance", "endLeftStance"),
+    "endLeftStance": (),
+    "endRightStance": (),
+}
+#: Prior samples drawn per primitive to measure its typical step (length, turn).
+PROFILE_SAMPLES = 512
+
+
+class UnknownStyleError(KeyError):
+    """The requested style has no trained model for a primitive the graph needs."""
+
+    def __str__(self) -> str:  # KeyError quotes its message otherwise
+        return str(self.args[0])
+
+
+@dataclass(frozen=True)
+class StepProfile:
+    """What one primitive's model typically does, from :data:`PROFILE_SAMPLES` prior samples.
+
+    Attributes:
+        length_m: mean root displacement over a clip, metres.
+        turn_rad: 99th percentile of the absolute heading change over a clip, radians (the sharpest
+            turn the model takes in one step, give or take its tail).
+        duration_s: mean clip duration, seconds.
+    """
+
+    length_m: float
+    turn_rad: float
+    duration_s: float
+
+
+@dataclass
+class MotionGraph:
+    """Primitive models of one action and style, and the allowed transitions.
+
+    Attributes:
+        action: e.g. ``walk``.
+        style: ``neutral`` or a style name.
+        models: primitive name without the action (e.g. ``leftStance``) → model (eval mode, frozen).
+        sources: primitive → checkpoint path.
+        profiles: primitive → :class:`StepProfile` (filled by :meth:`profile`).
+    """
+
+    action: str
+    style: str
+    models: dict[str, PrimitiveVAE]
+    sources: dict[str, str] = field(default_factory=dict)
+    profiles: dict[str, StepProfile] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        unknown = sorted(set(self.models) - set(PRIMITIVES))
+        if unknown:
+            raise ValueError(f"unknown primitives {unknown}; primitives are {list(PRIMITIVES)}")
+        if not {"leftStance", "rightStance"} <= set(self.models):
+            raise ValueError(f"a {self.action} graph needs leftStance and rightStance models to walk any "
+                             f"distance; it has {sorted(self.models)}")
+        for model in self.models.values():
+            model.eval().requires_grad_(False)
+
+    @property
+    def fps(self) -> float:
+        return self.models["leftStance"].fps
+
+    def successors(self, primitive: str) -> tuple[str, ...]:
+        """Primitives with a model that may follow ``primitive``."""
+        return tuple(p for p in TRANSITIONS[primitive] if p in self.models)
+
+    def first(self, foot: str = "left") -> str:
+        """The first primitive of a walk whose first planted foot is ``foot`` (``left``/``right``):
+        ``begin<Foot>Stance`` if modelled, else ``<foot>Stance``."""
+        if foot not in ("left", "right"):
+            raise ValueError(f"first foot must be 'left' or 'right', got {foot!r}")
+        begin = f"begin{foot.capitalize()}Stance"
+        return begin if begin in self.models else f"{foot}Stance"
+
+    def next(self, primitive: str, last: bool = False) -> str:
+        """The primitive after ``primitive``: the ``end*`` successor when ``last`` and modelled, else
+        the alternating stance."""
+        options = self.successors(primitive)
+        if not options:
+            raise ValueError(f"{primitive} ends a walk; nothing follows it")
+        ends = [p for p in options if p.startswith("end")]
+        stances = [p for p in options if not p.startswith("end")]
+        return ends[0] if last and ends else stances[0]
+
+    @torch.no_grad()
+    def profile(self, seed: int = 0) -> dict[str, StepProfile]:
+        """Measure (and keep) each primitive's :class:`StepProfile` from prior samples."""
+        from stylemotion.representation import integrate_root
+
+        for primitive, model in self.models.items():
+            samples = model.sample(PROFILE_SAMPLES, seed=seed)
+            root, yaw = integrate_root(samples.frames.double(), samples.fps)
+            last = (samples.num_frames - 1)[:, None]
+            end_xz = torch.gather(root, 1, last[..., None].expand(-1, 1, 2))[:, 0]
+            end_yaw = torch.gather(yaw, 1, last)[:, 0]
+            self.profiles[primitive] = StepProfile(
+                length_m=float(end_xz.norm(dim=-1).mean()),
+                turn_rad=float(np.quantile(end_yaw.abs().numpy(), 0.99)),
+                duration_s=float(samples.duration_s.mean()))
+        return self.profiles
+
+
+def available_models(run: str | Path) -> list[dict[str, str]]:
+    """Checkpoints of a ``stylemotion-reproduce`` run: ``[{primitive, name, style, path}]`` from its
+    ``report/report.json`` (``name`` is ``neutral`` or the style)."""
+    report = Path(run) / "report" / "report.json"
+    if not report.is_file():
+        raise FileNotFoundError(f"{report} does not exist: point run= at a finished stylemotion-reproduce folder "
+                                f"(e.g. runs/reproduce/synthetic), or give models={{primitive: checkpoint}}")
+    meta = json.loads(report.read_text()).get("meta", {})
+    entries = meta.get("checkpoints")
+    if not entries:
+        raise ValueError(f"{report}: meta.checkpoints is empty; no model to synthesize with")
+    return [{k: str(e[k]) for k in ("primitive", "name", "style", "path")} for e in entries]
+
+
+def load_graph(style: str, run: str | Path | None = None, models: Mapping[str, str] | None = None,
+               action: str = "walk", neutral_style: str = "normal") -> MotionGraph:
+    """A :class:`MotionGraph` for ``style`` (``neutral``, the data's neutral style name, or a style).
+
+    Args:
+        style: which models: ``neutral`` (or ``neutral_style``) picks the neutral VAEs, anything else
+            the StyleCVAEs trained for that style.
+        run: a ``stylemotion-reproduce`` folder to take checkpoints from (see :func:`available_models`).
+        models: explicit ``{primitive: checkpoint}`` (``walk_leftStance`` or ``leftStance``); overrides ``run``.
+        action: the action whose primitives to use.
+        neutral_style: the data's name of the neutral style (Bandai: ``normal``).
+
+    Raises:
+        UnknownStyleError: no model of ``style`` (the message lists the styles there are).
+    """
+    wanted = NEUTRAL if style in (NEUTRAL, neutral_style) else style
+    if models:
+        paths = {_short(k, action): str(v) for k, v in models.items()}
+    elif run is not None:
+        entries = [e for e in available_models(run) if e["primitive"].startswith(f"{action}_")]
+        paths = {_short(e["primitive"], action): e["path"] for e in entries if e["name"] == wanted}
+        if not paths:
+            have = sorted({e["name"] for e in entries})
+            raise UnknownStyleError(f"style {style!r} has no {action} model in {run}; styles there: {have} "
+                                    f"('{NEUTRAL}' = the neutral VAEs)")
+    else:
+        raise ValueError("give run=<stylemotion-reproduce folder> or models={primitive: checkpoint}")
+    loaded: dict[str, PrimitiveVAE] = {}
+    autoencoder = None
+    for primitive, path in sorted(paths.items()):
+        entry = load_model(path, neutral_style=neutral_style, autoencoder=autoencoder)
+        if entry.name != wanted:
+            raise UnknownStyleError(f"{path} models style {entry.name!r}, not {style!r}")
+        loaded[primitive] = entry.source
+        autoencoder = entry.source.autoencoder  # one autoencoder for all (load_model checks it is the same)
+    return MotionGraph(action=action, style=wanted, models=loaded, sources=paths)
+
+
+def _short(primitive: str, action: str) -> str:
+    """``walk_leftStance`` (or ``leftStance``) → ``leftStance``, checked."""
+    return check_primitive(primitive.split("_", 1)[1] if primitive.startswith(f"{action}_") else primitive)
