@@ -29,6 +29,9 @@ from scipy.ndimage import gaussian_filter1d
 
 from stylemotion.skeleton import CJ
 
+#: Identifier of the 66-dim frame layout below; a model trained on one representation refuses data or
+#: checkpoints of another. Bump when the layout changes.
+REPRESENTATION = "stylemotion.frames66/v1"
 FRAME_DIM = 66
 JOINT_DIMS = slice(0, 63)
 VELOCITY_DIMS = slice(63, 65)

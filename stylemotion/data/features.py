@@ -47,11 +47,10 @@ import torch
 from torch.utils.data import DataLoader, Dataset
 
 from stylemotion.data.clips import ClipDataModule, NoClipsError
-from stylemotion.data.windows import REPRESENTATION
 from stylemotion.datasets import TakeSet
 from stylemotion.models.autoencoder import IncompatibleModelError, MotionAutoencoder
 from stylemotion.primitives import ACTIONS, PRIMITIVES, Clip, time_normalize
-from stylemotion.representation import FRAME_DIM
+from stylemotion.representation import FRAME_DIM, REPRESENTATION
 from stylemotion.sampling import pad_motions
 from stylemotion.skeleton import CANONICAL_JOINTS
 

@@ -24,13 +24,9 @@ from torch.utils.data import DataLoader, Dataset
 
 from stylemotion.data.normalization import DEFAULT_STD_FLOOR, channel_stats
 from stylemotion.datasets import Take, TakeSet, build_dataset
-from stylemotion.representation import FRAME_DIM
+from stylemotion.representation import FRAME_DIM, REPRESENTATION
 
 log = logging.getLogger(__name__)
-
-#: Identifier of the 66-dim frame layout of :mod:`stylemotion.representation`; a model trained on
-#: one representation refuses data or checkpoints of another. Bump when the layout changes.
-REPRESENTATION = "stylemotion.frames66/v1"
 
 SPLITS = ("train", "val", "test")
 

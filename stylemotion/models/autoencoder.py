@@ -32,8 +32,7 @@ import torch.nn.functional as F
 from torch import nn
 
 from stylemotion.data.normalization import Normalizer
-from stylemotion.data.windows import REPRESENTATION
-from stylemotion.representation import FRAME_DIM, frames_to_positions
+from stylemotion.representation import FRAME_DIM, REPRESENTATION, frames_to_positions
 from stylemotion.skeleton import CANONICAL_JOINTS, CANONICAL_PARENTS
 
 POOLING = ("avg", "max")
@@ -165,7 +164,7 @@ class MotionAutoencoder(pl.LightningModule):
         lr_gamma: the learning rate is multiplied by this after every epoch (1 = constant).
         fps: frame rate of the frames the model is trained on (velocities are per second).
         frame_dim: values per frame. representation: frame layout id (see
-            :data:`stylemotion.data.windows.REPRESENTATION`).
+            :data:`stylemotion.representation.REPRESENTATION`).
         joint_names, joint_parents: the skeleton the frames describe (canonical 21 joints).
 
     All arguments are plain values and are saved as hyperparameters, so
