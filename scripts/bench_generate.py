@@ -34,6 +34,7 @@ def row(style: str, seed: int, summary: dict) -> dict:
     tr = summary["transitions"]
     return {"style": style, "seed": seed, **{f"deviation_{k}": summary["deviation"][k] for k in FIELDS},
             "duration_s": summary["duration_s"], "mean_speed_mps": summary["mean_speed_mps"], "steps": summary["steps"],
+            "latent_norm": summary["latent_norm_mean"],
             "skating": summary["foot_skating_ratio"], "skating_raw": summary["foot_skating_ratio_before_cleanup"],
             "skating_real": summary["real_foot_skating_ratio"], "transition_speed_ratio": tr["ratio"],
             "transition_accel_ratio": tr["accel_ratio"], "bvh_mpjpe_m": summary.get("bvh_reimport_mpjpe_m"),

@@ -62,7 +62,10 @@ class FollowSettings:
         lr: Adam learning rate (latent units).
         position_scale_m: ``σ_p``, metres.
         heading_scale_rad: ``σ_θ``, radians.
-        prior_weight: ``λ_prior``.
+        prior_weight: ``λ_prior``. At 1 the codes are pulled towards the prior's mode ‖z‖ = 0, far
+            inside its typical shell ‖z‖ ≈ √latent_dim, and the stylized models (whose codes vary
+            less in step length and turning than the neutral one) miss the path by 0.15–0.26 m; 0.3
+            keeps ‖z‖ at 2–4 and the deviation at 0.05–0.11 m (Bandai, benchmarks/synthesis.md).
         pose_scale_m: ``σ_pose``, metres.
         speed_scale_mps: ``σ_v``, m/s.
         blend_frames: frames over which each transition is blended (:mod:`.stitching`).
@@ -70,12 +73,12 @@ class FollowSettings:
         max_steps: safety limit on the number of steps.
     """
 
-    candidates: int = 64
-    iterations: int = 30
+    candidates: int = 128
+    iterations: int = 40
     lr: float = 0.05
     position_scale_m: float = 0.05
     heading_scale_rad: float = 0.15
-    prior_weight: float = 1.0
+    prior_weight: float = 0.3
     pose_scale_m: float = 0.03
     speed_scale_mps: float = 0.1
     blend_frames: int = 6

@@ -10,6 +10,8 @@
   of real clips of the style (``stylemotion-reproduce``'s ``report.json``, ``foot_skating_real``).
   Measured on the motion as given (after :mod:`stylemotion.synthesis.cleanup` if it was applied).
 * **Transitions**: :func:`stylemotion.synthesis.stitching.transition_speed_ratio`.
+* **Latent norms**: the mean ‖z‖ of the chosen codes next to √latent_dim, the radius around which
+  prior draws concentrate (how far the path pulled the codes from typical samples).
 """
 
 from __future__ import annotations
@@ -52,6 +54,8 @@ def walk_figures(motion: SynthesizedMotion) -> dict[str, Any]:
         "walked_m": walked,
         "mean_speed_mps": walked / duration,
         "steps": len(motion.steps),
+        "latent_norm_mean": float(np.mean([np.linalg.norm(s.latent) for s in motion.steps])),
+        "latent_norm_typical": float(np.sqrt(len(motion.steps[0].latent))),
         "frames": len(positions),
         "fps": motion.fps,
         "foot_skating_ratio": skating_ratio,
