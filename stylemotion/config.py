@@ -16,3 +16,27 @@ def config_dir() -> str:
             "'pip install -e .' so the configs/ folder stays beside the package"
         )
     return str(CONFIG_DIR)
+
+
+def cpu_precision() -> str:
+    """Lightning precision for CPU training: ``bf16-mixed`` where the CPU has bf16 instructions
+    (AVX-512 BF16 or AMX, read from ``/proc/cpuinfo``), else ``32-true``.
+
+    Without them bf16 autocast is emulated and an epoch takes ~40× longer than in float32 (measured
+    on an AMD EPYC without AVX-512: 3.7 min against ~5 s per Bandai autoencoder epoch).
+    """
+    try:
+        flags = Path("/proc/cpuinfo").read_text().split()
+    except OSError:  # not Linux: no way to tell, float32 is always safe
+        return "32-true"
+    return "bf16-mixed" if {"avx512_bf16", "amx_bf16"} & set(flags) else "32-true"
+
+
+def _register_resolvers() -> None:
+    from omegaconf import OmegaConf
+
+    if not OmegaConf.has_resolver("cpu_precision"):
+        OmegaConf.register_new_resolver("cpu_precision", cpu_precision)
+
+
+_register_resolvers()

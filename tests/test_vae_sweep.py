@@ -78,7 +78,7 @@ def test_style_cvae_sweep_over_styles_records_the_examples(ae_ckpt, tmp_path) ->
     takes = []
     for run, style in zip(runs, ("elderly", "youthful")):
         model = check_run(run, StyleCVAE)
-        assert model.style == style and model.hparams.style_weight == 200.0
+        assert model.style == style and model.hparams.style_weight == 5.0
         [example] = model.style_examples
         assert example["style"] == style and example["primitive"] == "rightStance" and example["content"] == "walk"
         metrics = json.loads((run / "metrics.json").read_text())
