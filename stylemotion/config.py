@@ -18,7 +18,7 @@ def config_dir() -> str:
     return str(CONFIG_DIR)
 
 
-def cpu_precision() -> str:
+def cpu_precision(cpuinfo: str | Path = "/proc/cpuinfo") -> str:
     """Lightning precision for CPU training: ``bf16-mixed`` where the CPU has bf16 instructions
     (AVX-512 BF16 or AMX, read from ``/proc/cpuinfo``), else ``32-true``.
 
@@ -26,7 +26,7 @@ def cpu_precision() -> str:
     on an AMD EPYC without AVX-512: 3.7 min against ~5 s per Bandai autoencoder epoch).
     """
     try:
-        flags = Path("/proc/cpuinfo").read_text().split()
+        flags = Path(cpuinfo).read_text().split()
     except OSError:  # not Linux: no way to tell, float32 is always safe
         return "32-true"
     return "bf16-mixed" if {"avx512_bf16", "amx_bf16"} & set(flags) else "32-true"

@@ -153,3 +153,18 @@ def test_style_model_without_its_example_in_the_data_is_refused(reproduced, tmp_
         run_evaluation(other_takes, [youthful], eval_cfg(), tmp_path / "b")
     with pytest.raises(ReportExistsError, match="already exists"):
         run_evaluation(data_cfg(), [youthful], eval_cfg(), out / "report")
+
+
+def test_budget_precision_follows_the_cpu(tmp_path) -> None:
+    """bf16 autocast only where the CPU has bf16 instructions (emulated bf16 is ~40× slower)."""
+    from stylemotion.config import cpu_precision
+
+    with_bf16, without = tmp_path / "bf16", tmp_path / "plain"
+    with_bf16.write_text("processor : 0\nflags : fpu sse2 avx2 avx512f avx512_bf16 amx_tile\n")
+    without.write_text("processor : 0\nflags : fpu sse2 avx2 fma\n")
+    assert cpu_precision(with_bf16) == "bf16-mixed" and cpu_precision(without) == "32-true"
+    assert cpu_precision(tmp_path / "missing") == "32-true"
+    with initialize_config_dir(config_dir=str(CONFIG_DIR), version_base="1.3"):
+        cfg = compose(config_name="reproduce", overrides=["data=bandai"])
+    assert cfg.budget.autoencoder.precision == cpu_precision()
+    assert f"trainer.precision={cpu_precision()}" in list(cfg.stages.autoencoder)
