@@ -15,7 +15,9 @@ Stages, each in its own folder under ``out`` (default ``runs/reproduce/<data nam
 5. ``report``: ``stylemotion-eval`` of all of them (:mod:`stylemotion.evaluate`).
 
 Each training stage composes the ``train`` config with its overrides, takes this command's ``data``
-node, and runs :func:`stylemotion.train.run` in this process. A stage that finished writes
+node, and runs :func:`stylemotion.train.run`: the autoencoder in this process, then the VAEs and
+CVAEs (which need only the autoencoder) ``workers`` at a time, each in a spawned process with
+``threads`` torch threads (``workers=1``: all in this process, one after the other). A stage that finished writes
 ``done.json`` (its checkpoint, metrics, seconds and a hash of its settings, including the hash of
 the stage it builds on); a rerun **reuses** it, and a stage interrupted mid-training **resumes**
 from its ``checkpoints/last.ckpt``. A stage whose recorded settings differ from the current ones
@@ -28,10 +30,12 @@ from __future__ import annotations
 import hashlib
 import json
 import logging
+import multiprocessing
 import sys
 import time
 from collections import Counter
 from collections.abc import Sequence
+from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -160,8 +164,11 @@ class Reproduction:
             self.say("    " + p + " clips: " + ", ".join(f"{s} {counts[(p, s)]}" for s in styles))
         _write_json(self.out / "data.json", self.data_summary)
 
-    def run_stage(self, index: int, stage: Stage) -> None:
-        """Train ``stage`` (or reuse/resume it)."""
+    def prepare_stage(self, index: int, stage: Stage) -> bool | None:
+        """Hash ``stage``'s settings, refuse a folder of other settings, reuse a finished stage.
+
+        Returns None when the stage was reused, else whether it resumes from ``last.ckpt``.
+        """
         parent_hash = stage.parent.settings_hash if stage.parent else None
         stage.settings_hash = _hash({"overrides": stage.overrides, "values": stage.values, "data": self.data_cfg,
                                      "seed": int(self.cfg.seed), "parent": parent_hash})
@@ -182,28 +189,70 @@ class Reproduction:
                 stage.status, stage.checkpoint = "reused", record["checkpoint"]
                 stage.seconds, stage.metrics = float(record.get("seconds", 0.0)), record.get("metrics", {})
                 self._line(index, f"{stage.name}: reused {stage.checkpoint}")
-                return
+                return None
         resume = last.is_file()
         self._line(index, f"{stage.name}: {'resuming from ' + str(last) if resume else 'training'}")
         _write_json(started, {"settings_hash": stage.settings_hash, "name": stage.name})
-        t0 = time.perf_counter()
-        result = self._train(stage, resume)
-        metrics = result["metrics"]
+        stage.folder.mkdir(parents=True, exist_ok=True)
+        return resume
+
+    def finish_stage(self, stage: Stage, metrics: dict[str, Any], resume: bool, seconds: float) -> None:
+        """Record a trained stage's checkpoint, metrics and time in its ``done.json``."""
+        last = stage.folder / "checkpoints" / "last.ckpt"
         ckpt = metrics.get("best_checkpoint") or (str(last) if last.is_file() else None)
         if not ckpt:
             raise RuntimeError(f"stage {stage.name} finished without a checkpoint in {stage.folder / 'checkpoints'}")
         stage.status, stage.checkpoint = ("resumed" if resume else "trained"), str(Path(ckpt).resolve())
-        stage.seconds = time.perf_counter() - t0
+        stage.seconds = seconds
         stage.metrics = {k: v for k, v in metrics.items() if k in ("test", "best_score", "global_step", "epoch")}
-        _write_json(done, {"settings_hash": stage.settings_hash, "checkpoint": stage.checkpoint,
-                           "seconds": stage.seconds, "metrics": stage.metrics, "name": stage.name})
+        _write_json(stage.folder / "done.json", {"settings_hash": stage.settings_hash, "checkpoint": stage.checkpoint,
+                                                 "seconds": stage.seconds, "metrics": stage.metrics,
+                                                 "name": stage.name})
         test = stage.metrics.get("test", {})
         shown = ", ".join(f"{k} {v:.4g}" for k, v in test.items() if isinstance(v, float))
-        self.say(f"    done in {stage.seconds / 60:.1f} min" + (f": {shown}" if shown else ""))
+        self.say(f"    {stage.name} done in {stage.seconds / 60:.1f} min" + (f": {shown}" if shown else ""))
 
-    def _train(self, stage: Stage, resume: bool) -> dict[str, Any]:
+    def run_stage(self, index: int, stage: Stage) -> None:
+        """Train ``stage`` in this process (or reuse/resume it)."""
         from stylemotion.train import run as train_run
 
+        resume = self.prepare_stage(index, stage)
+        if resume is None:
+            return
+        t0 = time.perf_counter()
+        result = train_run(self.train_config(stage, resume))
+        self.finish_stage(stage, result["metrics"], resume, time.perf_counter() - t0)
+
+    def run_stages_in_parallel(self, indexed: Sequence[tuple[int, Stage]], workers: int) -> None:
+        """Train independent stages in ``workers`` fresh processes (spawned, ``threads`` torch threads
+        each, no progress bars); every stage that finishes is recorded even if another one fails."""
+        pending: dict[Any, tuple[Stage, bool, float]] = {}
+        errors: list[tuple[Stage, BaseException]] = []
+        context = multiprocessing.get_context("spawn")
+        with ProcessPoolExecutor(max_workers=workers, mp_context=context) as pool:
+            for index, stage in indexed:
+                resume = self.prepare_stage(index, stage)
+                if resume is None:
+                    continue
+                cfg = self.train_config(stage, resume)
+                with open_dict(cfg):
+                    cfg.trainer.enable_progress_bar = False
+                container = OmegaConf.to_container(cfg, resolve=True)
+                pending[pool.submit(_train_in_worker, container)] = (stage, resume, time.perf_counter())
+            for future in as_completed(pending):
+                stage, resume, t0 = pending[future]
+                try:
+                    self.finish_stage(stage, future.result(), resume, time.perf_counter() - t0)
+                except Exception as exc:  # noqa: BLE001 - reported below, after the others are recorded
+                    self.say(f"    {stage.name} FAILED: {type(exc).__name__}: {exc}")
+                    errors.append((stage, exc))
+                _write_json(self.out / "reproduce.json", self.summary())
+        if errors:
+            names = ", ".join(stage.name for stage, _ in errors)
+            raise RuntimeError(f"{len(errors)} training stage(s) failed ({names}); rerun to resume") from errors[0][1]
+
+    def train_config(self, stage: Stage, resume: bool) -> DictConfig:
+        """The ``train`` config of ``stage``: its overrides, this run's data, seed, threads and folder."""
         cfg = compose(config_name="train", overrides=list(stage.overrides))
         with open_dict(cfg):
             cfg.data = OmegaConf.create(self.data_cfg)
@@ -216,8 +265,7 @@ class Reproduction:
             if stage.parent is not None:
                 cfg.autoencoder_ckpt = stage.parent.checkpoint
             cfg.ckpt_path = "last" if resume else None
-        stage.folder.mkdir(parents=True, exist_ok=True)
-        return train_run(cfg)
+        return cfg
 
     def evaluation_stage(self) -> dict[str, Any]:
         """Evaluate every trained model into ``<out>/report`` (or reuse the report of the same stages)."""
@@ -248,6 +296,14 @@ class Reproduction:
                             "seconds": s.seconds, "metrics": s.metrics, "folder": str(s.folder)} for s in self.stages]}
 
 
+def _train_in_worker(container: dict[str, Any]) -> dict[str, Any]:
+    """A worker process's job: :func:`stylemotion.train.run` on a resolved ``train`` config; returns
+    its metrics (the trainer and model stay in the worker)."""
+    from stylemotion.train import run as train_run
+
+    return train_run(OmegaConf.create(container))["metrics"]
+
+
 def run(cfg: DictConfig, say=print) -> dict[str, Any]:
     """Run (or resume) every stage; returns the summary written to ``<out>/reproduce.json``.
 
@@ -259,9 +315,13 @@ def run(cfg: DictConfig, say=print) -> dict[str, Any]:
     repro = Reproduction(cfg, say)
     repro.out.mkdir(parents=True, exist_ok=True)
     repro.data_stage()
-    for i, stage in enumerate(repro.stages):
-        repro.run_stage(i + 2, stage)
+    workers = int(cfg.get("workers") or 1)
+    indexed = list(enumerate(repro.stages, start=2))
+    for index, stage in indexed[:1] if workers > 1 else indexed:  # the others need the autoencoder
+        repro.run_stage(index, stage)
         _write_json(repro.out / "reproduce.json", repro.summary())
+    if workers > 1:
+        repro.run_stages_in_parallel(indexed[1:], workers)
     results = repro.evaluation_stage()
     summary = repro.summary()
     summary["report"] = str(repro.out / "report")

@@ -87,6 +87,21 @@ def test_reproduce_runs_every_stage_into_a_report(reproduced) -> None:
     assert (out / "cvae" / "walk_leftStance_elderly" / "samples").is_dir()  # the training stages' GIFs
 
 
+def test_parallel_stages_train_the_same_models_as_sequential_ones(reproduced, tmp_path: Path) -> None:
+    """workers=2 (the fixture: VAE and CVAEs in spawned processes) and workers=1 (all in this process)
+    give the same models: same seeds, one torch thread each."""
+    out, parallel, _ = reproduced
+    sequential = reproduce(tiny_overrides(tmp_path / "seq") + ["workers=1"], [])
+    for a, b in zip(parallel["stages"], sequential["stages"], strict=True):
+        assert a["name"] == b["name"] and a["metrics"]["global_step"] == b["metrics"]["global_step"]
+        assert a["metrics"]["test"] == pytest.approx(b["metrics"]["test"], rel=1e-5), a["name"]
+    def table(folder: Path) -> list[float]:
+        rows = json.loads((folder / "report" / "report.json").read_text())["table_5_1"]["walk_leftStance"]["distance"]
+        return [value for row in rows for value in row]
+
+    assert table(tmp_path / "seq") == pytest.approx(table(out), rel=1e-5)
+
+
 def test_rerun_reuses_finished_stages_and_resumes_an_interrupted_one(reproduced) -> None:
     out, _, _ = reproduced
     interrupted = out / "cvae" / "walk_leftStance_youthful"
