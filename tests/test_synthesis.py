@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import math
+import shutil
 from pathlib import Path
 
 import numpy as np
@@ -26,7 +27,7 @@ from stylemotion.synthesis import (
     load_graph,
     s_curve,
 )
-from stylemotion.synthesis.graph import TRANSITIONS
+from stylemotion.synthesis.graph import TRANSITIONS, relocated
 from stylemotion.synthesis.stitching import append_clip, blend_weights, transition_speed_ratio
 
 torch.set_num_threads(1)
@@ -217,6 +218,30 @@ def test_unknown_style_lists_the_styles_there_are(tmp_path: Path, tiny_models) -
         load_graph("neutral", run=tmp_path / "nowhere")
     with pytest.raises(ValueError, match="needs leftStance and rightStance"):
         load_graph("neutral", models={"walk_leftStance": str(tiny_models["walk_leftStance"])})
+
+
+def test_a_moved_run_folder_still_loads(tmp_path: Path, tiny_models) -> None:
+    """The report records absolute paths; a run copied elsewhere finds its files under its own folder."""
+    run, old = tmp_path / "moved", Path("/nonexistent/runs/reproduce/old")
+    entries = []
+    for primitive, ckpt in tiny_models.items():
+        (run / "vae" / primitive).mkdir(parents=True)
+        shutil.copy(ckpt, run / "vae" / primitive / "best.ckpt")
+        entries.append({"primitive": primitive, "name": "neutral", "style": "normal",
+                        "path": str(old / "vae" / primitive / "best.ckpt")})
+    ae_info = dict(torch.load(tiny_models["walk_leftStance"], map_location="cpu",
+                              weights_only=True)["hyper_parameters"]["spec"]["autoencoder"])
+    (run / "autoencoder").mkdir()
+    shutil.copy(ae_info["path"], run / "autoencoder" / "best.ckpt")
+    (run / "report").mkdir()
+    meta = {"checkpoints": entries, "autoencoder": {"path": str(old / "autoencoder" / "best.ckpt"),
+                                                    "fingerprint": ae_info["fingerprint"]}}
+    (run / "report" / "report.json").write_text(json.dumps({"meta": meta}))
+    assert relocated(old / "autoencoder" / "best.ckpt", run) == str(run / "autoencoder" / "best.ckpt")
+    graph = load_graph("neutral", run=run)
+    assert graph.sources["leftStance"] == str(run / "vae" / "walk_leftStance" / "best.ckpt")
+    assert graph.models["leftStance"].autoencoder is graph.models["rightStance"].autoencoder
+    assert relocated(old / "vae" / "missing.ckpt", run) == str(old / "vae" / "missing.ckpt")
 
 
 # -- stylemotion-generate

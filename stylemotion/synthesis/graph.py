@@ -150,7 +150,32 @@ def available_models(run: str | Path) -> list[dict[str, str]]:
     entries = meta.get("checkpoints")
     if not entries:
         raise ValueError(f"{report}: meta.checkpoints is empty; no model to synthesize with")
-    return [{k: str(e[k]) for k in ("primitive", "name", "style", "path")} for e in entries]
+    return [{**{k: str(e[k]) for k in ("primitive", "name", "style")}, "path": relocated(e["path"], run)}
+            for e in entries]
+
+
+def relocated(path: str | Path, run: str | Path) -> str:
+    """``path`` as recorded in a run's report, or, when the run folder has been moved or copied since,
+    the same file under ``run`` (the longest tail of ``path`` that exists below ``run``)."""
+    path = Path(path)
+    if path.is_file():
+        return str(path)
+    for start in range(1, len(path.parts)):
+        candidate = Path(run) / Path(*path.parts[start:])
+        if candidate.is_file():
+            return str(candidate)
+    return str(path)  # load_model names the missing file
+
+
+def run_autoencoder(run: str | Path):
+    """The autoencoder of a ``stylemotion-reproduce`` run (report ``meta.autoencoder``, relocated like
+    the checkpoints), checked against its recorded fingerprint; None if the report names none."""
+    from stylemotion.data.features import load_autoencoder
+
+    info = json.loads((Path(run) / "report" / "report.json").read_text()).get("meta", {}).get("autoencoder") or {}
+    if not info.get("path"):
+        return None
+    return load_autoencoder(relocated(info["path"], run), expected=info if info.get("fingerprint") else None)
 
 
 def load_graph(style: str, run: str | Path | None = None, models: Mapping[str, str] | None = None,
@@ -181,7 +206,7 @@ def load_graph(style: str, run: str | Path | None = None, models: Mapping[str, s
     else:
         raise ValueError("give run=<stylemotion-reproduce folder> or models={primitive: checkpoint}")
     loaded: dict[str, PrimitiveVAE] = {}
-    autoencoder = None
+    autoencoder = run_autoencoder(run) if run is not None and not models else None
     for primitive, path in sorted(paths.items()):
         entry = load_model(path, neutral_style=neutral_style, autoencoder=autoencoder)
         if entry.name != wanted:
