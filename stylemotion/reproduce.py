@@ -235,8 +235,10 @@ class Reproduction:
                 if resume is None:
                     continue
                 cfg = self.train_config(stage, resume)
-                with open_dict(cfg):
+                with open_dict(cfg):  # interleaved progress bars of several processes would be unreadable
                     cfg.trainer.enable_progress_bar = False
+                    if cfg.get("callbacks") and "progress_bar" in cfg.callbacks:
+                        cfg.callbacks.progress_bar = None
                 container = OmegaConf.to_container(cfg, resolve=True)
                 pending[pool.submit(_train_in_worker, container)] = (stage, resume, time.perf_counter())
             for future in as_completed(pending):

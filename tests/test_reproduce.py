@@ -25,6 +25,8 @@ from stylemotion.reproduce import StageConflictError, run
 torch.set_num_threads(1)
 QUIET = "trainer.enable_progress_bar=false,callbacks.progress_bar=null,trainer.enable_model_summary=false," \
         "trainer.num_sanity_val_steps=0,~logger"
+# the model stages keep the configs' progress-bar callback: worker processes must drop it themselves
+QUIET_MODELS = "trainer.enable_model_summary=false,trainer.num_sanity_val_steps=0,~logger"
 DATA = ["data.takes_per_pair=6", "data.duration_s=6.0", "data.styles=[normal,elderly,youthful]", "data.contents=[walk]"]
 EVAL = ["evaluation.samples.table_5_1=100", "evaluation.samples.variance=300", "evaluation.samples.metrics=100",
         "evaluation.classifier.components=8"]
@@ -42,9 +44,9 @@ def tiny_overrides(out: Path, vae_epochs: int = 12) -> list[str]:
                                   "trainer.limit_train_batches=null,datamodule.window_frames=30,datamodule.stride=15,"
                                   + QUIET),
         stage_list("vae", f"experiment=primitive_vae,trainer.max_epochs={vae_epochs},datamodule.min_train_clips=8,"
-                          "callbacks.samples=null," + QUIET),
+                          "callbacks.samples=null," + QUIET_MODELS),
         stage_list("cvae", "experiment=style_cvae,trainer.max_epochs=12,datamodule.min_train_clips=8,"
-                           "callbacks.samples.num_samples=4," + QUIET),
+                           "callbacks.samples.num_samples=4," + QUIET_MODELS),
     ]
 
 
