@@ -226,7 +226,7 @@ class Reproduction:
     def run_stages_in_parallel(self, indexed: Sequence[tuple[int, Stage]], workers: int) -> None:
         """Train independent stages in ``workers`` fresh processes (spawned, ``threads`` torch threads
         each, no progress bars); every stage that finishes is recorded even if another one fails."""
-        pending: dict[Any, tuple[Stage, bool, float]] = {}
+        pending: dict[Any, tuple[Stage, bool]] = {}
         errors: list[tuple[Stage, BaseException]] = []
         context = multiprocessing.get_context("spawn")
         with ProcessPoolExecutor(max_workers=workers, mp_context=context) as pool:
@@ -240,11 +240,12 @@ class Reproduction:
                     if cfg.get("callbacks") and "progress_bar" in cfg.callbacks:
                         cfg.callbacks.progress_bar = None
                 container = OmegaConf.to_container(cfg, resolve=True)
-                pending[pool.submit(_train_in_worker, container)] = (stage, resume, time.perf_counter())
+                pending[pool.submit(_train_in_worker, container)] = (stage, resume)
             for future in as_completed(pending):
-                stage, resume, t0 = pending[future]
+                stage, resume = pending[future]
                 try:
-                    self.finish_stage(stage, future.result(), resume, time.perf_counter() - t0)
+                    metrics, seconds = future.result()
+                    self.finish_stage(stage, metrics, resume, seconds)
                 except Exception as exc:  # noqa: BLE001 - reported below, after the others are recorded
                     self.say(f"    {stage.name} FAILED: {type(exc).__name__}: {exc}")
                     errors.append((stage, exc))
@@ -298,12 +299,14 @@ class Reproduction:
                             "seconds": s.seconds, "metrics": s.metrics, "folder": str(s.folder)} for s in self.stages]}
 
 
-def _train_in_worker(container: dict[str, Any]) -> dict[str, Any]:
+def _train_in_worker(container: dict[str, Any]) -> tuple[dict[str, Any], float]:
     """A worker process's job: :func:`stylemotion.train.run` on a resolved ``train`` config; returns
-    its metrics (the trainer and model stay in the worker)."""
+    its metrics and its training seconds (not counting the wait in the queue)."""
     from stylemotion.train import run as train_run
 
-    return train_run(OmegaConf.create(container))["metrics"]
+    t0 = time.perf_counter()
+    metrics = train_run(OmegaConf.create(container))["metrics"]
+    return metrics, time.perf_counter() - t0
 
 
 def run(cfg: DictConfig, say=print) -> dict[str, Any]:
