@@ -107,10 +107,16 @@ def feature_style_distance(features: torch.Tensor, target_gram: torch.Tensor | N
         if target_gram is None:
             raise ValueError("give target_gram or target_factor")
         target_factor = gram_factor(target_gram)
+    # float64: the three terms are each ~‖S‖² and cancel near the target; in float32 the rounding of
+    # the products alone leaves ~1e-3·‖S‖ of spurious distance (BLAS-dependent). The extra cost is small
+    # (channels · T · (T + rank) per sequence).
+    dtype = features.dtype
+    features = features.double()
+    target_factor = target_factor.to(features)
     steps = features.shape[-1]
     ff = features.transpose(-1, -2) @ features  # (..., T, T)
-    wf = target_factor.transpose(-1, -2).to(features) @ features  # (..., rank, T)
+    wf = target_factor.transpose(-1, -2) @ features  # (..., rank, T)
     ww = target_factor.transpose(-1, -2) @ target_factor
-    target_sq = ww.square().sum().to(features)
+    target_sq = ww.square().sum()
     squared = ff.square().sum((-1, -2)) / steps**2 - 2 * wf.square().sum((-1, -2)) / steps + target_sq
-    return squared.clamp_min(1e-12 * target_sq.clamp_min(1e-30)).sqrt()
+    return squared.clamp_min(1e-12 * target_sq.clamp_min(1e-30)).sqrt().to(dtype)
