@@ -322,11 +322,12 @@ def run(cfg: DictConfig, say=print) -> dict[str, Any]:
     repro.data_stage()
     workers = int(cfg.get("workers") or 1)
     indexed = list(enumerate(repro.stages, start=2))
-    for index, stage in indexed[:1] if workers > 1 else indexed:  # the others need the autoencoder
+    in_process = 1 if workers > 1 else len(indexed)  # stage 1 is the autoencoder the others need
+    for index, stage in indexed[:in_process]:
         repro.run_stage(index, stage)
         _write_json(repro.out / "reproduce.json", repro.summary())
-    if workers > 1:
-        repro.run_stages_in_parallel(indexed[1:], workers)
+    if indexed[in_process:]:
+        repro.run_stages_in_parallel(indexed[in_process:], workers)
     results = repro.evaluation_stage()
     summary = repro.summary()
     summary["report"] = str(repro.out / "report")

@@ -139,17 +139,23 @@ class MotionGraph:
         return self.profiles
 
 
-def available_models(run: str | Path) -> list[dict[str, str]]:
-    """Checkpoints of a ``stylemotion-reproduce`` run: ``[{primitive, name, style, path}]`` from its
-    ``report/report.json`` (``name`` is ``neutral`` or the style)."""
+def report_meta(run: str | Path) -> dict:
+    """``meta`` of a ``stylemotion-reproduce`` run's ``report/report.json`` (checkpoints, autoencoder)."""
     report = Path(run) / "report" / "report.json"
     if not report.is_file():
         raise FileNotFoundError(f"{report} does not exist: point run= at a finished stylemotion-reproduce folder "
                                 f"(e.g. runs/reproduce/synthetic), or give models={{primitive: checkpoint}}")
-    meta = json.loads(report.read_text()).get("meta", {})
+    return json.loads(report.read_text()).get("meta", {})
+
+
+def available_models(run: str | Path, meta: dict | None = None) -> list[dict[str, str]]:
+    """Checkpoints of a ``stylemotion-reproduce`` run: ``[{primitive, name, style, path}]`` from its
+    report's ``meta`` (read from ``run`` unless given; ``name`` is ``neutral`` or the style)."""
+    meta = report_meta(run) if meta is None else meta
     entries = meta.get("checkpoints")
     if not entries:
-        raise ValueError(f"{report}: meta.checkpoints is empty; no model to synthesize with")
+        raise ValueError(f"{Path(run) / 'report' / 'report.json'}: meta.checkpoints is empty; no model to "
+                         "synthesize with")
     return [{**{k: str(e[k]) for k in ("primitive", "name", "style")}, "path": relocated(e["path"], run)}
             for e in entries]
 
@@ -167,12 +173,12 @@ def relocated(path: str | Path, run: str | Path) -> str:
     return str(path)  # load_model names the missing file
 
 
-def run_autoencoder(run: str | Path):
+def run_autoencoder(run: str | Path, meta: dict | None = None):
     """The autoencoder of a ``stylemotion-reproduce`` run (report ``meta.autoencoder``, relocated like
     the checkpoints), checked against its recorded fingerprint; None if the report names none."""
     from stylemotion.data.features import load_autoencoder
 
-    info = json.loads((Path(run) / "report" / "report.json").read_text()).get("meta", {}).get("autoencoder") or {}
+    info = (report_meta(run) if meta is None else meta).get("autoencoder") or {}
     if not info.get("path"):
         return None
     return load_autoencoder(relocated(info["path"], run), expected=info if info.get("fingerprint") else None)
@@ -197,7 +203,8 @@ def load_graph(style: str, run: str | Path | None = None, models: Mapping[str, s
     if models:
         paths = {_short(k, action): str(v) for k, v in models.items()}
     elif run is not None:
-        entries = [e for e in available_models(run) if e["primitive"].startswith(f"{action}_")]
+        meta = report_meta(run)
+        entries = [e for e in available_models(run, meta) if e["primitive"].startswith(f"{action}_")]
         paths = {_short(e["primitive"], action): e["path"] for e in entries if e["name"] == wanted}
         if not paths:
             have = sorted({e["name"] for e in entries})
@@ -206,7 +213,7 @@ def load_graph(style: str, run: str | Path | None = None, models: Mapping[str, s
     else:
         raise ValueError("give run=<stylemotion-reproduce folder> or models={primitive: checkpoint}")
     loaded: dict[str, PrimitiveVAE] = {}
-    autoencoder = run_autoencoder(run) if run is not None and not models else None
+    autoencoder = run_autoencoder(run, meta) if not models else None  # models= names its own checkpoints
     for primitive, path in sorted(paths.items()):
         entry = load_model(path, neutral_style=neutral_style, autoencoder=autoencoder)
         if entry.name != wanted:
