@@ -317,10 +317,13 @@ def run(cfg: DictConfig, say=print) -> dict[str, Any]:
     """
     if cfg.get("threads"):
         torch.set_num_threads(int(cfg.threads))  # the evaluation's too, so reruns compute alike
+    workers = cfg.get("workers", 1)
+    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
+        raise ValueError(f"reproduce config key 'workers' must be an integer ≥ 1 (training stages at once), "
+                         f"got {workers!r}")
     repro = Reproduction(cfg, say)
     repro.out.mkdir(parents=True, exist_ok=True)
     repro.data_stage()
-    workers = int(cfg.get("workers") or 1)
     indexed = list(enumerate(repro.stages, start=2))
     in_process = 1 if workers > 1 else len(indexed)  # stage 1 is the autoencoder the others need
     for index, stage in indexed[:in_process]:

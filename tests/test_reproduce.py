@@ -185,3 +185,10 @@ def test_budget_precision_follows_the_cpu(tmp_path) -> None:
         cfg = compose(config_name="reproduce", overrides=["data=bandai"])
     assert cfg.budget.autoencoder.precision == cpu_precision()
     assert f"trainer.precision={cpu_precision()}" in list(cfg.stages.autoencoder)
+
+
+@pytest.mark.parametrize("workers", [0, -2, "two"])
+def test_bad_workers_value_is_refused_before_any_work(tmp_path: Path, workers) -> None:
+    with pytest.raises(ValueError, match=r"'workers' must be an integer ≥ 1.*got"):
+        reproduce(tiny_overrides(tmp_path / "run") + [f"workers={workers}"], [])
+    assert not (tmp_path / "run").exists()
