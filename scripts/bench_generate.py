@@ -2,7 +2,7 @@
 
     python scripts/bench_generate.py --run runs/reproduce/bandai --seeds 0 1 2 [--out runs/bench_generate]
 
-For each (style, seed) it runs :func:`stylemotion.generate.generate` (BVH written and read back,
+For each (style, seed) it runs :func:`stylemotion.synthesis.generate.generate` (BVH written and read back,
 GIF off unless ``--gif``) and prints one JSON line: path deviation (mean/max/final, m), duration,
 mean speed, foot skating before/after the clean-up and of real clips of the style, transition
 ratios, BVH round-trip MPJPE and the synthesis time (seconds, excluding model loading and file
@@ -23,8 +23,8 @@ import numpy as np
 import torch
 
 from stylemotion.evaluation.sources import NEUTRAL
-from stylemotion.generate import generate
 from stylemotion.synthesis.controller import SharpTurnWarning
+from stylemotion.synthesis.generate import generate
 from stylemotion.synthesis.graph import available_models
 
 FIELDS = ("mean_m", "max_m", "final_m")

@@ -30,7 +30,7 @@ def stand_in(folder: Path):
     """An untrained PrimitiveVAE (and autoencoder checkpoint) with Bandai walk-stance sizes."""
     import lightning.pytorch as pl
 
-    from stylemotion.data.features import autoencoder_info
+    from stylemotion.datamodules.features import autoencoder_info
     from stylemotion.models.autoencoder import MotionAutoencoder
     from stylemotion.models.vae import PrimitiveVAE
 

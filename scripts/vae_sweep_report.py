@@ -30,7 +30,7 @@ from pathlib import Path
 import torch
 import yaml
 
-from stylemotion.data.features import FeatureDataModule
+from stylemotion.datamodules.features import FeatureDataModule
 from stylemotion.datasets import build_dataset
 from stylemotion.models.cvae import StyleCVAE
 from stylemotion.models.style import feature_style_distance, gram

@@ -1,19 +1,25 @@
-"""Where the Hydra configs live and small helpers shared by the entry points."""
+"""Where the Hydra configs live and small helpers shared by the entry points.
+
+The configs ship inside the package (``stylemotion/configs``, package data), so every command works
+from a wheel or a non-editable install as well as from a clone.
+"""
 
 from __future__ import annotations
 
 from pathlib import Path
 
-#: The repository's ``configs/`` folder (the package is installed editable from the repository).
-CONFIG_DIR = Path(__file__).resolve().parents[1] / "configs"
+#: The packaged Hydra configs, as a folder on disk.
+CONFIG_DIR = Path(__file__).resolve().parent / "configs"
+#: The same configs as a Hydra search path (what the console scripts pass to ``hydra.main``).
+CONFIG_PACKAGE = "pkg://stylemotion.configs"
 
 
 def config_dir() -> str:
-    """Absolute path of ``configs/``; a clear error if the package was installed without it."""
-    if not CONFIG_DIR.is_dir():
+    """Absolute path of the packaged configs; a clear error if the installation lacks them."""
+    if not (CONFIG_DIR / "train.yaml").is_file():
         raise FileNotFoundError(
-            f"Hydra configs not found at {CONFIG_DIR}; install stylemotion from a clone with "
-            "'pip install -e .' so the configs/ folder stays beside the package"
+            f"Hydra configs not found at {CONFIG_DIR}: this installation of stylemotion is incomplete "
+            "(the wheel must include stylemotion/configs/**/*.yaml); reinstall it"
         )
     return str(CONFIG_DIR)
 

@@ -13,8 +13,8 @@ from pathlib import Path
 import lightning.pytorch as pl
 import torch
 
-from stylemotion.data import MotionWindowDataModule
-from stylemotion.data.features import FeatureDataModule
+from stylemotion.datamodules import MotionWindowDataModule
+from stylemotion.datamodules.features import FeatureDataModule
 from stylemotion.datasets import TakeSet
 from stylemotion.datasets.registry import load_synthetic
 from stylemotion.models import MotionAutoencoder

@@ -9,14 +9,14 @@
 * :mod:`.reference`: the real clips a primitive's models are compared with;
 * :mod:`.pipeline`: one evaluation → plain results; :mod:`.report`: the report folder.
 
-Entry point: ``stylemotion-eval`` (:mod:`stylemotion.evaluate`).
+* :mod:`.run`: checkpoints → loaded models → evaluation → report folder (what ``stylemotion-eval`` calls).
 """
 
 from stylemotion.evaluation.classifier import StyleClassifier
 from stylemotion.evaluation.metrics import diversity, foot_skating, frechet_distance, nearest_distances
 from stylemotion.evaluation.pipeline import EvalSettings, evaluate_models
 from stylemotion.evaluation.reference import PrimitiveData, primitive_data
-from stylemotion.evaluation.report import ReportExistsError, write_report
+from stylemotion.evaluation.report import write_report
 from stylemotion.evaluation.sources import (
     NEUTRAL,
     EvalModel,
@@ -29,6 +29,6 @@ from stylemotion.evaluation.sources import (
 from stylemotion.evaluation.tables import diagonal_minima, distance_table, variance_stats
 
 __all__ = ["NEUTRAL", "EvalModel", "EvalSettings", "MissingExampleError", "MixedAutoencodersError", "PrimitiveData",
-           "RealClipSource", "ReportExistsError", "SampleSource", "StyleClassifier", "diagonal_minima",
+           "RealClipSource", "SampleSource", "StyleClassifier", "diagonal_minima",
            "distance_table", "diversity", "evaluate_models", "foot_skating", "frechet_distance", "load_model",
            "nearest_distances", "primitive_data", "variance_stats", "write_report"]

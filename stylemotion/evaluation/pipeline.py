@@ -29,8 +29,8 @@ from typing import Any
 import numpy as np
 import torch
 
-from stylemotion.data.features import encode_examples
-from stylemotion.data.windows import MotionWindowDataModule
+from stylemotion.datamodules.features import encode_examples
+from stylemotion.datamodules.windows import MotionWindowDataModule
 from stylemotion.datasets import TakeSet
 from stylemotion.evaluation.classifier import StyleClassifier, predicted_shares
 from stylemotion.evaluation.metrics import (

@@ -1,6 +1,6 @@
 """The real clips an evaluation compares models with, for one primitive.
 
-The takes are segmented and split exactly as for training (:class:`stylemotion.data.clips.ClipDataModule`
+The takes are segmented and split exactly as for training (:class:`stylemotion.datamodules.clips.ClipDataModule`
 with the data's seeded split by take), and every clip of the primitive, of every style, is
 time-normalized to the models' canonical length. From them:
 
@@ -22,8 +22,8 @@ from typing import Any
 import numpy as np
 
 from stylemotion.contacts import foot_signals
-from stylemotion.data.clips import ClipDataModule
-from stylemotion.data.features import parse_primitive
+from stylemotion.datamodules.clips import ClipDataModule
+from stylemotion.datamodules.features import parse_primitive
 from stylemotion.datasets import TakeSet
 from stylemotion.evaluation.sources import EvalModel, MissingExampleError
 from stylemotion.primitives import STANCE_FOOT, Clip, action_of

@@ -39,29 +39,16 @@ from stylemotion.evaluation.figures import write_figures
 from stylemotion.evaluation.markdown import DEFINITIONS, format_markdown
 from stylemotion.evaluation.tables import VARIANCE_KEYS
 from stylemotion.io.atomic import atomic_folder
-
-
-class ReportExistsError(FileExistsError):
-    """The report folder exists and ``force`` is off."""
-
-
-def check_target(out: str | os.PathLike, force: bool = False) -> Path:
-    """``out`` as a Path; a :class:`ReportExistsError` if it exists and ``force`` is off (call it before
-    the evaluation, so a long run does not end in this error)."""
-    out = Path(out)
-    if out.exists() and not force:
-        raise ReportExistsError(f"report folder {out} already exists; choose another out=… or pass force=true to "
-                                "replace it")
-    return out
+from stylemotion.io.outputs import check_new_output
 
 
 def write_report(results: dict[str, Any], out: str | os.PathLike, force: bool = False) -> Path:
     """Write the report folder of ``results`` (from :func:`stylemotion.evaluation.pipeline.evaluate_models`
     plus ``meta``) atomically; returns its path."""
-    out = check_target(out, force)
+    out = check_new_output(out, force)
     results = {**results, "definitions": DEFINITIONS}
-    # check_target again at swap time: the folder may have appeared meanwhile
-    with atomic_folder(out, on_exists=lambda: check_target(out, force)) as tmp:
+    # checked again at swap time: the folder may have appeared meanwhile
+    with atomic_folder(out, on_exists=lambda: check_new_output(out, force)) as tmp:
         figures = write_figures(results, tmp)
         tables = write_csvs(results, tmp)
         (tmp / "report.json").write_text(json.dumps(_plain(results), indent=1, allow_nan=False))

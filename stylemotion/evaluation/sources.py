@@ -54,7 +54,7 @@ class EvalModel:
         style: the data's style label it should produce (the neutral style for ``neutral``).
         source: draws its samples.
         examples: the style example clips it was conditioned on (records with ``take``, ``start``,
-            ``stop``, ``encoded_frames``, … as saved by :mod:`stylemotion.data.features`); empty for
+            ``stop``, ``encoded_frames``, … as saved by :mod:`stylemotion.datamodules.features`); empty for
             the neutral model.
         autoencoder: the autoencoder it was trained on (``path``, ``fingerprint``, …), or None.
         checkpoint: its checkpoint path, or None.

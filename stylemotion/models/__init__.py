@@ -1,7 +1,7 @@
 """Networks (plain ``nn.Module``s) and the Lightning modules that train them.
 
 ``PrimitiveVAE``, ``MLPVAE`` and ``StyleCVAE`` are imported on first access: their modules build on
-:mod:`stylemotion.data.features`, which itself imports the autoencoder from this package.
+:mod:`stylemotion.datamodules.features`, which itself imports the autoencoder from this package.
 """
 
 from importlib import import_module

@@ -8,7 +8,7 @@ neutral clips of the primitive); the loss gains a style term::
 where ``decoder(z)`` is turned back into raw autoencoder features (de-normalized, duration value
 dropped), ``Gram`` is :func:`stylemotion.models.style.gram` (over time, normalized by the number of
 time steps) and ``Gram(Φ(x_s))`` is the mean Gram of the encoded style example clip(s) — any
-length, any primitive (see :mod:`stylemotion.data.features`).
+length, any primitive (see :mod:`stylemotion.datamodules.features`).
 
 Which ``z`` (``style_latents``): the thesis writes ``decoder(z)`` next to the reconstruction's
 ``z_il = μ(y_i) + σ(y_i) ε_l``. Styling only those (``posterior``) leaves the samples a user draws,

@@ -22,7 +22,7 @@ path and a fingerprint of its weights are hyperparameters (``spec["autoencoder"]
 loaded from there on first use (or given with :meth:`PrimitiveVAE.attach_autoencoder`).
 
 Everything the model learned about its data (feature shape, canonical length, fps, autoencoder,
-which clips and examples) is filled in from the :class:`~stylemotion.data.features.FeatureDataModule`
+which clips and examples) is filled in from the :class:`~stylemotion.datamodules.features.FeatureDataModule`
 at the first ``setup`` into the plain-valued hyperparameter ``spec``; normalization statistics are
 buffers. So ``PrimitiveVAE.load_from_checkpoint(path)`` works in a fresh process under
 ``torch.load(weights_only=True)``.
@@ -38,7 +38,7 @@ import lightning.pytorch as pl
 import torch
 from torch import nn
 
-from stylemotion.data.features import autoencoder_info, fingerprint, load_autoencoder
+from stylemotion.datamodules.features import autoencoder_info, fingerprint, load_autoencoder
 from stylemotion.models.autoencoder import IncompatibleModelError, MotionAutoencoder, NonFiniteLossError
 from stylemotion.sampling import DEFAULT_CHUNK, MotionSamples, decode_features, masked_mpjpe
 
@@ -120,7 +120,7 @@ def kl_divergence(mean: torch.Tensor, logvar: torch.Tensor) -> torch.Tensor:
 class PrimitiveVAE(pl.LightningModule):
     """Generative model of one motion primitive (a VAE on its clips' autoencoder features).
 
-    Batches come from :class:`~stylemotion.data.features.FeatureDataModule`. Logged per split:
+    Batches come from :class:`~stylemotion.datamodules.features.FeatureDataModule`. Logged per split:
     ``loss``, ``recon``, ``kl``; on val/test also ``mpjpe`` (metres: posterior-mean reconstruction
     decoded through the autoencoder at the clip's real duration, against the recorded clip, both
     integrated from the origin at the data's fps) and ``duration_error`` (seconds, mean absolute).
@@ -203,7 +203,7 @@ class PrimitiveVAE(pl.LightningModule):
         datamodule = getattr(self.trainer, "datamodule", None) if self._trainer is not None else None
         if datamodule is None or not hasattr(datamodule, "model_spec"):
             raise RuntimeError(f"{type(self).__name__} is trained on a FeatureDataModule "
-                               "(stylemotion.data.features), which provides the features and their statistics")
+                               "(stylemotion.datamodules.features), which provides the features and their statistics")
         spec = self._adapt_spec(datamodule.model_spec())
         if self.net is None:
             self._build(spec)

@@ -176,7 +176,7 @@ def relocated(path: str | Path, run: str | Path) -> str:
 def run_autoencoder(run: str | Path, meta: dict | None = None):
     """The autoencoder of a ``stylemotion-reproduce`` run (report ``meta.autoencoder``, relocated like
     the checkpoints), checked against its recorded fingerprint; None if the report names none."""
-    from stylemotion.data.features import load_autoencoder
+    from stylemotion.datamodules.features import load_autoencoder
 
     info = (report_meta(run) if meta is None else meta).get("autoencoder") or {}
     if not info.get("path"):

@@ -1,0 +1,38 @@
+"""``stylemotion-segment``: segment walks and runs into motion primitives and write a report folder.
+
+    stylemotion-segment                                  # the embedded synthetic dataset
+    stylemotion-segment data=bandai 'data.contents=[walk,walk-turn-left,walk-turn-right,run]' \\
+        out=reports/segmentation/bandai
+
+The work and the folder's contents: :mod:`stylemotion.segmentation_report`.
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import hydra
+from omegaconf import DictConfig
+
+from stylemotion.config import CONFIG_PACKAGE
+from stylemotion.io.outputs import OutputExistsError
+from stylemotion.segmentation_report import print_summary, write_report
+
+
+def _main(cfg: DictConfig) -> None:
+    command = "stylemotion-segment " + " ".join(sys.argv[1:])
+    try:
+        report = write_report(cfg, Path(cfg.out), bool(cfg.force), command)
+    except OutputExistsError as exc:
+        sys.exit(f"stylemotion-segment: {exc}")
+    print_summary(report, Path(cfg.out))
+
+
+def main() -> None:
+    """Console script ``stylemotion-segment``."""
+    hydra.main(config_path=CONFIG_PACKAGE, config_name="segment", version_base="1.3")(_main)()
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,216 @@
+"""Sliding windows over whole takes, as a Lightning DataModule (thesis §5.4.1).
+
+Every take of the dataset (every content and style) is cut into windows of ``window_frames``
+frames (60 = the canonical timeline) with a stride of ``stride`` frames (30 = half overlap). With
+``cover_tail`` a last window aligned to the take's end is added when the stride leaves frames
+uncovered, so every frame of a take of at least one window's length is seen. Takes shorter than
+one window are left out (counted in :attr:`MotionWindowDataModule.summary`).
+
+The split is by take (:meth:`stylemotion.datasets.TakeSet.split`, seeded, with the data config's
+``split`` settings); the per-channel z-score statistics come from the train split only. Batches are
+raw (un-normalized) frames ``(batch, window_frames, 66)``: the model owns its normalization.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import lightning.pytorch as pl
+import numpy as np
+import torch
+from torch.utils.data import DataLoader, Dataset
+
+from stylemotion.datamodules.normalization import DEFAULT_STD_FLOOR, channel_stats
+from stylemotion.datasets import Take, TakeSet, build_dataset
+from stylemotion.representation import FRAME_DIM, REPRESENTATION
+
+log = logging.getLogger(__name__)
+
+SPLITS = ("train", "val", "test")
+
+
+class EmptySplitError(ValueError):
+    """A split needed for training or testing holds no window."""
+
+
+def window_starts(num_frames: int, window: int, stride: int, cover_tail: bool = True) -> list[int]:
+    """First frame of each window of a take of ``num_frames`` frames (empty if shorter than one)."""
+    if window < 1 or stride < 1:
+        raise ValueError(f"window and stride must be ≥ 1, got {window} and {stride}")
+    if num_frames < window:
+        return []
+    starts = list(range(0, num_frames - window + 1, stride))
+    if cover_tail and starts[-1] != num_frames - window:
+        starts.append(num_frames - window)
+    return starts
+
+
+class WindowDataset(Dataset):
+    """Windows cut on the fly from the concatenated frames of a list of takes.
+
+    Attributes:
+        frames: ``(total_frames, 66)`` float32 raw frames of all takes, one after another.
+        starts: ``(windows,)`` int64 index of each window's first frame in ``frames``.
+        window: frames per window.
+        take_names: name of the take each window comes from.
+    """
+
+    def __init__(self, takes: Sequence[Take], window: int, stride: int, cover_tail: bool = True):
+        self.window = window
+        chunks, starts, names, offset = [], [], [], 0
+        for take in takes:
+            frames = take.frames
+            if not np.isfinite(frames).all():
+                raise ValueError(f"take {take.name!r} ({take.source or 'no source'}) has non-finite frames")
+            local = window_starts(len(frames), window, stride, cover_tail)
+            if not local:
+                continue
+            chunks.append(frames)
+            starts.extend(offset + s for s in local)
+            names.extend([take.name] * len(local))
+            offset += len(frames)
+        self.frames = torch.from_numpy(np.concatenate(chunks).astype(np.float32)) if chunks \
+            else torch.zeros(0, FRAME_DIM)
+        self.starts = torch.as_tensor(starts, dtype=torch.int64)
+        self.take_names = names
+
+    def __len__(self) -> int:
+        return int(self.starts.numel())
+
+    def __getitem__(self, index: int) -> torch.Tensor:
+        """``(window, 66)`` raw frames of window ``index``."""
+        start = int(self.starts[index])
+        return self.frames[start:start + self.window]
+
+
+class MotionWindowDataModule(pl.LightningDataModule):
+    """Train/val/test windows of a dataset, with train-split normalization statistics.
+
+    Args:
+        data: a ``data`` config node as a plain mapping (``name``, loader options, ``split``);
+            see ``configs/data/``. Ignored when ``takeset`` is given.
+        takeset: an already built :class:`TakeSet` (Python use; not saved in checkpoints).
+        window_frames: frames per window (at the dataset's fps).
+        stride: frames between window starts.
+        cover_tail: add an end-aligned last window where the stride leaves frames out.
+        batch_size: training batch size (windows).
+        eval_batch_size: validation/test batch size; None = ``batch_size``.
+        num_workers: DataLoader worker processes (0 = load in the training process).
+        std_floor: smallest per-channel standard deviation (see :mod:`.normalization`).
+        split: split settings (``seed``, ``val_fraction``, ``test_fraction``); None = ``data.split``.
+    """
+
+    #: What a model checks the data against (see ``MotionAutoencoder.check_compatible``).
+    representation = REPRESENTATION
+    frame_dim = FRAME_DIM
+
+    def __init__(
+        self,
+        data: Mapping[str, Any] | None = None,
+        takeset: TakeSet | None = None,
+        window_frames: int = 60,
+        stride: int = 30,
+        cover_tail: bool = True,
+        batch_size: int = 64,
+        eval_batch_size: int | None = None,
+        num_workers: int = 0,
+        std_floor: float = DEFAULT_STD_FLOOR,
+        split: Mapping[str, Any] | None = None,
+    ):
+        super().__init__()
+        if data is None and takeset is None:
+            raise ValueError("MotionWindowDataModule needs a data config or a takeset")
+        if window_frames < 2 or stride < 1 or batch_size < 1:
+            raise ValueError(f"need window_frames ≥ 2, stride ≥ 1, batch_size ≥ 1; got {window_frames}, "
+                             f"{stride}, {batch_size}")
+        self.save_hyperparameters(ignore=["takeset"])
+        self.data_cfg = dict(data) if data is not None else None
+        self.split_cfg = dict(split if split is not None else (self.data_cfg or {}).get("split") or {})
+        self._takeset = takeset
+        self.window_frames, self.stride, self.cover_tail = window_frames, stride, cover_tail
+        self.batch_size = batch_size
+        self.eval_batch_size = eval_batch_size or batch_size
+        self.num_workers = num_workers
+        self.std_floor = std_floor
+        self.datasets: dict[str, WindowDataset] = {}
+        self.split_takes: dict[str, list[Take]] = {}
+        self.mean: np.ndarray | None = None
+        self.std: np.ndarray | None = None
+        self.summary: dict[str, Any] = {}
+
+    @property
+    def takeset(self) -> TakeSet:
+        if self._takeset is None:
+            self._takeset = build_dataset(self.data_cfg)
+        return self._takeset
+
+    @property
+    def fps(self) -> float:
+        return float(self.takeset.fps)
+
+    @property
+    def normalization(self) -> tuple[np.ndarray, np.ndarray]:
+        """``(mean, std)``, each ``(66,)``, of the train split's frames (after :meth:`setup`)."""
+        if self.mean is None or self.std is None:
+            raise RuntimeError("call setup() before asking for normalization statistics")
+        return self.mean, self.std
+
+    def prepare_data(self) -> None:
+        """Build (and cache on disk) the dataset once, on the first process of each machine."""
+        _ = self.takeset
+
+    def setup(self, stage: str | None = None) -> None:
+        takeset = self.takeset
+        if not self.split_takes:
+            self.split_takes = takeset.split(**self.split_cfg)
+            for name in SPLITS:
+                self.datasets[name] = WindowDataset(self.split_takes[name], self.window_frames, self.stride,
+                                                    self.cover_tail)
+            self.summary = {
+                name: {"takes": len(self.split_takes[name]), "windows": len(self.datasets[name]),
+                       "frames": int(self.datasets[name].frames.shape[0])} for name in SPLITS
+            }
+            log.info("windows of %d frames (stride %d) from %s: %s", self.window_frames, self.stride,
+                     takeset.name, self.summary)
+        needed = {"fit": ("train", "val"), "validate": ("train", "val"), "test": ("train", "test"),
+                  "predict": ("train", "test"), None: ("train", "val", "test")}[stage]
+        for name in needed:
+            self._require(name)
+        if self.mean is None:
+            self.mean, self.std = channel_stats([self.datasets["train"].frames.numpy()], self.std_floor)
+
+    def _require(self, name: str) -> None:
+        if len(self.datasets[name]):
+            return
+        takes = self.split_takes[name]
+        short = sum(t.num_frames < self.window_frames for t in takes)
+        raise EmptySplitError(
+            f"the {name!r} split of dataset {self.takeset.name!r} has no window of {self.window_frames} "
+            f"frames: it holds {len(takes)} of the dataset's {len(self.takeset)} takes"
+            + (f" ({short} shorter than one window)" if short else "")
+            + f"; split settings {self.split_cfg or '(defaults)'}. A (content, style) group needs at least "
+            "3 takes to give val and test one each: use more takes, other split fractions or a shorter "
+            "window."
+        )
+
+    def _loader(self, name: str, shuffle: bool) -> DataLoader:
+        if name not in self.datasets:
+            raise RuntimeError("call setup() before asking for a DataLoader")
+        return DataLoader(
+            self.datasets[name], batch_size=self.batch_size if name == "train" else self.eval_batch_size,
+            shuffle=shuffle, num_workers=self.num_workers, persistent_workers=self.num_workers > 0,
+        )
+
+    def train_dataloader(self) -> DataLoader:
+        return self._loader("train", shuffle=True)
+
+    def val_dataloader(self) -> DataLoader:
+        return self._loader("val", shuffle=False)
+
+    def test_dataloader(self) -> DataLoader:
+        return self._loader("test", shuffle=False)
+
+    def predict_dataloader(self) -> DataLoader:
+        return self._loader("test", shuffle=False)

@@ -1,0 +1,71 @@
+"""Output folders: never over a finished result, never outside the folder.
+
+Every command writes into one output folder. :func:`check_new_output` refuses an existing folder
+unless the user forces it; :func:`safe_name` turns a label that came from data (a take name from a
+zip member path, a style from a user's CSV) into a single, harmless file-name component; and
+:func:`inside` checks that a path built from such names stays inside its folder.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import unicodedata
+from pathlib import Path
+
+
+class OutputExistsError(FileExistsError):
+    """An output (folder or file) exists and the command was not told to replace it."""
+
+
+class UnsafePathError(ValueError):
+    """A path built from data would leave its output folder."""
+
+
+#: Characters kept in a file-name component; everything else becomes ``_``.
+_UNSAFE = re.compile(r"[^A-Za-z0-9._+\-]+")
+#: Longest file-name component written (bytes on common file systems are 255).
+MAX_NAME_LENGTH = 120
+
+
+def check_new_output(path: str | os.PathLike, force: bool = False, key: str = "out") -> Path:
+    """``path`` as a Path; :class:`OutputExistsError` naming ``key`` if it exists and ``force`` is off.
+
+    Call it before any work, and again when the result is swapped into place.
+    """
+    path = Path(path).expanduser()
+    if path.exists() and not force:
+        raise OutputExistsError(f"{path} already exists; choose another {key}=… or pass force=true to replace it")
+    return path
+
+
+def safe_name(label: str, what: str = "name") -> str:
+    """``label`` as one file-name component: no separators, no ``..``, no leading dot, printable ASCII.
+
+    Letters, digits and ``._+-`` are kept; runs of anything else (``/``, ``\\``, spaces, control
+    characters, non-ASCII after NFKD folding) become one ``_``. Long names are cut to
+    :data:`MAX_NAME_LENGTH` characters.
+
+    Raises:
+        ValueError: nothing usable is left (naming ``what``).
+    """
+    folded = unicodedata.normalize("NFKD", str(label)).encode("ascii", "ignore").decode()
+    name = _UNSAFE.sub("_", folded).strip("._")
+    name = name[:MAX_NAME_LENGTH]
+    if not name or set(name) <= {".", "_"}:
+        raise ValueError(f"{what} {label!r} has no character usable in a file name")
+    return name
+
+
+def inside(root: str | os.PathLike, *parts: str | os.PathLike) -> Path:
+    """``root / parts…``, refused if it resolves outside ``root`` (``..``, absolute parts, links).
+
+    Raises:
+        UnsafePathError: naming the path and the folder.
+    """
+    root_path = Path(root).resolve()
+    path = root_path.joinpath(*parts)
+    resolved = path.resolve()
+    if resolved != root_path and root_path not in resolved.parents:
+        raise UnsafePathError(f"output path {path} would be written outside its folder {root_path}")
+    return path

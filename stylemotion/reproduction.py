@@ -1,0 +1,340 @@
+"""The reproduction (what ``stylemotion-reproduce`` runs): data → autoencoder → VAEs → CVAEs → evaluation.
+
+    stylemotion-reproduce                                   # the embedded synthetic data, a few minutes
+    stylemotion-reproduce data=bandai 'data.contents=[walk,walk-turn-left,walk-turn-right]'
+    stylemotion-reproduce data=bandai ... out=runs/reproduce/bandai_2   # a second, independent run
+
+Stages, each in its own folder under ``out`` (default ``runs/reproduce/<data name>``):
+
+1. ``data``: build (or load from the cache) the dataset, segment it, count the clips of each
+   primitive and style (``data.json``);
+2. ``autoencoder``: ``stylemotion-train`` with ``stages.autoencoder`` overrides (default
+   ``experiment=autoencoder``) on all takes of the data;
+3. ``vae/<primitive>``: the neutral PrimitiveVAE of each primitive (``experiment=primitive_vae``);
+4. ``cvae/<primitive>_<style>``: a StyleCVAE per primitive and style (``experiment=style_cvae``);
+5. ``report``: ``stylemotion-eval`` of all of them (:mod:`stylemotion.evaluation.run`).
+
+Each training stage composes the ``train`` config with its overrides, takes this command's ``data``
+node, and runs :func:`stylemotion.training.run`: the autoencoder in this process, then the VAEs and
+CVAEs (which need only the autoencoder) ``workers`` at a time, each in a spawned process with
+``threads`` torch threads (``workers=1``: all in this process, one after the other). A stage that finished writes
+``done.json`` (its checkpoint, metrics, seconds and a hash of its settings, including the hash of
+the stage it builds on); a rerun **reuses** it, and a stage interrupted mid-training **resumes**
+from its ``checkpoints/last.ckpt``. A stage whose recorded settings differ from the current ones
+stops the run with an error (choose another ``out`` or delete that stage's folder) — results are
+never overwritten silently. ``reproduce.json`` under ``out`` summarizes the stages.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import logging
+import multiprocessing
+import sys
+import time
+from collections import Counter
+from collections.abc import Sequence
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import torch
+from hydra import compose
+from omegaconf import DictConfig, OmegaConf, open_dict
+
+from stylemotion.datamodules.features import parse_primitive
+from stylemotion.datasets import build_dataset
+from stylemotion.evaluation.run import run_evaluation, summary_lines
+from stylemotion.io.atomic import atomic_write_bytes
+from stylemotion.primitives import SegmentSettings, action_of, segment_takes
+
+log = logging.getLogger(__name__)
+
+
+class StageConflictError(RuntimeError):
+    """A stage folder holds results of different settings than the current run's."""
+
+
+@dataclass
+class Stage:
+    """One step of the reproduction.
+
+    Attributes:
+        kind: ``autoencoder``, ``vae`` or ``cvae``.
+        name: display name (e.g. ``cvae walk_leftStance/elderly``).
+        folder: its output folder.
+        overrides: Hydra overrides of the ``train`` config.
+        values: config values set after composing (primitive, style, autoencoder_ckpt).
+        parent: the stage whose checkpoint it builds on.
+    """
+
+    kind: str
+    name: str
+    folder: Path
+    overrides: list[str]
+    values: dict[str, Any] = field(default_factory=dict)
+    parent: Stage | None = None
+    status: str = "pending"
+    checkpoint: str | None = None
+    seconds: float = 0.0
+    metrics: dict[str, Any] = field(default_factory=dict)
+    settings_hash: str = ""
+
+
+def _hash(payload: Any) -> str:
+    return hashlib.sha256(json.dumps(payload, sort_keys=True, default=str).encode()).hexdigest()[:16]
+
+
+def _write_json(path: Path, payload: Any) -> None:
+    atomic_write_bytes(path, json.dumps(payload, indent=1, default=str).encode())
+
+
+class Reproduction:
+    """The stages of one reproduction run (see the module doc) and their execution.
+
+    Args:
+        cfg: the composed ``reproduce`` config.
+        say: prints a progress line.
+    """
+
+    def __init__(self, cfg: DictConfig, say=print):
+        self.cfg = cfg
+        self.say = say
+        self.out = Path(cfg.out)
+        self.data_cfg = OmegaConf.to_container(cfg.data, resolve=True)
+        self.primitives = [str(p) for p in cfg.primitives]
+        for p in self.primitives:
+            parse_primitive(p)
+        self.started = time.perf_counter()
+        self.stages: list[Stage] = []
+        self.data_summary: dict[str, Any] = {}
+
+    # -- stages
+
+    def total_steps(self) -> int:
+        return len(self.stages) + 2
+
+    def _line(self, step: int, text: str) -> None:
+        elapsed = time.perf_counter() - self.started
+        self.say(f"[{step}/{self.total_steps()}] {text}  (at {elapsed / 60:.1f} min)")
+
+    def plan(self, styles: Sequence[str]) -> None:
+        """The training stages for the primitives and ``styles`` (called by :meth:`data_stage`)."""
+        stages_cfg = self.cfg.stages
+        ae = Stage("autoencoder", "autoencoder", self.out / "autoencoder", list(stages_cfg.autoencoder))
+        self.stages = [ae]
+        for p in self.primitives:
+            self.stages.append(Stage("vae", f"vae {p}", self.out / "vae" / p, list(stages_cfg.vae),
+                                     {"primitive": p}, ae))
+        for p in self.primitives:
+            for s in styles:
+                self.stages.append(Stage("cvae", f"cvae {p}/{s}", self.out / "cvae" / f"{p}_{s}",
+                                         list(stages_cfg.cvae), {"primitive": p, "style": s}, ae))
+
+    def data_stage(self) -> None:
+        """Build and segment the data, count its clips, and plan the training stages."""
+        t0 = time.perf_counter()
+        takeset = build_dataset(self.data_cfg)
+        settings = SegmentSettings.from_dict(dict(self.cfg.evaluation.get("segment") or {}))
+        actions = {parse_primitive(p)[0] for p in self.primitives}
+        takes = [t for t in takeset.takes if action_of(t.content, settings.actions) in actions]
+        seg = segment_takes(takes, settings)
+        counts = Counter((f"{c.action}_{c.primitive}", c.style) for c in seg.clips)
+        styles = takeset.label_values("style")
+        neutral = str(self.cfg.evaluation.neutral_style)
+        if neutral not in styles:
+            raise ValueError(f"the neutral style {neutral!r} is not in dataset {takeset.name!r} (styles {styles}); "
+                             "set evaluation.neutral_style")
+        wanted = [s for s in (self.cfg.styles if self.cfg.styles is not None else styles) if s != neutral]
+        missing = [s for s in wanted if s not in styles]
+        if missing:
+            raise ValueError(f"style(s) {missing} are not in dataset {takeset.name!r} (styles {styles})")
+        self.data_summary = {"name": takeset.name, "takes": len(takeset), "frames": takeset.num_frames,
+                             "styles": styles, "cvae_styles": wanted,
+                             "clips": {p: {s: counts[(p, s)] for s in styles} for p in self.primitives},
+                             "seconds": time.perf_counter() - t0}
+        self.plan(wanted)
+        self._line(1, f"data: {takeset.name}, {len(takeset)} takes, {takeset.num_frames} frames; CVAE styles {wanted}")
+        for p in self.primitives:
+            self.say("    " + p + " clips: " + ", ".join(f"{s} {counts[(p, s)]}" for s in styles))
+        _write_json(self.out / "data.json", self.data_summary)
+
+    def prepare_stage(self, index: int, stage: Stage) -> bool | None:
+        """Hash ``stage``'s settings, refuse a folder of other settings, reuse a finished stage.
+
+        Returns None when the stage was reused, else whether it resumes from ``last.ckpt``.
+        """
+        parent_hash = stage.parent.settings_hash if stage.parent else None
+        stage.settings_hash = _hash({"overrides": stage.overrides, "values": stage.values, "data": self.data_cfg,
+                                     "seed": int(self.cfg.seed), "parent": parent_hash})
+        done, started = stage.folder / "done.json", stage.folder / "stage.json"
+        last = stage.folder / "checkpoints" / "last.ckpt"
+        has_results = done.is_file() or any((stage.folder / "checkpoints").glob("*.ckpt"))
+        for record_path in (done, started):
+            if record_path.is_file() and has_results:  # a stage that saved nothing is simply started again
+                recorded = json.loads(record_path.read_text()).get("settings_hash")
+                if recorded != stage.settings_hash:
+                    raise StageConflictError(
+                        f"{stage.folder} holds the {stage.name} stage of a run with other settings (hash {recorded}, "
+                        f"now {stage.settings_hash}: overrides, data, seed or an earlier stage changed). Choose "
+                        f"another out=… or delete {stage.folder} to train it again")
+        if done.is_file():
+            record = json.loads(done.read_text())
+            if record.get("checkpoint") and Path(record["checkpoint"]).is_file():
+                stage.status, stage.checkpoint = "reused", record["checkpoint"]
+                stage.seconds, stage.metrics = float(record.get("seconds", 0.0)), record.get("metrics", {})
+                self._line(index, f"{stage.name}: reused {stage.checkpoint}")
+                return None
+        resume = last.is_file()
+        self._line(index, f"{stage.name}: {'resuming from ' + str(last) if resume else 'training'}")
+        _write_json(started, {"settings_hash": stage.settings_hash, "name": stage.name})
+        stage.folder.mkdir(parents=True, exist_ok=True)
+        return resume
+
+    def finish_stage(self, stage: Stage, metrics: dict[str, Any], resume: bool, seconds: float) -> None:
+        """Record a trained stage's checkpoint, metrics and time in its ``done.json``."""
+        last = stage.folder / "checkpoints" / "last.ckpt"
+        ckpt = metrics.get("best_checkpoint") or (str(last) if last.is_file() else None)
+        if not ckpt:
+            raise RuntimeError(f"stage {stage.name} finished without a checkpoint in {stage.folder / 'checkpoints'}")
+        stage.status, stage.checkpoint = ("resumed" if resume else "trained"), str(Path(ckpt).resolve())
+        stage.seconds = seconds
+        stage.metrics = {k: v for k, v in metrics.items() if k in ("test", "best_score", "global_step", "epoch")}
+        _write_json(stage.folder / "done.json", {"settings_hash": stage.settings_hash, "checkpoint": stage.checkpoint,
+                                                 "seconds": stage.seconds, "metrics": stage.metrics,
+                                                 "name": stage.name})
+        test = stage.metrics.get("test", {})
+        shown = ", ".join(f"{k} {v:.4g}" for k, v in test.items() if isinstance(v, float))
+        self.say(f"    {stage.name} done in {stage.seconds / 60:.1f} min" + (f": {shown}" if shown else ""))
+
+    def run_stage(self, index: int, stage: Stage) -> None:
+        """Train ``stage`` in this process (or reuse/resume it)."""
+        from stylemotion.training import run as train_run
+
+        resume = self.prepare_stage(index, stage)
+        if resume is None:
+            return
+        t0 = time.perf_counter()
+        result = train_run(self.train_config(stage, resume))
+        self.finish_stage(stage, result["metrics"], resume, time.perf_counter() - t0)
+
+    def run_stages_in_parallel(self, indexed: Sequence[tuple[int, Stage]], workers: int) -> None:
+        """Train independent stages in ``workers`` fresh processes (spawned, ``threads`` torch threads
+        each, no progress bars); every stage that finishes is recorded even if another one fails."""
+        pending: dict[Any, tuple[Stage, bool]] = {}
+        errors: list[tuple[Stage, BaseException]] = []
+        context = multiprocessing.get_context("spawn")
+        with ProcessPoolExecutor(max_workers=workers, mp_context=context) as pool:
+            for index, stage in indexed:
+                resume = self.prepare_stage(index, stage)
+                if resume is None:
+                    continue
+                cfg = self.train_config(stage, resume)
+                with open_dict(cfg):  # interleaved progress bars of several processes would be unreadable
+                    cfg.trainer.enable_progress_bar = False
+                    if cfg.get("callbacks") and "progress_bar" in cfg.callbacks:
+                        cfg.callbacks.progress_bar = None
+                container = OmegaConf.to_container(cfg, resolve=True)
+                pending[pool.submit(_train_in_worker, container)] = (stage, resume)
+            for future in as_completed(pending):
+                stage, resume = pending[future]
+                try:
+                    metrics, seconds = future.result()
+                    self.finish_stage(stage, metrics, resume, seconds)
+                except Exception as exc:  # noqa: BLE001 - reported below, after the others are recorded
+                    self.say(f"    {stage.name} FAILED: {type(exc).__name__}: {exc}")
+                    errors.append((stage, exc))
+                _write_json(self.out / "reproduce.json", self.summary())
+        if errors:
+            names = ", ".join(stage.name for stage, _ in errors)
+            raise RuntimeError(f"{len(errors)} training stage(s) failed ({names}); rerun to resume") from errors[0][1]
+
+    def train_config(self, stage: Stage, resume: bool) -> DictConfig:
+        """The ``train`` config of ``stage``: its overrides, this run's data, seed, threads and folder."""
+        cfg = compose(config_name="train", overrides=list(stage.overrides))
+        with open_dict(cfg):
+            cfg.data = OmegaConf.create(self.data_cfg)
+            cfg.output_dir = str(stage.folder.resolve())
+            cfg.seed = int(self.cfg.seed)
+            if self.cfg.get("threads"):
+                cfg.threads = int(self.cfg.threads)
+            for key, value in stage.values.items():
+                OmegaConf.update(cfg, key, value, force_add=True)
+            if stage.parent is not None:
+                cfg.autoencoder_ckpt = stage.parent.checkpoint
+            cfg.ckpt_path = "last" if resume else None
+        return cfg
+
+    def evaluation_stage(self) -> dict[str, Any]:
+        """Evaluate every trained model into ``<out>/report`` (or reuse the report of the same stages)."""
+        report, record = self.out / "report", self.out / "evaluation.json"
+        step = self.total_steps()
+        settings_hash = _hash({"stages": [s.settings_hash for s in self.stages], "seed": int(self.cfg.seed),
+                               "evaluation": OmegaConf.to_container(self.cfg.evaluation, resolve=True)})
+        if report.exists():
+            recorded = json.loads(record.read_text()).get("settings_hash") if record.is_file() else None
+            if recorded != settings_hash or not (report / "report.json").is_file():
+                raise StageConflictError(
+                    f"{report} holds a report of other models or settings (a stage was retrained, or the evaluation "
+                    f"settings changed); delete {report} to evaluate again, or choose another out=…")
+            self._line(step, f"evaluation: reused {report}")
+            return json.loads((report / "report.json").read_text())
+        self._line(step, f"evaluation → {report}")
+        models = [s.checkpoint for s in self.stages if s.kind in ("vae", "cvae")]
+        ae = next(s.checkpoint for s in self.stages if s.kind == "autoencoder")
+        command = "stylemotion-reproduce " + " ".join(sys.argv[1:])
+        results = run_evaluation(self.cfg.data, models, self.cfg.evaluation, report, int(self.cfg.seed),
+                                 autoencoder_ckpt=ae, command=command, progress=lambda text: self.say("    " + text))
+        _write_json(record, {"settings_hash": settings_hash, "report": str(report)})
+        return results
+
+    def summary(self) -> dict[str, Any]:
+        return {"out": str(self.out), "data": self.data_summary, "seconds": time.perf_counter() - self.started,
+                "stages": [{"name": s.name, "kind": s.kind, "status": s.status, "checkpoint": s.checkpoint,
+                            "seconds": s.seconds, "metrics": s.metrics, "folder": str(s.folder)} for s in self.stages]}
+
+
+def _train_in_worker(container: dict[str, Any]) -> tuple[dict[str, Any], float]:
+    """A worker process's job: :func:`stylemotion.training.run` on a resolved ``train`` config; returns
+    its metrics and its training seconds (not counting the wait in the queue)."""
+    from stylemotion.training import run as train_run
+
+    t0 = time.perf_counter()
+    metrics = train_run(OmegaConf.create(container))["metrics"]
+    return metrics, time.perf_counter() - t0
+
+
+def reproduce(cfg: DictConfig, say=print) -> dict[str, Any]:
+    """Run (or resume) every stage; returns the summary written to ``<out>/reproduce.json``.
+
+    Must be called with Hydra's global config search initialized (inside ``stylemotion-reproduce``,
+    or within ``hydra.initialize_config_dir``), since the training stages compose the ``train`` config.
+    """
+    if cfg.get("threads"):
+        torch.set_num_threads(int(cfg.threads))  # the evaluation's too, so reruns compute alike
+    workers = cfg.get("workers", 1)
+    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
+        raise ValueError(f"reproduce config key 'workers' must be an integer ≥ 1 (training stages at once), "
+                         f"got {workers!r}")
+    repro = Reproduction(cfg, say)
+    repro.out.mkdir(parents=True, exist_ok=True)
+    repro.data_stage()
+    indexed = list(enumerate(repro.stages, start=2))
+    in_process = 1 if workers > 1 else len(indexed)  # stage 1 is the autoencoder the others need
+    for index, stage in indexed[:in_process]:
+        repro.run_stage(index, stage)
+        _write_json(repro.out / "reproduce.json", repro.summary())
+    if indexed[in_process:]:
+        repro.run_stages_in_parallel(indexed[in_process:], workers)
+    results = repro.evaluation_stage()
+    summary = repro.summary()
+    summary["report"] = str(repro.out / "report")
+    _write_json(repro.out / "reproduce.json", summary)
+    say(f"done in {summary['seconds'] / 60:.1f} min: "
+        + ", ".join(f"{k} {v}" for k, v in Counter(s.status for s in repro.stages).items()) + " training stages")
+    for line in summary_lines(results):
+        say(line)
+    say(f"report: {repro.out / 'report' / 'report.md'}")
+    return summary

@@ -1,0 +1,152 @@
+"""A walk along a ground path, neutral or stylized, written to a folder (what ``stylemotion-generate`` runs; §5.4.4).
+
+    stylemotion-generate                                          # neutral, 10 m S-curve, synthetic run
+    stylemotion-generate run=runs/reproduce/bandai style=elderly seed=3
+    stylemotion-generate style=active path.file=path.csv out=runs/generate/active_path
+
+The models come from a ``stylemotion-reproduce`` folder (``run``) or an explicit ``models`` mapping;
+the path from ``path.file`` (.json/.csv), ``path.points`` or the default S-curve
+(:mod:`stylemotion.synthesis.path`). The walk is synthesized by
+:func:`stylemotion.synthesis.controller.follow_path` and written to the folder ``out`` (refused if
+it exists, unless ``force=true``; the folder appears complete or not at all):
+
+* ``motion.npz``: ``positions`` (frames, 21, 3) float32 metres Y up (after the foot clean-up of
+  :mod:`stylemotion.synthesis.cleanup` unless ``clean_feet=false``), ``frames`` (frames, 66: the
+  stitched frames as synthesized, before the clean-up),
+  ``fps``, ``path`` (n, 2) x/z metres, ``junctions`` (keyframe index of each transition),
+  ``joint_names``;
+* ``motion.bvh``: the canonical skeleton with rotations fitted to the positions
+  (:mod:`stylemotion.export`);
+* ``motion.gif`` (and ``motion.mp4`` with ``outputs.mp4=true`` and ffmpeg): the stick figure on the path;
+* ``summary.json``: :func:`stylemotion.synthesis.quality.walk_figures`, the BVH round trip error,
+  the real data's foot-skating ratio for the style, the steps, the settings and provenance.
+"""
+
+from __future__ import annotations
+
+import io
+import json
+import logging
+import time
+from collections.abc import Mapping
+from dataclasses import asdict, replace
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from omegaconf import DictConfig, OmegaConf
+
+from stylemotion.datasets.loading import ConversionSettings, load_canonical_positions
+from stylemotion.evaluation.sources import NEUTRAL
+from stylemotion.export import write_motion_bvh
+from stylemotion.io.atomic import atomic_folder
+from stylemotion.io.outputs import check_new_output
+from stylemotion.io.sources import FileSource
+from stylemotion.provenance import provenance
+from stylemotion.skeleton import CANONICAL_JOINTS
+from stylemotion.synthesis.cleanup import clean_foot_skating
+from stylemotion.synthesis.controller import FollowSettings, SynthesizedMotion, follow_path
+from stylemotion.synthesis.graph import load_graph
+from stylemotion.synthesis.path import GroundPath, s_curve
+from stylemotion.synthesis.quality import skating, walk_figures
+from stylemotion.viz.walk import save_walk_animation
+
+log = logging.getLogger(__name__)
+
+
+def path_from_config(node: Mapping[str, Any]) -> GroundPath:
+    """The path of a ``path`` config node: ``file``, else ``points``, else ``s_curve``."""
+    if node.get("file"):
+        return GroundPath.from_file(node["file"], spline=bool(node.get("spline", True)))
+    if node.get("points") is not None:
+        return GroundPath.from_points(node["points"], spline=bool(node.get("spline", True)), source="path.points")
+    curve = node.get("s_curve") or {}
+    return s_curve(float(curve.get("length_m", 10.0)), float(curve.get("amplitude_m", 1.0)),
+                   float(curve.get("waves", 1.0)))
+
+
+def bvh_round_trip_error(bvh: Path, positions: np.ndarray, fps: float) -> float:
+    """MPJPE (m) between ``positions`` and the BVH file read back by the project's own loader."""
+    back = load_canonical_positions(FileSource(str(bvh)), ConversionSettings(fps=fps))
+    if back.shape != positions.shape:
+        raise RuntimeError(f"{bvh} reads back as {back.shape}, expected {positions.shape}")
+    return float(np.linalg.norm(back - positions, axis=-1).mean())
+
+
+def real_foot_skating(run: str | Path | None, style: str) -> float | None:
+    """The foot-skating ratio of real clips of ``style`` in a reproduce run's report, if recorded."""
+    report = Path(run) / "report" / "report.json" if run else None
+    if report is None or not report.is_file():
+        return None
+    value = json.loads(report.read_text()).get("foot_skating_real", {}).get(style)
+    return None if value is None else float(value)
+
+
+def write_outputs(motion: SynthesizedMotion, folder: Path, outputs: Mapping[str, Any], title: str) -> dict[str, Any]:
+    """Write the motion's files into ``folder``; returns what the BVH round trip measured."""
+    buffer = io.BytesIO()
+    np.savez(buffer, positions=motion.positions, frames=motion.frames, fps=np.float64(motion.fps),
+             path=motion.path.points, junctions=np.asarray(motion.junctions, dtype=np.int64),
+             joint_names=np.asarray(CANONICAL_JOINTS))
+    (folder / "motion.npz").write_bytes(buffer.getvalue())
+    figures: dict[str, Any] = {}
+    if outputs.get("bvh", True):
+        write_motion_bvh(motion.positions, folder / "motion.bvh", motion.fps)
+        figures["bvh_reimport_mpjpe_m"] = bvh_round_trip_error(folder / "motion.bvh", motion.positions, motion.fps)
+    keys = [s.start_frame for s in motion.steps[1:]]
+    if outputs.get("gif", True):
+        save_walk_animation(motion.positions, motion.fps, motion.path.points, folder / "motion.gif", keys, title)
+    if outputs.get("mp4", False):
+        save_walk_animation(motion.positions, motion.fps, motion.path.points, folder / "motion.mp4", keys, title)
+    return figures
+
+
+def generate(cfg: DictConfig | Mapping[str, Any], command: str = "") -> dict[str, Any]:
+    """Synthesize and write one walk (see the module doc); returns the summary."""
+    cfg = OmegaConf.to_container(cfg, resolve=True) if isinstance(cfg, DictConfig) else dict(cfg)
+    force = bool(cfg.get("force", False))
+    out = check_new_output(cfg["out"], force)
+    started = time.perf_counter()
+    path = path_from_config(cfg.get("path") or {})
+    graph = load_graph(str(cfg["style"]), run=cfg.get("run"), models=cfg.get("models"),
+                       action=str(cfg.get("action", "walk")), neutral_style=str(cfg.get("neutral_style", "normal")))
+    settings = FollowSettings(**(cfg.get("follow") or {}))
+    motion = follow_path(graph, path, seed=int(cfg.get("seed", 0)), settings=settings)
+    raw_skating, _ = skating(motion.positions, motion.fps)
+    if cfg.get("clean_feet", True):
+        motion = replace(motion, positions=clean_foot_skating(motion.positions, motion.fps).astype(np.float32))
+    summary = walk_figures(motion)
+    summary["foot_skating_ratio_before_cleanup"] = raw_skating
+    style = graph.style if graph.style != NEUTRAL else str(cfg.get("neutral_style", "normal"))
+    summary["real_foot_skating_ratio"] = real_foot_skating(cfg.get("run"), graph.style)
+    title = (f"{graph.action} · {graph.style} · seed {cfg.get('seed', 0)} · {path.length:.1f} m path · "
+             f"{summary['duration_s']:.1f} s")
+    with atomic_folder(out, on_exists=lambda: check_new_output(out, force)) as tmp:
+        summary.update(write_outputs(motion, tmp, cfg.get("outputs") or {}, title))
+        summary["meta"] = {
+            "style": graph.style, "data_style": style, "seed": int(cfg.get("seed", 0)), "models": graph.sources,
+            "profiles": {k: asdict(v) for k, v in graph.profiles.items()}, "follow": asdict(settings),
+            "path": cfg.get("path"), **provenance(command or None), "seconds": time.perf_counter() - started,
+        }
+        summary["steps_detail"] = [asdict(s) for s in motion.steps]
+        (tmp / "summary.json").write_text(json.dumps(summary, indent=1, default=float))
+    return summary
+
+
+def summary_lines(summary: Mapping[str, Any]) -> list[str]:
+    """A few lines for the terminal."""
+    dev, tr = summary["deviation"], summary["transitions"]
+    real = summary.get("real_foot_skating_ratio")
+    real = "" if real is None else f"; real clips of the style: {real:.1%}"
+    lines = [f"{summary['style']}: {summary['steps']} steps, {summary['duration_s']:.2f} s, "
+             f"{summary['walked_m']:.2f} m walked at {summary['mean_speed_mps']:.2f} m/s",
+             f"path deviation: mean {dev['mean_m']:.3f} m, max {dev['max_m']:.3f} m, final {dev['final_m']:.3f} m",
+             f"transitions: peak joint speed {tr['ratio']:.2f}×, peak acceleration {tr['accel_ratio']:.2f}× the 99th "
+             "percentile inside clips",
+             f"foot skating {summary['foot_skating_ratio']:.1%} (before clean-up "
+             f"{summary['foot_skating_ratio_before_cleanup']:.1%})" + real,
+             f"synthesis {summary['synthesis_seconds']:.2f} s"]
+    if "bvh_reimport_mpjpe_m" in summary:
+        lines.append(f"BVH re-import MPJPE {summary['bvh_reimport_mpjpe_m'] * 100:.2f} cm")
+    lines += [f"warning: {w}" for w in summary.get("warnings", [])]
+    return lines

@@ -1,0 +1,167 @@
+"""The evaluation pipeline and report on synthetic data with "oracle models" that draw real clips of
+their style: what must hold when the styles are known (Table 5.1 diagonal dominance), the report
+folder, and bad input (mixed autoencoders, missing style examples, an existing report folder)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+import torch
+from vae_fixtures import TINY_DATA, tiny_autoencoder_ckpt, tiny_takeset
+
+from stylemotion.datamodules.features import autoencoder_info, describe_clip, load_autoencoder
+from stylemotion.evaluation.pipeline import EvalSettings, evaluate_models
+from stylemotion.evaluation.reference import primitive_data
+from stylemotion.evaluation.report import write_report
+from stylemotion.evaluation.sources import (
+    NEUTRAL,
+    EvalModel,
+    MissingExampleError,
+    MixedAutoencodersError,
+    RealClipSource,
+    SampleSource,
+)
+from stylemotion.io.outputs import OutputExistsError
+
+torch.set_num_threads(1)
+SETTINGS = EvalSettings(table_samples=120, variance_samples=200, metric_samples=120, classifier_components=8)
+PRIMITIVES = ("walk_leftStance", "walk_rightStance")
+
+
+@pytest.fixture(scope="module")
+def autoencoder(tmp_path_factory):
+    path = tiny_autoencoder_ckpt(tmp_path_factory.mktemp("eval_ae"))
+    ae = load_autoencoder(path)
+    return ae, autoencoder_info(ae, path)
+
+
+def oracle_models(info) -> list[EvalModel]:
+    """Per primitive: a neutral model drawing the neutral training clips, and per other style a model
+    drawing that style's clips, conditioned on the style's first clip (left out of its draws)."""
+    models = []
+    for primitive in PRIMITIVES:
+        data = primitive_data(tiny_takeset(), primitive, 16, split=TINY_DATA["split"])
+        for style in data.styles:
+            if style == "normal":
+                models.append(EvalModel(NEUTRAL, primitive, style, RealClipSource(data.training_data(), 16),
+                                        autoencoder=info, timeline_frames=16, dataset="synthetic"))
+                continue
+            example, *rest = data.style_clips(style)
+            models.append(EvalModel(style, primitive, style, RealClipSource(rest, 16), autoencoder=info,
+                                    examples=[{**describe_clip(example), "encoded_frames": 16}], timeline_frames=16,
+                                    dataset="synthetic"))
+    return models
+
+
+@pytest.fixture(scope="module")
+def results(autoencoder):
+    ae, info = autoencoder
+    out = evaluate_models(oracle_models(info), tiny_takeset(), ae, SETTINGS, split=TINY_DATA["split"],
+                          autoencoder_info=info)
+    out["meta"] = {"data_name": "synthetic", "seed": 0, "samples": {"table_5_1": 120, "variance": 200, "metrics": 120},
+                   "checkpoints": [], "autoencoder": {"path": info["path"], "fingerprint": info["fingerprint"]},
+                   "git_commit": "test", "seconds": 1.0}
+    return out
+
+
+def test_table_5_1_is_diagonal_for_models_that_produce_their_style(results) -> None:
+    """Samples of a style are closer (in Gram distance) to that style's example than to any other, and
+    each example is closest to its own style's samples — for both stance primitives."""
+    assert isinstance(RealClipSource(oracle_clips(), 16), SampleSource)
+    for primitive in PRIMITIVES:
+        table = results["table_5_1"][primitive]
+        assert table["models"] == ["neutral", "elderly", "youthful"] == table["examples"]
+        assert table["diagonal"]["all_rows"] and table["diagonal"]["all_columns"], table["distance"]
+        assert table["samples"] == 120
+
+
+def oracle_clips():
+    return primitive_data(tiny_takeset(), "walk_leftStance", 16, split=TINY_DATA["split"]).training_data()
+
+
+def test_results_of_real_clips_look_like_real_data(results) -> None:
+    rec = results["style_recognition"]
+    assert rec["classifier_heldout_accuracy"] >= 0.8 and rec["chance"] == pytest.approx(1 / 3)
+    assert all(share >= 0.8 for share in rec["per_model"].values()), rec["per_model"]
+    for primitive in PRIMITIVES:
+        ratio = results["variance_ratio"][primitive]["neutral"]  # resampled training clips
+        assert 0.9 < ratio["pose_sd"] < 1.1 and 0.8 < ratio["step_sd"] < 1.2, ratio
+        # a resampled training clip is its own nearest training clip
+        assert results["nearest_training"][primitive]["neutral"]["samples_median_m"] == pytest.approx(0.0, abs=1e-6)
+        assert results["nearest_training"][primitive]["elderly"]["samples_median_m"] > 0.005
+    for name, ratio in results["foot_skating"].items():
+        assert ratio == pytest.approx(results["foot_skating_real"][name], abs=0.05)
+    assert 0 < results["autoencoder"]["test_mpjpe_m"] < 0.5
+
+
+def test_report_folder_is_complete_and_never_overwritten_silently(results, tmp_path: Path) -> None:
+    out = write_report(results, tmp_path / "report")
+    names = {p.name for p in out.iterdir()}
+    for p in PRIMITIVES:
+        assert {f"table_5_1_{p}.csv", f"table_5_1_{p}.png", f"variance_{p}.csv",
+                f"classifier_confusion_{p}.png"} <= names
+    assert {"report.md", "report.json", "variance.png", "style_recognition.csv", "foot_skating.csv"} <= names
+    saved = json.loads((out / "report.json").read_text())
+    t = saved["table_5_1"]["walk_leftStance"]
+    assert len(t["distance"]) == len(t["models"]) == len(t["examples"]) == 3
+    assert set(saved["variance"]["walk_rightStance"]["elderly"]) >= {"pose_sd", "v_sd", "step_sd"}
+    assert {"classifier_heldout_accuracy", "per_model"} <= set(saved["style_recognition"])
+    assert isinstance(saved["frechet"]["walk_leftStance"]["youthful"], float)
+    assert isinstance(saved["foot_skating"]["neutral"], float)
+    assert saved["autoencoder"]["test_mpjpe_m"] > 0
+    assert {"data_name", "seed", "samples", "checkpoints", "git_commit", "seconds"} <= set(saved["meta"])
+    md = (out / "report.md").read_text()
+    for heading in ("## Against the thesis", "## Table 5.1", "## Tables 5.2/5.3", "## Style recognition",
+                    "## Foot skating", "## Nearest training clip", "## Definitions", "pose_SD in cm"):
+        assert heading in md
+    (out / "notes.txt").write_text("keep me")
+    with pytest.raises(OutputExistsError, match="already exists"):
+        write_report(results, out)
+    assert (out / "notes.txt").read_text() == "keep me"
+    write_report(results, out, force=True)
+    assert not (out / "notes.txt").exists() and (out / "report.json").is_file()
+    assert not [p for p in tmp_path.iterdir() if p.name.startswith(".")]  # no temporary folder left
+
+
+def test_the_same_seed_gives_the_same_tables(autoencoder, results) -> None:
+    ae, info = autoencoder
+    models = [m for m in oracle_models(info) if m.primitive == "walk_leftStance"]
+    again = evaluate_models(models, tiny_takeset(), ae, SETTINGS, split=TINY_DATA["split"])
+    assert np.allclose(again["table_5_1"]["walk_leftStance"]["distance"],
+                       results["table_5_1"]["walk_leftStance"]["distance"])
+    assert again["frechet"]["walk_leftStance"] == results["frechet"]["walk_leftStance"]
+
+
+def test_bad_input_gets_clear_errors(autoencoder) -> None:
+    ae, info = autoencoder
+    by_name = {m.name: m for m in oracle_models(info) if m.primitive == "walk_leftStance"}
+    models = [by_name["neutral"], by_name["elderly"], by_name["youthful"]]
+    run = lambda ms, **kw: evaluate_models(ms, tiny_takeset(), ae, SETTINGS, split=TINY_DATA["split"], **kw)  # noqa: E731
+
+    other = dict(info, fingerprint="0123456789abcdef", path="/elsewhere/ae.ckpt")
+    mixed = models[:1] + [EvalModel(**{**vars(models[1]), "autoencoder": other, "checkpoint": "cvae_elderly.ckpt"})]
+    with pytest.raises(MixedAutoencodersError, match="different autoencoders") as err:
+        run(mixed)
+    assert "0123456789abcdef" in str(err.value) and info["fingerprint"] in str(err.value)
+    with pytest.raises(MixedAutoencodersError, match="another autoencoder"):
+        run(models, autoencoder_info=other)
+
+    no_example = EvalModel(**{**vars(models[1]), "examples": []})
+    with pytest.raises(MissingExampleError, match="records no style example"):
+        run([models[0], no_example])
+    elsewhere = EvalModel(**{**vars(models[1]), "examples": [{**models[1].examples[0], "take": "no_such_take"}]})
+    with pytest.raises(MissingExampleError, match="no_such_take"):
+        run([models[0], elsewhere])
+    wrong_gram = EvalModel(**{**vars(models[1]), "target_gram": torch.eye(32)})
+    with pytest.raises(MissingExampleError, match="different Gram matrix"):
+        run([models[0], wrong_gram])
+    unknown_style = EvalModel(**{**vars(models[1]), "name": "proud", "style": "proud"})
+    with pytest.raises(MissingExampleError, match="proud"):
+        run([models[0], unknown_style])
+    with pytest.raises(ValueError, match="two models of walk_leftStance/elderly"):
+        run([models[1], models[1]])
+    with pytest.raises(ValueError, match="no model"):
+        run([])
