@@ -1,75 +1,13 @@
 """Segmentation of walks and runs into motion primitives at foot-contact keyframes (thesis §4.3,
 §5.2, Fig. 4.5 and 5.1), and canonical timelines (§4.4.1).
 
-Support phases and keyframes
-----------------------------
-From the per-frame contacts of :func:`stylemotion.contacts.foot_contacts` every frame is in one
-support state: left only, right only, both feet (double support, or standing) or none (flight).
-A *single-support phase* is a maximal run of "left only" or "right only" frames; two phases of
-the same foot separated only by double support or flight are one phase (the other foot tapped
-the ground, or the stance foot hopped — the latter is rejected below).
-
-Between a phase of one foot and the next phase of the other foot lies the *support transfer*:
-the double support of a walk (from the new foot's strike to the old foot's lift-off) or the
-flight of a run (from the old foot's lift-off to the new foot's strike). Its **keyframe** is the
-middle frame of that transfer, ``(first + last) // 2`` of the double-support or flight frames,
-so it lies between the two contact-state transitions (strike and lift-off) that bound it.
-Cutting in the middle of the transfer puts each foot's whole support in the middle of its own
-clip, for walks (where the transfer is 2–5 frames of double support at 30 fps) and for runs
-(where it is a flight of similar length) alike.
-
-*Rest* is a run of at least ``min_rest_s`` double-support frames with the root slower than
-``rest_speed`` leg lengths per second (standing).
-
-The six primitives per action
------------------------------
-``leftStance``
-    From the keyframe of the transfer onto the left foot to the keyframe of the transfer onto
-    the right foot. The **left foot is planted** (it supports the body); the right foot swings
-    forward (and, in a run, the clip starts and ends in the air).
-``rightStance``
-    The mirror image: right foot planted, left foot swings.
-``beginLeftStance``
-    The first step out of standing: from the last rest frame to the keyframe of the first
-    transfer (onto the right foot). The **left foot stays planted** while the right foot makes
-    the first step.
-``beginRightStance``
-    The mirror image: right foot planted, left foot makes the first step.
-``endLeftStance``
-    The last step into standing: from the keyframe of the transfer onto the left foot to the
-    first rest frame. The **left foot is planted** while the right foot swings and lands beside
-    it.
-``endRightStance``
-    The mirror image: right foot planted, left foot swings to a stop.
-
-Clips contain both end keyframes (source frames ``start`` to ``stop - 1``), so consecutive clips
-share their boundary frame; a clip's duration is ``(frames - 1) / fps`` seconds.
-
-What is not a clip is reported
-------------------------------
-Each single-support phase is a *step*. A step whose incoming or outgoing transfer lies outside
-the take (the take starts or ends inside it or inside the transfer next to it) is a *border*
-step: counted and listed with that reason, but it cannot be cut. Every other step ends up in a
-clip or in :attr:`Segmentation.rejections` with a reason (too short, too long, swing foot never
-lifts, stance foot hops, …). A take with too few frames, no contact, or contacts of one foot
-only is rejected as a whole, with its reason. Takes whose content is not one of the locomotion
-actions are listed in :attr:`Segmentation.ignored`.
-
-Placement and the representation
---------------------------------
-A clip holds the take's 66-dim frames (:mod:`stylemotion.representation`) of its frame range;
-those are placement-free (joints in the root's facing frame, root velocity in m/s, yaw rate in
-rad/s), and :attr:`Clip.positions` integrates them from the origin facing +Z with
-:func:`~stylemotion.representation.frames_to_positions`: every clip starts at the origin facing
-+Z.
-
-Canonical timelines
--------------------
-:func:`canonical_timelines` gives each (action, primitive) the median clip length in frames;
-:func:`time_normalize` resamples a clip to that length while the clip keeps its real duration.
-Velocity and yaw-rate channels stay in per-second units, so a normalized clip plays back at
-``playback_fps(length, duration_s)`` frames per second and :func:`restore_duration` resamples it
-back to any frame rate.
+Each single-support phase is a step; its clip runs from the keyframe of the support transfer onto
+the planted foot (the middle of the double support of a walk or the flight of a run) to the next
+one, in six primitives per action (``leftStance``, ``rightStance``, ``begin…``/``end…`` from and
+into standing). Every step becomes a clip or a reported rejection; clips start at the origin facing
++Z; :func:`time_normalize` resamples a clip to its primitive's canonical length while it keeps its
+real duration. The full specification (support states, keyframes, the six primitives, what is
+rejected, placement, timelines) is ``docs/primitives.md``.
 """
 
 from __future__ import annotations

@@ -1,26 +1,10 @@
 """The report folder of an evaluation: ``report.md``, ``report.json``, one CSV per table, PNG figures.
 
-Layout of ``report.json`` (``<p>`` a primitive such as ``walk_leftStance``, ``<m>`` a model row:
-``neutral`` or a style):
-
-* ``table_5_1.<p>.{models, examples, distance, diagonal, samples, example_clips}``: Table 5.1,
-  ``distance[i][j]`` = D(models[i], examples[j]);
-* ``variance.<p>.<row>.{pose_sd, v_sd, step_sd, …}`` for rows ``training_data`` and every model
-  (cm, m/s ⊕ rad/s, cm); ``variance_ratio.<p>.<row>`` the same divided by the training data's;
-  ``variance_real.<p>.<style>`` real clips of every style;
-* ``style_recognition.{classifier_heldout_accuracy, chance, per_model.<m>, per_primitive.<p>,
-  per_model_detail.<p>.<m>}``;
-* ``frechet.<p>.<m>`` and ``frechet_reference.<p>.<m>.{neutral_samples, real_floor, ground_truth_clips}``;
-* ``diversity.<p>.<m>.{samples, real}``;
-* ``foot_skating.<m>`` (ratio pooled over primitives), ``foot_skating_real.<m>`` (the model's real
-  ground truth), ``foot_skating_detail.<p>.<m>.{samples, real}``;
-* ``nearest_training.<p>.<m>``;
-* ``autoencoder.{test_mpjpe_m, test_local_mpjpe_m, …}``;
-* ``meta.{data, seed, samples, checkpoints, autoencoder, git_commit, seconds, command, …}``;
-* ``definitions``: the definition of every number, in words.
-
-The folder is built beside its final place and renamed into it, so a report is never half
-written; an existing folder is refused unless ``force`` (then replaced as a whole).
+The layout of ``report.json`` (Table 5.1 under ``table_5_1.<primitive>``, Tables 5.2/5.3 under
+``variance``/``variance_ratio``, the extra metrics, ``meta`` with provenance, ``definitions`` of
+every number) is specified in ``docs/report.md``. The folder is built beside its final place and
+renamed into it, so a report is never half written; an existing folder is refused unless
+``force`` (then replaced as a whole).
 """
 
 from __future__ import annotations
