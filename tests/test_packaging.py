@@ -9,6 +9,7 @@ no download is needed. The environment's editable install of stylemotion is not 
 from __future__ import annotations
 
 import os
+import shutil
 import subprocess
 import sys
 import sysconfig
@@ -27,10 +28,14 @@ def _run(args: list[str], cwd: Path, env: dict[str, str], timeout: int = 600) ->
 
 @pytest.fixture(scope="module")
 def wheel(tmp_path_factory) -> Path:
+    # built from a copy of the source tree: setuptools writes build/ and *.egg-info beside the sources
+    source = tmp_path_factory.mktemp("source") / "stylemotion"
+    shutil.copytree(REPO_ROOT, source, ignore=shutil.ignore_patterns(
+        ".git", ".venv", "runs", "reports", ".cache", "build", "dist", "*.egg-info", "__pycache__", "notebooks"))
     dist = tmp_path_factory.mktemp("dist")
     env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
     _run([sys.executable, "-m", "pip", "wheel", "--no-deps", "--no-build-isolation", "--wheel-dir", str(dist),
-          str(REPO_ROOT)], dist, env)
+          str(source)], dist, env)
     (found,) = dist.glob("stylemotion-*.whl")
     return found
 
