@@ -14,7 +14,11 @@ trained on and the autoencoder they share, and computes per primitive:
   (:meth:`.reference.PrimitiveData.ground_truth`);
 
 and, once, the autoencoder's reconstruction error on the data's test split. Every model is sampled
-with the same seed. The result is a JSON-able dict (see :mod:`.report` for its layout).
+once, with the same seed, and that draw serves every metric. Per primitive the data is segmented
+and split once (:func:`real_side`: clips, classifier, ground truths), then each metric family is
+one function returning a small dataclass (:func:`real_variance`, :func:`recognition`,
+:func:`distribution`, :func:`skating`, :func:`style_table`). The result is a JSON-able dict
+(layout: ``docs/report.md``).
 """
 
 from __future__ import annotations
@@ -23,7 +27,7 @@ import logging
 import time
 from collections import defaultdict
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 from typing import Any
 
 import numpy as np
@@ -35,6 +39,7 @@ from stylemotion.datasets import TakeSet
 from stylemotion.evaluation.classifier import StyleClassifier, predicted_shares
 from stylemotion.evaluation.metrics import (
     SKATE_SPEED_MPS,
+    FootSkating,
     diversity,
     foot_skating,
     frechet_distance,
@@ -213,6 +218,214 @@ def _example_clips(data: PrimitiveData, model: EvalModel) -> list:
     return [data.find_example(record) for record in model.examples]
 
 
+# ---------------------------------------------------------------------------------------------
+# The real side of one primitive, prepared once
+
+
+@dataclass
+class RealSide:
+    """Everything real that the metrics of one primitive compare with, converted once.
+
+    Attributes:
+        data: the primitive's segmented, split clips.
+        models: the models, neutral first, then in the data's style order.
+        examples: each model's style example clips (empty for the neutral model).
+        classifier: the style classifier fitted on the train split of every style.
+        classifier_result: its held-out accuracy and confusion (``report.json`` layout).
+        training: the neutral train-split clips (the training data).
+        heldout_neutral: the neutral val+test clips.
+        truth: each model's ground truth clips (its style, never seen by it).
+    """
+
+    data: PrimitiveData
+    models: list[EvalModel]
+    examples: dict[str, list]
+    classifier: StyleClassifier
+    classifier_result: dict[str, Any]
+    training: MotionSamples
+    heldout_neutral: MotionSamples
+    truth: dict[str, MotionSamples]
+
+    @property
+    def length(self) -> int:
+        return self.data.length
+
+    def features(self, motions: MotionSamples) -> np.ndarray:
+        """``(n, d)`` the classifier's feature space of ``motions``."""
+        return self.classifier.features(motions.normalized_frames.numpy(), motions.duration_s.numpy())
+
+
+def _canonical_length(primitive: str, models: Sequence[EvalModel], takeset: TakeSet, settings: EvalSettings,
+                      split: Mapping[str, Any] | None) -> int:
+    """The models' (one) canonical timeline; for sources without one, the median neutral train clip."""
+    lengths = {m.timeline_frames for m in models if m.timeline_frames is not None}
+    if len(lengths) > 1:
+        raise ValueError(f"the models of {primitive} use different canonical timelines {sorted(lengths)}: they were "
+                         "trained on different data")
+    if lengths:
+        return lengths.pop()
+    probe = primitive_data(takeset, primitive, 2, settings.neutral_style, settings.segment, split)
+    return int(round(float(np.median([c.num_frames for c in probe.training_data()]))))
+
+
+def real_side(primitive: str, models: Sequence[EvalModel], takeset: TakeSet, settings: EvalSettings,
+              split: Mapping[str, Any] | None, say: Callable[[str], None]) -> RealSide:
+    """Segment and split the data once for ``primitive``, fit the style classifier, gather the ground truths.
+
+    Raises:
+        MissingExampleError: a model's style is not in the data, or its example clip is missing.
+        ValueError: a model has fewer than 2 ground-truth clips.
+    """
+    length = _canonical_length(primitive, models, takeset, settings, split)
+    say(f"{primitive}: real clips")
+    data = primitive_data(takeset, primitive, length, settings.neutral_style, settings.segment, split)
+    for m in models:
+        if m.style not in data.styles:
+            raise MissingExampleError(f"{m.checkpoint or m.label} models style {m.style!r}, which dataset "
+                                      f"{takeset.name!r} does not have (styles: {data.styles}): no example, no "
+                                      "ground truth")
+    ordered = _order(models, data.styles)
+    examples = {m.name: _example_clips(data, m) for m in ordered}
+    truth = {}
+    for m in ordered:
+        clips = data.ground_truth(m, examples[m.name])
+        if len(clips) < 2:
+            raise ValueError(f"{m.label}: fewer than 2 real clips of style {m.style!r} besides its example; the "
+                             "metrics need ground truth")
+        truth[m.name] = motions_from_clips(clips, length)
+    say(f"{primitive}: style classifier on {len(data.split('train'))} real train clips")
+    classifier, result = fit_style_classifier(data, settings)
+    return RealSide(data, ordered, examples, classifier, result, motions_from_clips(data.training_data(), length),
+                    motions_from_clips(data.heldout(settings.neutral_style), length), truth)
+
+
+# ---------------------------------------------------------------------------------------------
+# Metric families: each returns a small dataclass; ``as_dict`` is its report.json layout
+
+
+def fit_style_classifier(data: PrimitiveData, settings: EvalSettings) -> tuple[StyleClassifier, dict[str, Any]]:
+    """The style classifier fitted on the train split of every style, and its held-out result."""
+    train_clips, held = data.split("train"), data.heldout()
+    train = motions_from_clips(train_clips, data.length)
+    classifier = StyleClassifier(settings.classifier_components, settings.classifier_c, settings.seed)
+    classifier.fit(train.normalized_frames.numpy(), train.duration_s.numpy(), [c.style for c in train_clips])
+    held_m = motions_from_clips(held, data.length)
+    rep = classifier.evaluate(held_m.normalized_frames.numpy(), held_m.duration_s.numpy(), [c.style for c in held])
+    return classifier, {"heldout_accuracy": rep.accuracy, "heldout_clips": rep.clips, "train_clips": len(train),
+                        "styles": rep.styles, "confusion": rep.confusion.tolist(), "recall": rep.recall,
+                        "chance": 1.0 / len(rep.styles), "components": classifier.pca.n_components_}
+
+
+def _variance(motions: MotionSamples) -> dict[str, float]:
+    return variance_stats(motions.frames.numpy(), motions.positions.numpy(), motions.num_frames.numpy())
+
+
+@dataclass
+class Variance:
+    """Tables 5.2/5.3 of one primitive: pose_SD, V_SD, step_SD per row (training data, models) and per real style."""
+
+    rows: dict[str, dict[str, float]]
+    real: dict[str, dict[str, float]]
+
+    @property
+    def ratio(self) -> dict[str, dict[str, float]]:
+        """Every row divided by the training data's."""
+        base = self.rows["training_data"]
+        return {row: {k: stats[k] / base[k] if base[k] else float("nan") for k in ("pose_sd", "v_sd", "step_sd")}
+                for row, stats in self.rows.items()}
+
+
+def real_variance(real: RealSide) -> Variance:
+    """The reference rows of Tables 5.2/5.3: the training data, and the real clips of every style."""
+    return Variance({"training_data": _variance(real.training)},
+                    {style: _variance(motions_from_clips(real.data.style_clips(style), real.length))
+                     for style in real.data.styles})
+
+
+@dataclass
+class Recognition:
+    """How the style classifier labels a model's samples (and its real ground truth)."""
+
+    target_style: str
+    share: float
+    samples: int
+    predicted: dict[str, float]
+    real_share: float
+
+
+def recognition(real: RealSide, model: EvalModel, sample_features: np.ndarray,
+                truth_features: np.ndarray) -> Recognition:
+    """Share of the samples (and of the ground truth) the classifier assigns to the model's style."""
+    predicted = real.classifier.predict_features(sample_features)
+    return Recognition(model.style, float((predicted == model.style).mean()), len(sample_features),
+                       predicted_shares(predicted, real.classifier.styles),
+                       float((real.classifier.predict_features(truth_features) == model.style).mean()))
+
+
+@dataclass
+class Distribution:
+    """Fréchet distance and diversity of a model's samples against its ground truth, in classifier features."""
+
+    frechet: float
+    frechet_reference: dict[str, Any]
+    diversity: dict[str, Any]
+
+
+def distribution(real: RealSide, model: EvalModel, sample_features: np.ndarray, truth_features: np.ndarray,
+                 neutral_features: np.ndarray | None, settings: EvalSettings) -> Distribution:
+    """Fréchet distance with its references (neutral samples, the real-vs-real floor) and diversity."""
+    return Distribution(
+        frechet_distance(sample_features, truth_features),
+        _frechet_reference(real, model, truth_features, neutral_features),
+        {"samples": diversity(sample_features, settings.diversity_items),
+         "real": diversity(truth_features, settings.diversity_items), "real_clips": len(real.truth[model.name])})
+
+
+@dataclass
+class Skating:
+    """Foot skating of a model's samples and of its real ground truth."""
+
+    samples: FootSkating
+    real: FootSkating
+
+    def as_dict(self) -> dict[str, Any]:
+        return {"samples": self.samples.as_dict(), "real": self.real.as_dict()}
+
+
+def skating(real: RealSide, model: EvalModel, samples: MotionSamples, settings: EvalSettings) -> Skating:
+    """Share of contact foot-frames whose planted point moves faster than ``settings.skate_speed``."""
+    data, truth = real.data, real.truth[model.name]
+    return Skating(
+        foot_skating(samples.positions.numpy(), samples.num_frames.numpy(), samples.fps, data.rest_heights,
+                     data.stance_foot, settings.skate_speed),
+        foot_skating(truth.positions.numpy(), truth.num_frames.numpy(), truth.fps, data.rest_heights,
+                     data.stance_foot, settings.skate_speed))
+
+
+@dataclass
+class StyleTable:
+    """Table 5.1 of one primitive: ``distance[i][j]`` = D(models[i], examples[j])."""
+
+    models: list[str]
+    distance: np.ndarray
+    samples: int
+    example_clips: dict[str, Any]
+
+    def as_dict(self) -> dict[str, Any]:
+        return {"models": self.models, "examples": self.models, "distance": self.distance.tolist(),
+                "diagonal": diagonal_minima(self.distance, self.models), "samples": self.samples,
+                "example_clips": self.example_clips}
+
+
+def style_table(real: RealSide, autoencoder, model_frames: Sequence[np.ndarray], settings: EvalSettings) -> StyleTable:
+    """Table 5.1 from each model's first ``table_samples`` normalized sample frames (in ``real.models`` order)."""
+    grams = torch.stack([_example_gram(autoencoder, real.data, m, real.examples[m.name]) for m in real.models])
+    table = distance_table(autoencoder, model_frames, grams, settings.chunk)
+    clips = {m.name: ("mean motion of the neutral training clips" if m.name == NEUTRAL
+                      else [c.describe() for c in real.examples[m.name]]) for m in real.models}
+    return StyleTable([m.name for m in real.models], table, settings.table_samples, clips)
+
+
 def _example_gram(autoencoder, data: PrimitiveData, model: EvalModel, clips: list) -> torch.Tensor:
     if model.name == NEUTRAL:
         return example_gram(autoencoder, [mean_motion(motions_from_clips(data.training_data(),
@@ -231,120 +444,65 @@ def _example_gram(autoencoder, data: PrimitiveData, model: EvalModel, clips: lis
     return g
 
 
+# ---------------------------------------------------------------------------------------------
+# One primitive
+
+
 def _evaluate_primitive(primitive: str, models: list[EvalModel], takeset: TakeSet, autoencoder,
                         settings: EvalSettings, split: Mapping[str, Any] | None,
                         say: Callable[[str], None]) -> dict[str, Any]:
-    lengths = {m.timeline_frames for m in models if m.timeline_frames is not None}
-    if len(lengths) > 1:
-        raise ValueError(f"the models of {primitive} use different canonical timelines {sorted(lengths)}: they were "
-                         "trained on different data")
-    length = lengths.pop() if lengths else None
-    say(f"{primitive}: real clips")
-    if length is None:  # sources without a recorded timeline: the median neutral train clip
-        probe = primitive_data(takeset, primitive, 2, settings.neutral_style, settings.segment, split)
-        length = int(round(float(np.median([c.num_frames for c in probe.training_data()]))))
-    data = primitive_data(takeset, primitive, length, settings.neutral_style, settings.segment, split)
-    for m in models:
-        if m.style not in data.styles:
-            raise MissingExampleError(f"{m.checkpoint or m.label} models style {m.style!r}, which dataset "
-                                      f"{takeset.name!r} does not have (styles: {data.styles}): no example, no "
-                                      "ground truth")
-    models = _order(models, data.styles)
-    names = [m.name for m in models]
-    examples = {m.name: _example_clips(data, m) for m in models}
-    grams = torch.stack([_example_gram(autoencoder, data, m, examples[m.name]) for m in models])
-
-    say(f"{primitive}: style classifier on {len(data.split('train'))} real train clips")
-    train = motions_from_clips(data.split("train"), length)
-    classifier = StyleClassifier(settings.classifier_components, settings.classifier_c, settings.seed)
-    classifier.fit(train.normalized_frames.numpy(), train.duration_s.numpy(), [c.style for c in data.split("train")])
-    held = data.heldout()
-    held_m = motions_from_clips(held, length)
-    rep = classifier.evaluate(held_m.normalized_frames.numpy(), held_m.duration_s.numpy(), [c.style for c in held])
-    classifier_out = {"heldout_accuracy": rep.accuracy, "heldout_clips": rep.clips, "train_clips": len(train),
-                      "styles": rep.styles, "confusion": rep.confusion.tolist(), "recall": rep.recall,
-                      "chance": 1.0 / len(rep.styles), "components": classifier.pca.n_components_}
-
-    def feats(m: MotionSamples) -> np.ndarray:
-        return classifier.features(m.normalized_frames.numpy(), m.duration_s.numpy())
-
-    training = motions_from_clips(data.training_data(), length)
-    train_poses = pose_sequences(training.normalized_frames.numpy())
-    heldout_neutral = motions_from_clips(data.heldout(settings.neutral_style), length)
-    out: dict[str, Any] = {"variance": {"training_data": variance_stats(training.frames.numpy(),
-                                                                       training.positions.numpy(),
-                                                                       training.num_frames.numpy())},
-                           "frechet": {}, "frechet_reference": {}, "diversity": {}, "foot_skating_detail": {},
-                           "nearest_training": {}, "recognition": {}, "skating": {}, "classifier": classifier_out}
-    out["variance_real"] = {}
-    for style in data.styles:
-        real = motions_from_clips(data.style_clips(style), length)
-        out["variance_real"][style] = variance_stats(real.frames.numpy(), real.positions.numpy(),
-                                                     real.num_frames.numpy())
+    real = real_side(primitive, models, takeset, settings, split, say)
+    variance = real_variance(real)
+    train_poses = pose_sequences(real.training.normalized_frames.numpy())
+    out: dict[str, Any] = {"frechet": {}, "frechet_reference": {}, "diversity": {}, "foot_skating_detail": {},
+                           "nearest_training": {}, "recognition": {}, "skating": {},
+                           "classifier": real.classifier_result}
     table_frames = []
-    neutral_feats = None
+    neutral_features = None
     n_draw = max(settings.table_samples, settings.variance_samples, settings.metric_samples)
-    for m in models:
+    for m in real.models:
         t0 = time.perf_counter()
         say(f"{primitive}: {m.name}: {n_draw} samples")
-        samples = m.source.sample(n_draw, seed=settings.seed)
+        samples = m.source.sample(n_draw, seed=settings.seed)  # one draw serves every family
         table_frames.append(samples.normalized_frames[:settings.table_samples].numpy())
-        v = samples.subset(slice(0, settings.variance_samples))
-        out["variance"][m.name] = variance_stats(v.frames.numpy(), v.positions.numpy(), v.num_frames.numpy())
+        variance.rows[m.name] = _variance(samples.subset(slice(0, settings.variance_samples)))
         s = samples.subset(slice(0, settings.metric_samples))
-        del samples, v
-        f_s = feats(s)
+        del samples
+        f_s, f_t = real.features(s), real.features(real.truth[m.name])
         if m.name == NEUTRAL:
-            neutral_feats = f_s
-        truth_clips = data.ground_truth(m, examples[m.name])
-        if len(truth_clips) < 2:
-            raise ValueError(f"{m.label}: fewer than 2 real clips of style {m.style!r} besides its example; the "
-                             "metrics need ground truth")
-        truth = motions_from_clips(truth_clips, length)
-        f_t = feats(truth)
-        predicted = classifier.predict_features(f_s)
-        share = float((predicted == m.style).mean())
-        out["recognition"][m.name] = {"target_style": m.style, "share": share, "samples": len(s),
-                                      "predicted": predicted_shares(predicted, classifier.styles),
-                                      "real_share": float((classifier.predict_features(f_t) == m.style).mean())}
-        out["frechet"][m.name] = frechet_distance(f_s, f_t)
-        out["frechet_reference"][m.name] = _frechet_reference(data, m, examples[m.name], feats, length, f_t,
-                                                              neutral_feats)
-        out["diversity"][m.name] = {"samples": diversity(f_s, settings.diversity_items),
-                                    "real": diversity(f_t, settings.diversity_items), "real_clips": len(truth_clips)}
-        sk = foot_skating(s.positions.numpy(), s.num_frames.numpy(), s.fps, data.rest_heights, data.stance_foot,
-                          settings.skate_speed)
-        sk_real = foot_skating(truth.positions.numpy(), truth.num_frames.numpy(), truth.fps, data.rest_heights,
-                               data.stance_foot, settings.skate_speed)
-        out["skating"][m.name] = {"samples": sk, "real": sk_real}
-        out["foot_skating_detail"][m.name] = {"samples": sk.as_dict(), "real": sk_real.as_dict()}
-        out["nearest_training"][m.name] = _nearest(train_poses, examples[m.name], s, truth, heldout_neutral, length)
+            neutral_features = f_s
+        out["recognition"][m.name] = asdict(recognition(real, m, f_s, f_t))
+        dist = distribution(real, m, f_s, f_t, neutral_features, settings)
+        out["frechet"][m.name] = dist.frechet
+        out["frechet_reference"][m.name] = dist.frechet_reference
+        out["diversity"][m.name] = dist.diversity
+        sk = skating(real, m, s, settings)
+        out["skating"][m.name] = {"samples": sk.samples, "real": sk.real}
+        out["foot_skating_detail"][m.name] = sk.as_dict()
+        out["nearest_training"][m.name] = _nearest(train_poses, real.examples[m.name], s, real.truth[m.name],
+                                                   real.heldout_neutral, real.length)
         log.debug("%s/%s evaluated in %.1f s", primitive, m.name, time.perf_counter() - t0)
-    say(f"{primitive}: Table 5.1 ({len(models)} × {len(models)}, {settings.table_samples} samples per model)")
-    table = distance_table(autoencoder, table_frames, grams, settings.chunk)
-    out["table_5_1"] = {"models": names, "examples": names, "distance": table.tolist(),
-                        "diagonal": diagonal_minima(table, names), "samples": settings.table_samples,
-                        "example_clips": {m.name: ("mean motion of the neutral training clips"
-                                                   if m.name == NEUTRAL else [c.describe() for c in examples[m.name]])
-                                          for m in models}}
-    base = out["variance"]["training_data"]
-    out["variance_ratio"] = {row: {k: stats[k] / base[k] if base[k] else float("nan")
-                                   for k in ("pose_sd", "v_sd", "step_sd")} for row, stats in out["variance"].items()}
+    say(f"{primitive}: Table 5.1 ({len(real.models)} × {len(real.models)}, {settings.table_samples} samples per model)")
+    out["table_5_1"] = style_table(real, autoencoder, table_frames, settings).as_dict()
+    out["variance"] = variance.rows
+    out["variance_real"] = variance.real
+    out["variance_ratio"] = variance.ratio
     return out
 
 
-def _frechet_reference(data: PrimitiveData, model: EvalModel, examples: list, feats, length: int, f_truth: np.ndarray,
-                       neutral_feats: np.ndarray | None) -> dict[str, Any]:
+def _frechet_reference(real: RealSide, model: EvalModel, f_truth: np.ndarray,
+                       neutral_features: np.ndarray | None) -> dict[str, Any]:
     """Neutral-model samples against the same ground truth, and the real-vs-real floor (train-split
     clips of the style against its val+test clips, examples left out)."""
     ref: dict[str, Any] = {"ground_truth_clips": len(f_truth)}
-    if neutral_feats is not None:
-        ref["neutral_samples"] = frechet_distance(neutral_feats, f_truth)
-    skip = {(c.take, c.start) for c in examples}
-    a = [c for c in data.split("train", model.style) if (c.take, c.start) not in skip]
-    b = [c for c in data.heldout(model.style) if (c.take, c.start) not in skip]
+    if neutral_features is not None:
+        ref["neutral_samples"] = frechet_distance(neutral_features, f_truth)
+    skip = {(c.take, c.start) for c in real.examples[model.name]}
+    a = [c for c in real.data.split("train", model.style) if (c.take, c.start) not in skip]
+    b = [c for c in real.data.heldout(model.style) if (c.take, c.start) not in skip]
     if len(a) >= 2 and len(b) >= 2:
-        ref["real_floor"] = frechet_distance(feats(motions_from_clips(a, length)), feats(motions_from_clips(b, length)))
+        ref["real_floor"] = frechet_distance(real.features(motions_from_clips(a, real.length)),
+                                             real.features(motions_from_clips(b, real.length)))
     return ref
 
 
