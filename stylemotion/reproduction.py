@@ -16,13 +16,22 @@ Stages, each in its own folder under ``out`` (default ``runs/reproduce/<data nam
 
 Each training stage composes the ``train`` config with its overrides, takes this command's ``data``
 node, and runs :func:`stylemotion.training.run`: the autoencoder in this process, then the VAEs and
-CVAEs (which need only the autoencoder) ``workers`` at a time, each in a spawned process with
-``threads`` torch threads (``workers=1``: all in this process, one after the other). A stage that finished writes
+CVAEs (which need only the autoencoder) on the ``executor``: ``pool`` (default) runs them
+``workers`` at a time, each in a spawned process with ``threads`` torch threads (``workers=1``: all
+in this process, one after the other); ``local`` and ``slurm`` submit each as a submitit job (the
+engine of ``hydra/launcher=slurm``; ``local`` runs ``workers`` jobs at a time on this machine,
+``slurm`` submits all and lets the cluster schedule them). Every stage that finishes is recorded,
+even if another one fails. A stage that finished writes
 ``done.json`` (its checkpoint, metrics, seconds and a hash of its settings, including the hash of
 the stage it builds on); a rerun **reuses** it, and a stage interrupted mid-training **resumes**
 from its ``checkpoints/last.ckpt``. A stage whose recorded settings differ from the current ones
 stops the run with an error (choose another ``out`` or delete that stage's folder) — results are
 never overwritten silently. ``reproduce.json`` under ``out`` summarizes the stages.
+
+Training lengths come from ``configs/budget/<data config name>.yaml``, or from
+``budget/default.yaml`` (Bandai's) for data without a budget of its own; the first line says which.
+Paths recorded in ``reproduce.json``, ``done.json``, ``evaluation.json`` and the report that point
+inside ``out`` are relative to ``out``, so a moved run folder describes itself (and resumes).
 """
 
 from __future__ import annotations
@@ -34,7 +43,7 @@ import multiprocessing
 import sys
 import time
 from collections import Counter
-from collections.abc import Sequence
+from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -46,11 +55,18 @@ from omegaconf import DictConfig, OmegaConf, open_dict
 
 from stylemotion.datamodules.features import parse_primitive
 from stylemotion.datasets import build_dataset
-from stylemotion.evaluation.run import run_evaluation, summary_lines
+from stylemotion.evaluation.run import recorded_path, run_evaluation, summary_lines
 from stylemotion.io.atomic import atomic_write_bytes
+from stylemotion.io.outputs import inside, safe_name
 from stylemotion.primitives import SegmentSettings, action_of, segment_takes
 
 log = logging.getLogger(__name__)
+
+
+#: Where the VAE/CVAE stages run (``executor.engine``): this machine's process pool, or submitit jobs.
+ENGINES = ("pool", "local", "slurm")
+#: Seconds between looks at running submitit jobs.
+POLL_SECONDS = 2.0
 
 
 class StageConflictError(RuntimeError):
@@ -102,7 +118,7 @@ class Reproduction:
     def __init__(self, cfg: DictConfig, say=print):
         self.cfg = cfg
         self.say = say
-        self.out = Path(cfg.out)
+        self.out = Path(str(cfg.out)).expanduser()
         self.data_cfg = OmegaConf.to_container(cfg.data, resolve=True)
         self.primitives = [str(p) for p in cfg.primitives]
         for p in self.primitives:
@@ -128,10 +144,16 @@ class Reproduction:
         for p in self.primitives:
             self.stages.append(Stage("vae", f"vae {p}", self.out / "vae" / p, list(stages_cfg.vae),
                                      {"primitive": p}, ae))
+        folders: dict[Path, str] = {}
         for p in self.primitives:
             for s in styles:
-                self.stages.append(Stage("cvae", f"cvae {p}/{s}", self.out / "cvae" / f"{p}_{s}",
-                                         list(stages_cfg.cvae), {"primitive": p, "style": s}, ae))
+                folder = inside(self.out, "cvae", f"{p}_{safe_name(s, 'style label')}")
+                if folder in folders:
+                    raise ValueError(f"style labels {folders[folder]!r} and {s!r} would share the folder {folder}; "
+                                     "rename one in the data's labels")
+                folders[folder] = s
+                self.stages.append(Stage("cvae", f"cvae {p}/{s}", folder, list(stages_cfg.cvae),
+                                         {"primitive": p, "style": s}, ae))
 
     def data_stage(self) -> None:
         """Build and segment the data, count its clips, and plan the training stages."""
@@ -182,8 +204,9 @@ class Reproduction:
                         f"another out=… or delete {stage.folder} to train it again")
         if done.is_file():
             record = json.loads(done.read_text())
-            if record.get("checkpoint") and Path(record["checkpoint"]).is_file():
-                stage.status, stage.checkpoint = "reused", record["checkpoint"]
+            checkpoint = self.located(record.get("checkpoint"))
+            if checkpoint and Path(checkpoint).is_file():
+                stage.status, stage.checkpoint = "reused", checkpoint
                 stage.seconds, stage.metrics = float(record.get("seconds", 0.0)), record.get("metrics", {})
                 self._line(index, f"{stage.name}: reused {stage.checkpoint}")
                 return None
@@ -202,7 +225,8 @@ class Reproduction:
         stage.status, stage.checkpoint = ("resumed" if resume else "trained"), str(Path(ckpt).resolve())
         stage.seconds = seconds
         stage.metrics = {k: v for k, v in metrics.items() if k in ("test", "best_score", "global_step", "epoch")}
-        _write_json(stage.folder / "done.json", {"settings_hash": stage.settings_hash, "checkpoint": stage.checkpoint,
+        _write_json(stage.folder / "done.json", {"settings_hash": stage.settings_hash,
+                                                 "checkpoint": self.recorded(stage.checkpoint),
                                                  "seconds": stage.seconds, "metrics": stage.metrics,
                                                  "name": stage.name})
         test = stage.metrics.get("test", {})
@@ -221,35 +245,39 @@ class Reproduction:
         self.finish_stage(stage, result["metrics"], resume, time.perf_counter() - t0)
 
     def run_stages_in_parallel(self, indexed: Sequence[tuple[int, Stage]], workers: int) -> None:
-        """Train independent stages in ``workers`` fresh processes (spawned, ``threads`` torch threads
-        each, no progress bars); every stage that finishes is recorded even if another one fails."""
-        pending: dict[Any, tuple[Stage, bool]] = {}
+        """Train independent stages on the configured executor (see the module doc): fresh processes
+        (``threads`` torch threads each, no progress bars) or submitit jobs. Every stage that
+        finishes is recorded even if another one fails; then the first failure is raised."""
+        jobs: list[tuple[Stage, bool, dict[str, Any]]] = []
+        for index, stage in indexed:
+            resume = self.prepare_stage(index, stage)
+            if resume is not None:
+                jobs.append((stage, resume, self.worker_config(stage, resume)))
         errors: list[tuple[Stage, BaseException]] = []
-        context = multiprocessing.get_context("spawn")
-        with ProcessPoolExecutor(max_workers=workers, mp_context=context) as pool:
-            for index, stage in indexed:
-                resume = self.prepare_stage(index, stage)
-                if resume is None:
-                    continue
-                cfg = self.train_config(stage, resume)
-                with open_dict(cfg):  # interleaved progress bars of several processes would be unreadable
-                    cfg.trainer.enable_progress_bar = False
-                    if cfg.get("callbacks") and "progress_bar" in cfg.callbacks:
-                        cfg.callbacks.progress_bar = None
-                container = OmegaConf.to_container(cfg, resolve=True)
-                pending[pool.submit(_train_in_worker, container)] = (stage, resume)
-            for future in as_completed(pending):
-                stage, resume = pending[future]
-                try:
-                    metrics, seconds = future.result()
-                    self.finish_stage(stage, metrics, resume, seconds)
-                except Exception as exc:  # noqa: BLE001 - reported below, after the others are recorded
-                    self.say(f"    {stage.name} FAILED: {type(exc).__name__}: {exc}")
-                    errors.append((stage, exc))
-                _write_json(self.out / "reproduce.json", self.summary())
+        engine = executor_engine(self.cfg)
+        finished = _pool_results(jobs, workers) if engine == "pool" else \
+            _submitit_results(jobs, self.cfg.executor, None if engine == "slurm" else workers)
+        for stage, resume, outcome in finished:
+            try:
+                metrics, seconds = outcome()
+                self.finish_stage(stage, metrics, resume, seconds)
+            except Exception as exc:  # noqa: BLE001 - reported below, after the others are recorded
+                self.say(f"    {stage.name} FAILED: {type(exc).__name__}: {exc}")
+                errors.append((stage, exc))
+            _write_json(self.out / "reproduce.json", self.summary())
         if errors:
             names = ", ".join(stage.name for stage, _ in errors)
             raise RuntimeError(f"{len(errors)} training stage(s) failed ({names}); rerun to resume") from errors[0][1]
+
+    def worker_config(self, stage: Stage, resume: bool) -> dict[str, Any]:
+        """:meth:`train_config` resolved to plain values for another process, without progress bars
+        (interleaved bars of several processes would be unreadable)."""
+        cfg = self.train_config(stage, resume)
+        with open_dict(cfg):
+            cfg.trainer.enable_progress_bar = False
+            if cfg.get("callbacks") and "progress_bar" in cfg.callbacks:
+                cfg.callbacks.progress_bar = None
+        return OmegaConf.to_container(cfg, resolve=True)
 
     def train_config(self, stage: Stage, resume: bool) -> DictConfig:
         """The ``train`` config of ``stage``: its overrides, this run's data, seed, threads and folder."""
@@ -286,24 +314,127 @@ class Reproduction:
         ae = next(s.checkpoint for s in self.stages if s.kind == "autoencoder")
         command = "stylemotion-reproduce " + " ".join(sys.argv[1:])
         results = run_evaluation(self.cfg.data, models, self.cfg.evaluation, report, int(self.cfg.seed),
-                                 autoencoder_ckpt=ae, command=command, progress=lambda text: self.say("    " + text))
-        _write_json(record, {"settings_hash": settings_hash, "report": str(report)})
+                                 autoencoder_ckpt=ae, command=command, progress=lambda text: self.say("    " + text),
+                                 root=self.out)
+        _write_json(record, {"settings_hash": settings_hash, "report": self.recorded(report)})
         return results
 
+    def recorded(self, path: str | Path | None) -> str | None:
+        """``path`` as this run's records hold it: relative to ``out`` when inside it, else absolute."""
+        return recorded_path(path, self.out.resolve())
+
+    def located(self, path: str | None) -> str | None:
+        """A recorded path as a file path now: relative ones are relative to ``out``."""
+        if not path:
+            return None
+        return str(Path(path) if Path(path).is_absolute() else self.out / path)
+
     def summary(self) -> dict[str, Any]:
+        """What ``reproduce.json`` holds; paths inside ``out`` are relative to it."""
         return {"out": str(self.out), "data": self.data_summary, "seconds": time.perf_counter() - self.started,
-                "stages": [{"name": s.name, "kind": s.kind, "status": s.status, "checkpoint": s.checkpoint,
-                            "seconds": s.seconds, "metrics": s.metrics, "folder": str(s.folder)} for s in self.stages]}
+                "stages": [{"name": s.name, "kind": s.kind, "status": s.status,
+                            "checkpoint": self.recorded(s.checkpoint), "seconds": s.seconds, "metrics": s.metrics,
+                            "folder": self.recorded(s.folder)} for s in self.stages]}
 
 
 def _train_in_worker(container: dict[str, Any]) -> tuple[dict[str, Any], float]:
-    """A worker process's job: :func:`stylemotion.training.run` on a resolved ``train`` config; returns
-    its metrics and its training seconds (not counting the wait in the queue)."""
+    """A worker process's (or submitit job's) work: :func:`stylemotion.training.run` on a resolved
+    ``train`` config; returns its metrics and its training seconds (not counting the wait in the queue)."""
     from stylemotion.training import run as train_run
 
     t0 = time.perf_counter()
     metrics = train_run(OmegaConf.create(container))["metrics"]
     return metrics, time.perf_counter() - t0
+
+
+#: A finished job: its stage, whether it resumed, and a call that returns ``(metrics, seconds)`` or raises.
+Finished = tuple[Stage, bool, Callable[[], tuple[dict[str, Any], float]]]
+
+
+def executor_engine(cfg: DictConfig) -> str:
+    """``executor.engine`` of a reproduce config (``pool`` when there is no executor node), checked."""
+    node = cfg.get("executor")
+    engine = str(node.get("engine", "pool")) if node is not None else "pool"
+    if engine not in ENGINES:
+        raise ValueError(f"reproduce config key 'executor.engine' must be one of {list(ENGINES)}, got {engine!r}")
+    return engine
+
+
+def _pool_results(jobs: Sequence[tuple[Stage, bool, dict[str, Any]]], workers: int) -> Iterator[Finished]:
+    """Run the jobs in ``workers`` spawned processes; yield each as it finishes."""
+    if not jobs:
+        return
+    with ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("spawn")) as pool:
+        pending = {pool.submit(_train_in_worker, container): (stage, resume) for stage, resume, container in jobs}
+        for future in as_completed(pending):
+            yield (*pending[future], future.result)
+
+
+def submitit_executor(node: Any, folder: Path, engine: str) -> Any:
+    """A submitit ``AutoExecutor`` for one stage (logs in ``folder``) with the ``executor`` node's
+    ``parameters`` (and ``partition`` as ``slurm_partition``).
+
+    Raises:
+        ImportError: submitit is not installed (the ``cluster`` extra).
+    """
+    try:
+        import submitit
+    except ImportError as exc:
+        raise ImportError(f"executor={engine} runs the stages through submitit, which is not installed: "
+                          "pip install 'stylemotion[cluster]' (or pip install submitit)") from exc
+    params = OmegaConf.to_container(node.get("parameters") or {}, resolve=True) if isinstance(node, DictConfig) \
+        else dict(node.get("parameters") or {})
+    if node.get("partition"):
+        params["slurm_partition"] = str(node.get("partition"))
+    executor = submitit.AutoExecutor(folder=str(folder), cluster=engine)
+    executor.update_parameters(**params)
+    return executor
+
+
+def _submitit_results(jobs: Sequence[tuple[Stage, bool, dict[str, Any]]], node: Any,
+                      limit: int | None) -> Iterator[Finished]:
+    """Submit the jobs through submitit (at most ``limit`` running at once; None = all) and yield each
+    as it finishes; a job's log folder is its stage's ``submitit/``."""
+    engine = str(node.get("engine"))
+    waiting, running = list(jobs), []
+    while waiting or running:
+        while waiting and (limit is None or len(running) < limit):
+            stage, resume, container = waiting.pop(0)
+            job = submitit_executor(node, stage.folder / "submitit", engine).submit(_train_in_worker, container)
+            log.info("%s: submitit job %s (%s)", stage.name, job.job_id, engine)
+            running.append((stage, resume, job))
+        done = [item for item in running if item[2].done()]
+        if not done:
+            time.sleep(POLL_SECONDS)
+            continue
+        for item in done:
+            running.remove(item)
+            yield item[0], item[1], item[2].result
+
+
+def choose_budget(cfg: DictConfig) -> str:
+    """Fall back to ``default_budget`` when no ``budget`` was composed (no ``configs/budget/<data config
+    name>.yaml``); returns a line saying which budget the training lengths come from."""
+    data_choice = _data_choice(cfg)
+    if cfg.get("budget") is None:
+        if cfg.get("default_budget") is None:
+            raise ValueError(f"no training budget: there is no configs/budget/{data_choice}.yaml and no default_budget")
+        with open_dict(cfg):
+            cfg.budget = cfg.default_budget
+        return (f"budget: budget/{cfg.budget.get('name', 'default')} (there is no budget/{data_choice}.yaml for this "
+                "data; scale the epochs with its number of clips, e.g. stages.vae=[...])")
+    return f"budget: budget/{cfg.budget.get('name', data_choice)}"
+
+
+def _data_choice(cfg: DictConfig) -> str:
+    """The name of the ``data`` config chosen (Hydra's choice when known, else ``data.name``)."""
+    from hydra.core.hydra_config import HydraConfig
+
+    if HydraConfig.initialized():
+        choice = HydraConfig.get().runtime.choices.get("data")
+        if choice:
+            return str(choice)
+    return str(cfg.data.get("name", "?"))
 
 
 def reproduce(cfg: DictConfig, say=print) -> dict[str, Any]:
@@ -318,11 +449,14 @@ def reproduce(cfg: DictConfig, say=print) -> dict[str, Any]:
     if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
         raise ValueError(f"reproduce config key 'workers' must be an integer ≥ 1 (training stages at once), "
                          f"got {workers!r}")
+    engine = executor_engine(cfg)
+    say(choose_budget(cfg))
     repro = Reproduction(cfg, say)
     repro.out.mkdir(parents=True, exist_ok=True)
     repro.data_stage()
     indexed = list(enumerate(repro.stages, start=2))
-    in_process = 1 if workers > 1 else len(indexed)  # stage 1 is the autoencoder the others need
+    parallel = workers > 1 or engine != "pool"
+    in_process = 1 if parallel else len(indexed)  # stage 1 is the autoencoder the others need
     for index, stage in indexed[:in_process]:
         repro.run_stage(index, stage)
         _write_json(repro.out / "reproduce.json", repro.summary())
@@ -330,7 +464,7 @@ def reproduce(cfg: DictConfig, say=print) -> dict[str, Any]:
         repro.run_stages_in_parallel(indexed[in_process:], workers)
     results = repro.evaluation_stage()
     summary = repro.summary()
-    summary["report"] = str(repro.out / "report")
+    summary["report"] = repro.recorded(repro.out / "report")
     _write_json(repro.out / "reproduce.json", summary)
     say(f"done in {summary['seconds'] / 60:.1f} min: "
         + ", ".join(f"{k} {v}" for k, v in Counter(s.status for s in repro.stages).items()) + " training stages")

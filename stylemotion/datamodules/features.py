@@ -22,7 +22,8 @@ so they travel in the model's checkpoint. The common scale keeps the channels' r
 the thesis' unnormalized features do: per-channel z-scores make a channel that neutral walking
 barely uses, but a style does, very expensive to change, so the style term can hardly move it.
 The autoencoder is identified by its path and a fingerprint of its weights
-(:func:`autoencoder_info`), stored in the model's hyperparameters as plain values.
+(:func:`stylemotion.models.checkpoints.autoencoder_info`), stored in the model's hyperparameters
+as plain values (the model's checkpoint also embeds the autoencoder itself).
 
 Style examples (for :class:`~stylemotion.models.cvae.StyleCVAE`): with ``style`` set, one clip per
 entry of ``examples`` (each entry is a :class:`~stylemotion.datamodules.clips.ClipDataModule` ``example``
@@ -35,10 +36,8 @@ receptive field (:func:`receptive_field`).
 
 from __future__ import annotations
 
-import hashlib
 import logging
 from collections.abc import Mapping, Sequence
-from pathlib import Path
 from typing import Any
 
 import lightning.pytorch as pl
@@ -48,7 +47,8 @@ from torch.utils.data import DataLoader, Dataset
 
 from stylemotion.datamodules.clips import ClipDataModule, NoClipsError
 from stylemotion.datasets import TakeSet
-from stylemotion.models.autoencoder import IncompatibleModelError, MotionAutoencoder
+from stylemotion.models.autoencoder import MotionAutoencoder
+from stylemotion.models.checkpoints import autoencoder_info, load_autoencoder
 from stylemotion.primitives import ACTIONS, PRIMITIVES, Clip, time_normalize
 from stylemotion.representation import FRAME_DIM, REPRESENTATION
 from stylemotion.sampling import pad_motions
@@ -82,70 +82,10 @@ def parse_primitive(name: str) -> tuple[str, str]:
     return action, primitive
 
 
-def fingerprint(module: torch.nn.Module) -> str:
-    """Short SHA-256 of a module's state (names, shapes and values of parameters and buffers)."""
-    digest = hashlib.sha256()
-    for key, value in sorted(module.state_dict().items()):
-        tensor = value.detach().cpu().contiguous()
-        digest.update(key.encode())
-        digest.update(str(tuple(tensor.shape)).encode())
-        digest.update(tensor.numpy().tobytes())
-    return digest.hexdigest()[:16]
-
-
-def autoencoder_info(autoencoder: MotionAutoencoder, path: str | Path | None) -> dict[str, Any]:
-    """Plain values that identify an autoencoder: checkpoint path, weight fingerprint, layout."""
-    hp = autoencoder.hparams
-    return {"path": None if path is None else str(Path(path).resolve()), "fingerprint": fingerprint(autoencoder),
-            "hidden_units": int(hp["hidden_units"]), "kernel_size": int(hp["kernel_size"]),
-            "pooling": str(hp["pooling"]), "fps": float(hp["fps"]), "frame_dim": int(hp["frame_dim"]),
-            "representation": str(hp["representation"])}
-
-
 def receptive_field(autoencoder: MotionAutoencoder) -> int:
     """Fewest frames a clip needs so that at least one hidden unit sees no zero padding: the
     encoder's kernel width (15 frames in the thesis)."""
     return int(autoencoder.hparams["kernel_size"])
-
-
-def load_autoencoder(path: str | Path, expected: Mapping[str, Any] | None = None) -> MotionAutoencoder:
-    """Load a frozen :class:`MotionAutoencoder` (eval mode, no gradients) on the CPU.
-
-    Args:
-        path: its Lightning checkpoint.
-        expected: an :func:`autoencoder_info` dict; when given, the loaded weights must have the
-            same fingerprint (they are the ones a VAE was trained on).
-
-    Raises:
-        FileNotFoundError: no such file.
-        IncompatibleModelError: not an autoencoder checkpoint, a representation or skeleton this
-            code does not compute, no normalization statistics, or a different fingerprint.
-    """
-    path = Path(path).expanduser()
-    if not path.is_file():
-        raise FileNotFoundError(f"autoencoder checkpoint {str(path)!r} does not exist; train one with "
-                                "'stylemotion-train experiment=autoencoder data=...' and pass its "
-                                "checkpoints/best.ckpt as autoencoder_ckpt=...")
-    saved = torch.load(path, map_location="cpu", weights_only=True).get("hyper_parameters", {})
-    missing = [k for k in ("hidden_units", "kernel_size", "representation", "fps") if k not in saved]
-    if missing:
-        raise IncompatibleModelError(f"{path} is not a MotionAutoencoder checkpoint (its hyperparameters lack "
-                                     f"{missing}; it has {sorted(saved)[:12]})")
-    try:
-        autoencoder = MotionAutoencoder.load_from_checkpoint(path, map_location="cpu")
-    except IncompatibleModelError as err:
-        raise IncompatibleModelError(f"autoencoder checkpoint {path}: {err}") from err
-    if not autoencoder.net.normalizer.initialized:
-        raise IncompatibleModelError(f"autoencoder checkpoint {path} holds no frame normalization statistics")
-    autoencoder.eval().requires_grad_(False)
-    if expected is not None:
-        got = fingerprint(autoencoder)
-        if got != expected.get("fingerprint"):
-            raise IncompatibleModelError(
-                f"autoencoder checkpoint {path} has weights {got}, but the model was trained on features of "
-                f"the autoencoder with weights {expected.get('fingerprint')} (then at {expected.get('path')}); "
-                "load that checkpoint, or retrain the model on this autoencoder")
-    return autoencoder
 
 
 @torch.no_grad()

@@ -13,7 +13,6 @@ the one they record). ``data`` must be the data they were trained on. The report
 
 from __future__ import annotations
 
-import glob
 import logging
 import os
 import time
@@ -21,15 +20,14 @@ from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-import torch
 from omegaconf import DictConfig, OmegaConf
 
-from stylemotion.datamodules.features import autoencoder_info, load_autoencoder
 from stylemotion.datasets import build_dataset
 from stylemotion.evaluation.pipeline import EvalSettings, evaluate_models
 from stylemotion.evaluation.report import write_report
 from stylemotion.evaluation.sources import check_one_autoencoder, load_model
 from stylemotion.io.outputs import check_new_output
+from stylemotion.models.checkpoints import autoencoder_info, find_checkpoints, load_autoencoder
 from stylemotion.provenance import provenance
 
 log = logging.getLogger(__name__)
@@ -55,40 +53,29 @@ def settings_from_config(node: Mapping[str, Any], seed: int) -> EvalSettings:
                         segment=dict(node.get("segment") or {}))
 
 
-def is_model_checkpoint(path: str | os.PathLike) -> bool:
-    """Whether a checkpoint holds a trained PrimitiveVAE/StyleCVAE (its hyperparameters carry a data ``spec``)."""
-    hparams = torch.load(path, map_location="cpu", weights_only=True).get("hyper_parameters", {})
-    return isinstance(hparams.get("spec"), dict)
-
-
-def find_checkpoints(patterns: Sequence[str]) -> list[Path]:
-    """Checkpoint files from files, glob patterns and folders.
-
-    A folder is searched for ``**/checkpoints/best.ckpt`` of primitive models (an autoencoder's
-    checkpoint in it is skipped); files and glob matches are taken as given.
-    """
-    if isinstance(patterns, str):
-        patterns = [patterns]
-    found: list[Path] = []
-    for pattern in patterns:
-        path = Path(pattern).expanduser()
-        if path.is_dir():
-            hits = [h for h in sorted(path.glob("**/checkpoints/best.ckpt")) if is_model_checkpoint(h)]
-        elif path.is_file():
-            hits = [path]
-        else:
-            hits = sorted(Path(p) for p in glob.glob(str(path), recursive=True))
-        if not hits:
-            raise FileNotFoundError(f"no checkpoint matches {pattern!r} (a file, a glob pattern, or a folder holding "
-                                    "**/checkpoints/best.ckpt of a PrimitiveVAE/StyleCVAE)")
-        found += [h for h in hits if h not in found]
-    return found
+def recorded_path(path: str | os.PathLike | None, root: Path) -> str | None:
+    """``path`` as a report records it: relative to ``root`` when it lies inside it (so the folder can
+    move), else absolute."""
+    if path is None:
+        return None
+    path = Path(path).expanduser().resolve()
+    try:
+        return path.relative_to(root).as_posix()
+    except ValueError:
+        return str(path)
 
 
 def run_evaluation(data_cfg: Mapping[str, Any], checkpoints: Sequence[str], evaluation: Mapping[str, Any],
                    out: str | os.PathLike, seed: int = 0, autoencoder_ckpt: str | None = None, force: bool = False,
-                   command: str = "", progress: Callable[[str], None] | None = None) -> dict[str, Any]:
+                   command: str = "", progress: Callable[[str], None] | None = None,
+                   root: str | os.PathLike | None = None) -> dict[str, Any]:
     """Load the models and their autoencoder, evaluate them on ``data_cfg``'s data, write the report.
+
+    The autoencoder is ``autoencoder_ckpt`` if given, else the models' own (embedded in their
+    checkpoints; see :func:`stylemotion.models.checkpoints.resolve_autoencoder`). Checkpoint and
+    autoencoder paths inside ``root`` (default ``out``; a ``stylemotion-reproduce`` run passes its
+    run folder) are recorded relative to it, and ``meta.paths_relative_to`` says where ``root`` is
+    from ``out``, so a moved folder still describes itself.
 
     Returns:
         The results as written to ``report.json`` (with ``meta``).
@@ -98,7 +85,8 @@ def run_evaluation(data_cfg: Mapping[str, Any], checkpoints: Sequence[str], eval
         MixedAutoencodersError, MissingExampleError, FileNotFoundError, ValueError: bad input.
     """
     started = time.perf_counter()
-    out = check_new_output(out, force)
+    out = check_new_output(Path(out).expanduser(), force)
+    base = Path(root if root is not None else out).expanduser().resolve()
     settings = settings_from_config(evaluation, seed)
     data_cfg = OmegaConf.to_container(data_cfg, resolve=True) if isinstance(data_cfg, DictConfig) else dict(data_cfg)
     paths = find_checkpoints(checkpoints)
@@ -109,11 +97,11 @@ def run_evaluation(data_cfg: Mapping[str, Any], checkpoints: Sequence[str], eval
         check_one_autoencoder(models, info["fingerprint"])
     else:
         check_one_autoencoder(models)
-        recorded = models[0].autoencoder
-        autoencoder = load_autoencoder(recorded["path"], expected=recorded)
-        info = autoencoder_info(autoencoder, recorded["path"])
+        autoencoder = models[0].source.autoencoder  # embedded in its checkpoint (or found on disk)
+        info = {**autoencoder_info(autoencoder, None), "path": models[0].autoencoder.get("path")}
     for m in models:
         m.source.attach_autoencoder(autoencoder)
+    info = {**info, "path": recorded_path(info["path"], base)}
     takeset = build_dataset(data_cfg)
     results = evaluate_models(models, takeset, autoencoder, settings, split=data_cfg.get("split"),
                               autoencoder_info=info, progress=progress)
@@ -121,9 +109,10 @@ def run_evaluation(data_cfg: Mapping[str, Any], checkpoints: Sequence[str], eval
         "data": data_cfg, "data_name": takeset.name, "seed": int(seed),
         "samples": {"table_5_1": settings.table_samples, "variance": settings.variance_samples,
                     "metrics": settings.metric_samples},
-        "checkpoints": [{"path": str(m.checkpoint), "primitive": m.primitive, "name": m.name, "style": m.style}
-                        for m in models],
+        "checkpoints": [{"path": recorded_path(m.checkpoint, base), "primitive": m.primitive, "name": m.name,
+                         "style": m.style} for m in models],
         "autoencoder": {"path": info["path"], "fingerprint": info["fingerprint"]},
+        "paths_relative_to": Path(os.path.relpath(base, out.resolve())).as_posix(),
         "settings": {k: v for k, v in vars(settings).items()}, **provenance(command or None),
         "seconds": time.perf_counter() - started,
     }

@@ -20,6 +20,8 @@ import numpy as np
 import torch
 
 from stylemotion.models.autoencoder import IncompatibleModelError
+from stylemotion.models.checkpoints import load_generative
+from stylemotion.models.cvae import StyleCVAE
 from stylemotion.primitives import Clip, time_normalize
 from stylemotion.sampling import MotionSamples, pad_motions
 
@@ -89,25 +91,13 @@ def load_model(path: str | Path, neutral_style: str = "normal", autoencoder=None
         path: the checkpoint.
         neutral_style: data style of the neutral model when its spec names several content styles.
         autoencoder: an already loaded autoencoder to attach (must be the model's own: same weights);
-            None loads the one recorded in the checkpoint on first use.
+            None takes the one embedded in the checkpoint (or recorded) on first use.
 
     Raises:
-        FileNotFoundError, IncompatibleModelError: no file, or not a trained primitive model.
+        FileNotFoundError, IncompatibleModelError: no file, or not a trained primitive model
+        (:func:`stylemotion.models.checkpoints.load_generative` reads it).
     """
-    from stylemotion.models.cvae import StyleCVAE
-    from stylemotion.models.vae import PrimitiveVAE
-
-    path = Path(path)
-    if not path.is_file():
-        raise FileNotFoundError(f"model checkpoint {str(path)!r} does not exist")
-    hparams = torch.load(path, map_location="cpu", weights_only=True).get("hyper_parameters", {})
-    if not isinstance(hparams.get("spec"), dict):
-        raise IncompatibleModelError(f"{path} is not a trained PrimitiveVAE/StyleCVAE checkpoint (no data spec in "
-                                     f"its hyperparameters; it has {sorted(hparams)[:12]})")
-    cls = StyleCVAE if "style_weight" in hparams else PrimitiveVAE
-    model = cls.load_from_checkpoint(path, map_location="cpu").eval()
-    if autoencoder is not None:
-        model.attach_autoencoder(autoencoder)
+    model = load_generative(path, autoencoder)
     spec = model.spec
     styled = isinstance(model, StyleCVAE)
     if styled:

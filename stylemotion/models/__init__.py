@@ -1,11 +1,6 @@
-"""Networks (plain ``nn.Module``s) and the Lightning modules that train them.
-
-``PrimitiveVAE``, ``MLPVAE`` and ``StyleCVAE`` are imported on first access: their modules build on
-:mod:`stylemotion.datamodules.features`, which itself imports the autoencoder from this package.
-"""
-
-from importlib import import_module
-from typing import Any
+"""Networks (plain ``nn.Module``s), the Lightning modules that train them, and the one path that
+loads their checkpoints (:mod:`stylemotion.models.checkpoints`). Nothing here imports
+:mod:`stylemotion.datamodules`: the data side builds on the models, not the other way round."""
 
 from stylemotion.models.autoencoder import (
     ConvAutoencoder,
@@ -15,16 +10,11 @@ from stylemotion.models.autoencoder import (
     local_mpjpe,
     mpjpe,
 )
+from stylemotion.models.checkpoints import load_autoencoder, load_generative
+from stylemotion.models.cvae import StyleCVAE
 from stylemotion.models.style import gram, mean_gram
-
-_LAZY = {"MLPVAE": "stylemotion.models.vae", "PrimitiveVAE": "stylemotion.models.vae",
-         "StyleCVAE": "stylemotion.models.cvae"}
+from stylemotion.models.vae import MLPVAE, PrimitiveVAE
 
 __all__ = ["MLPVAE", "ConvAutoencoder", "IncompatibleModelError", "MotionAutoencoder", "NonFiniteLossError",
-           "PrimitiveVAE", "StyleCVAE", "gram", "local_mpjpe", "mean_gram", "mpjpe"]
-
-
-def __getattr__(name: str) -> Any:
-    if name in _LAZY:
-        return getattr(import_module(_LAZY[name]), name)
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+           "PrimitiveVAE", "StyleCVAE", "gram", "load_autoencoder", "load_generative", "local_mpjpe", "mean_gram",
+           "mpjpe"]

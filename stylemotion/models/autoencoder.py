@@ -31,7 +31,7 @@ import torch
 import torch.nn.functional as F
 from torch import nn
 
-from stylemotion.datamodules.normalization import Normalizer
+from stylemotion.models.normalization import Normalizer
 from stylemotion.representation import FRAME_DIM, REPRESENTATION, frames_to_positions
 from stylemotion.skeleton import CANONICAL_JOINTS, CANONICAL_PARENTS
 

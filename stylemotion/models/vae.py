@@ -17,9 +17,13 @@ feature value by 1. Samples thus carry their own durations, correlated with the 
 
 Sampling (:meth:`PrimitiveVAE.sample`) decodes ``z ~ N(0, I)`` to features and a duration, and
 :func:`stylemotion.sampling.decode_features` turns them into motions (autoencoder decoder, duration
-restored, root integrated). The autoencoder is not part of this module's state: its checkpoint
-path and a fingerprint of its weights are hyperparameters (``spec["autoencoder"]``), and it is
-loaded from there on first use (or given with :meth:`PrimitiveVAE.attach_autoencoder`).
+restored, root integrated). The autoencoder is not part of this module's state (not a submodule,
+not in ``state_dict``), but every checkpoint embeds it beside the state dict (its hyperparameters
+and weights, :func:`stylemotion.models.checkpoints.autoencoder_record`), so a checkpoint samples
+wherever it is copied. Its path and a fingerprint of its weights are hyperparameters
+(``spec["autoencoder"]``); on first use it is taken from the checkpoint (or, for checkpoints written
+before the embedding, from that path; see :func:`stylemotion.models.checkpoints.resolve_autoencoder`),
+or it is given with :meth:`PrimitiveVAE.attach_autoencoder`.
 
 Everything the model learned about its data (feature shape, canonical length, fps, autoencoder,
 which clips and examples) is filled in from the :class:`~stylemotion.datamodules.features.FeatureDataModule`
@@ -30,6 +34,7 @@ buffers. So ``PrimitiveVAE.load_from_checkpoint(path)`` works in a fresh process
 
 from __future__ import annotations
 
+import logging
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -38,9 +43,17 @@ import lightning.pytorch as pl
 import torch
 from torch import nn
 
-from stylemotion.datamodules.features import autoencoder_info, fingerprint, load_autoencoder
 from stylemotion.models.autoencoder import IncompatibleModelError, MotionAutoencoder, NonFiniteLossError
+from stylemotion.models.checkpoints import (
+    EMBEDDED_AUTOENCODER,
+    autoencoder_record,
+    fingerprint,
+    load_autoencoder,
+    resolve_autoencoder,
+)
 from stylemotion.sampling import DEFAULT_CHUNK, MotionSamples, decode_features, masked_mpjpe
+
+log = logging.getLogger(__name__)
 
 #: Spec keys that must agree between a model and the data it is trained or evaluated on.
 STRUCTURAL_KEYS = ("primitive", "feature_channels", "feature_steps", "timeline_frames", "fps")
@@ -164,6 +177,9 @@ class PrimitiveVAE(pl.LightningModule):
         })
         self.net: MLPVAE | None = None
         object.__setattr__(self, "_autoencoder", None)  # not a submodule: not in state_dict
+        object.__setattr__(self, "_autoencoder_record", None)  # the one embedded in a loaded checkpoint
+        #: the checkpoint file this model was loaded from, when known (finds an old checkpoint's autoencoder)
+        self.checkpoint_file: str | None = None
         if spec is not None:
             self._build(spec)
 
@@ -239,12 +255,11 @@ class PrimitiveVAE(pl.LightningModule):
 
     @property
     def autoencoder(self) -> MotionAutoencoder:
-        """The frozen autoencoder that decodes features (loaded from ``spec`` on first use)."""
+        """The frozen autoencoder that decodes features: the attached one, else the one embedded in
+        the checkpoint, else the recorded file (see :func:`~stylemotion.models.checkpoints.resolve_autoencoder`)."""
         if self._autoencoder is None:
-            info = self.spec["autoencoder"]
-            if not info.get("path"):
-                raise RuntimeError("no autoencoder checkpoint path recorded: call attach_autoencoder(...)")
-            self.attach_autoencoder(load_autoencoder(info["path"], expected=info))
+            autoencoder = resolve_autoencoder(self.spec["autoencoder"], self._autoencoder_record, self.checkpoint_file)
+            self.attach_autoencoder(autoencoder)
         if self._autoencoder.net.encoder.weight.device != self.device:
             self._autoencoder.to(self.device)
         return self._autoencoder
@@ -255,12 +270,31 @@ class PrimitiveVAE(pl.LightningModule):
         info = self.spec["autoencoder"]
         if isinstance(autoencoder, (str, Path)):
             autoencoder = load_autoencoder(autoencoder, expected=info)
-        elif fingerprint(autoencoder) != info["fingerprint"]:
-            got = autoencoder_info(autoencoder, None)
-            raise IncompatibleModelError(f"this autoencoder (weights {got['fingerprint']}) is not the one the model "
-                                         f"was trained with (weights {info['fingerprint']}, {info['path']})")
+        else:
+            got = fingerprint(autoencoder)
+            if got != info["fingerprint"]:
+                raise IncompatibleModelError(f"this autoencoder (weights {got}) is not the one the model "
+                                             f"was trained with (weights {info['fingerprint']}, {info['path']})")
         autoencoder.eval().requires_grad_(False)
         object.__setattr__(self, "_autoencoder", autoencoder.to(self.device))
+
+    def on_save_checkpoint(self, checkpoint: dict[str, Any]) -> None:
+        """Embed the autoencoder (hyperparameters and weights, plain values; see the module doc)."""
+        if self.hparams.spec is None:
+            return
+        if self._autoencoder is not None:
+            checkpoint[EMBEDDED_AUTOENCODER] = autoencoder_record(self._autoencoder)
+        elif self._autoencoder_record is not None:
+            checkpoint[EMBEDDED_AUTOENCODER] = self._autoencoder_record
+        else:
+            try:
+                checkpoint[EMBEDDED_AUTOENCODER] = autoencoder_record(self.autoencoder)
+            except (FileNotFoundError, IncompatibleModelError) as err:
+                log.warning("checkpoint saved without its autoencoder (%s)", err)
+
+    def on_load_checkpoint(self, checkpoint: dict[str, Any]) -> None:
+        """Keep the embedded autoencoder (built on first use; absent in older checkpoints)."""
+        object.__setattr__(self, "_autoencoder_record", checkpoint.get(EMBEDDED_AUTOENCODER))
 
     # -- feature space ⇄ model space
 

@@ -28,6 +28,7 @@ import numpy as np
 import torch
 
 from stylemotion.evaluation.sources import NEUTRAL, load_model
+from stylemotion.models.checkpoints import load_autoencoder
 from stylemotion.models.vae import PrimitiveVAE
 from stylemotion.primitives import PRIMITIVES, check_primitive
 
@@ -156,8 +157,18 @@ def available_models(run: str | Path, meta: dict | None = None) -> list[dict[str
     if not entries:
         raise ValueError(f"{Path(run) / 'report' / 'report.json'}: meta.checkpoints is empty; no model to "
                          "synthesize with")
-    return [{**{k: str(e[k]) for k in ("primitive", "name", "style")}, "path": relocated(e["path"], run)}
+    return [{**{k: str(e[k]) for k in ("primitive", "name", "style")}, "path": recorded(e["path"], run, meta)}
             for e in entries]
+
+
+def recorded(path: str | Path, run: str | Path, meta: dict | None = None) -> str:
+    """A path from a run's report: a relative one is relative to the folder ``meta.paths_relative_to``
+    names (from ``<run>/report``; reports of runs before that key: absolute paths, see :func:`relocated`)."""
+    path = Path(path).expanduser()
+    if path.is_absolute():
+        return relocated(path, run)
+    base = Path(run).expanduser() / "report" / str((meta or {}).get("paths_relative_to", ".."))
+    return str(base / path)
 
 
 def relocated(path: str | Path, run: str | Path) -> str:
@@ -174,14 +185,17 @@ def relocated(path: str | Path, run: str | Path) -> str:
 
 
 def run_autoencoder(run: str | Path, meta: dict | None = None):
-    """The autoencoder of a ``stylemotion-reproduce`` run (report ``meta.autoencoder``, relocated like
-    the checkpoints), checked against its recorded fingerprint; None if the report names none."""
-    from stylemotion.datamodules.features import load_autoencoder
-
-    info = (report_meta(run) if meta is None else meta).get("autoencoder") or {}
+    """The autoencoder of a ``stylemotion-reproduce`` run (report ``meta.autoencoder``, located like
+    the checkpoints), checked against its recorded fingerprint; None if the report names none or the
+    file is gone (the models then use the autoencoder embedded in their checkpoints)."""
+    meta = report_meta(run) if meta is None else meta
+    info = meta.get("autoencoder") or {}
     if not info.get("path"):
         return None
-    return load_autoencoder(relocated(info["path"], run), expected=info if info.get("fingerprint") else None)
+    path = Path(recorded(info["path"], run, meta))
+    if not path.is_file():
+        return None
+    return load_autoencoder(path, expected=info if info.get("fingerprint") else None)
 
 
 def load_graph(style: str, run: str | Path | None = None, models: Mapping[str, str] | None = None,

@@ -219,8 +219,9 @@ class SampleAnimation(pl.Callback):
                      if getattr(cb, "monitor", None) and getattr(cb, "best_model_path", "")), "")
         model = pl_module
         if best:
-            model = type(pl_module).load_from_checkpoint(best, map_location="cpu")
-            model.attach_autoencoder(pl_module.autoencoder.cpu())
+            from stylemotion.models.checkpoints import load_generative  # viz does not need the models otherwise
+
+            model = load_generative(best, autoencoder=pl_module.autoencoder.cpu())
         model.eval()
         samples = model.sample(self.num_samples, seed=self.seed)
         style = model.spec.get("style")

@@ -12,7 +12,7 @@ import pytest
 import torch
 from vae_fixtures import TINY_DATA, tiny_autoencoder_ckpt, tiny_takeset
 
-from stylemotion.datamodules.features import autoencoder_info, describe_clip, load_autoencoder
+from stylemotion.datamodules.features import describe_clip
 from stylemotion.evaluation.pipeline import EvalSettings, evaluate_models
 from stylemotion.evaluation.reference import primitive_data
 from stylemotion.evaluation.report import write_report
@@ -25,6 +25,7 @@ from stylemotion.evaluation.sources import (
     SampleSource,
 )
 from stylemotion.io.outputs import OutputExistsError
+from stylemotion.models.checkpoints import autoencoder_info, load_autoencoder
 
 torch.set_num_threads(1)
 SETTINGS = EvalSettings(table_samples=120, variance_samples=200, metric_samples=120, classifier_components=8)
