@@ -25,12 +25,13 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.ndimage import label, median_filter
 
-from stylemotion.skeleton import CJ
+from stylemotion.skeleton import JOINT_INDEX, NUM_JOINTS
 
 #: Feet in the order of the last axis of every contact array.
 FEET: tuple[str, str] = ("left", "right")
 #: ``(foot, point)`` joint indices: heel (ankle) and ball (toes) of the left and the right foot.
-FOOT_POINTS: np.ndarray = np.array([[CJ["Foot_L"], CJ["Toes_L"]], [CJ["Foot_R"], CJ["Toes_R"]]])
+FOOT_POINTS: np.ndarray = np.array([[JOINT_INDEX["Foot_L"], JOINT_INDEX["Toes_L"]],
+                                    [JOINT_INDEX["Foot_R"], JOINT_INDEX["Toes_R"]]])
 
 
 @dataclass(frozen=True)
@@ -98,8 +99,9 @@ def leg_length(positions: np.ndarray) -> np.ndarray:
     p = np.asarray(positions, dtype=np.float64)
     total = 0.0
     for side in ("L", "R"):
-        thigh = np.linalg.norm(p[..., CJ[f"LowerLeg_{side}"], :] - p[..., CJ[f"UpperLeg_{side}"], :], axis=-1)
-        shin = np.linalg.norm(p[..., CJ[f"Foot_{side}"], :] - p[..., CJ[f"LowerLeg_{side}"], :], axis=-1)
+        hip, knee, ankle = (JOINT_INDEX[f"{joint}_{side}"] for joint in ("UpperLeg", "LowerLeg", "Foot"))
+        thigh = np.linalg.norm(p[..., knee, :] - p[..., hip, :], axis=-1)
+        shin = np.linalg.norm(p[..., ankle, :] - p[..., knee, :], axis=-1)
         total = total + thigh + shin
     return np.median(total / 2.0, axis=-1)
 
@@ -135,8 +137,8 @@ def foot_signals(
     """
     settings = settings or ContactSettings()
     p = np.asarray(positions, dtype=np.float64)
-    if p.ndim < 3 or p.shape[-2:] != (21, 3):
-        raise ValueError(f"positions must be (..., frames, 21, 3), got {p.shape}")
+    if p.ndim < 3 or p.shape[-2:] != (NUM_JOINTS, 3):
+        raise ValueError(f"positions must be (..., frames, {NUM_JOINTS}, 3), got {p.shape}")
     if p.shape[-3] < 2:
         raise ValueError(f"foot contacts need at least 2 frames, got {p.shape[-3]}")
     pts = p[..., FOOT_POINTS.reshape(-1), :]  # (..., frames, 4, 3)

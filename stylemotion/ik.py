@@ -32,6 +32,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from stylemotion.geometry import relative_rotation
 from stylemotion.skeleton import CANONICAL_JOINTS, CANONICAL_PARENTS, forward_kinematics
 
 #: Bones shorter than this (metres) have no direction to fit and are rejected.
@@ -348,7 +349,7 @@ def fit_rotations(
     for joint, kids in enumerate(_children(parents)):
         parent_rot = identity if parents[joint] < 0 else global_rot[:, parents[joint]]
         if len(kids) >= 2:
-            local_rot[:, joint] = parent_rot.swapaxes(-1, -2) @ kabsch(rest[kids], targets[:, kids])
+            local_rot[:, joint] = relative_rotation(parent_rot, kabsch(rest[kids], targets[:, kids]))
         elif len(kids) == 1:
             target_local = np.einsum("fji,fj->fi", parent_rot, targets[:, kids[0]])
             local_rot[:, joint] = swing_rotation(rest[kids[0]], target_local)

@@ -18,7 +18,8 @@ direction of yaw ``θ`` is ``(sin θ, 0, cos θ)``.
 
 One implementation each: :func:`positions_to_frames` (numpy, data preparation) and
 :func:`frames_to_positions` (torch, differentiable; numpy in, numpy out), whose root integration
-:func:`integrate_root` is also what synthesis uses to place steps.
+:func:`integrate_root` is also what synthesis uses to place steps. The rotations about the vertical
+and the angle wrapping are those of :mod:`stylemotion.geometry`.
 """
 
 from __future__ import annotations
@@ -27,16 +28,21 @@ import numpy as np
 import torch
 from scipy.ndimage import gaussian_filter1d
 
-from stylemotion.skeleton import CJ
+from stylemotion.geometry import direction_yaw, rotate_yaw, rotate_yaw_torch, rotate_yaw_xz_torch, wrap_angle
+from stylemotion.skeleton import JOINT_INDEX, NUM_JOINTS
 
 #: Identifier of the 66-dim frame layout below; a model trained on one representation refuses data or
 #: checkpoints of another. Bump when the layout changes.
 REPRESENTATION = "stylemotion.frames66/v1"
-FRAME_DIM = 66
-JOINT_DIMS = slice(0, 63)
-VELOCITY_DIMS = slice(63, 65)
-YAW_RATE_DIM = 65
-ROOT_JOINT = CJ["Hips"]
+#: Values of the root-local joint positions in a frame (63: 21 joints × xyz).
+POSITION_DIM = 3 * NUM_JOINTS
+#: Values per frame (66): joint positions, root ground velocity (2), yaw rate (1).
+FRAME_DIM = POSITION_DIM + 3
+#: Where the parts of a frame lie in its values.
+JOINT_DIMS = slice(0, POSITION_DIM)
+VELOCITY_DIMS = slice(POSITION_DIM, POSITION_DIM + 2)
+YAW_RATE_DIM = POSITION_DIM + 2
+ROOT_JOINT = JOINT_INDEX["Hips"]
 
 
 def facing_yaw(positions: np.ndarray, fps: float, smooth_seconds: float = 0.15) -> np.ndarray:
@@ -51,27 +57,15 @@ def facing_yaw(positions: np.ndarray, fps: float, smooth_seconds: float = 0.15) 
     Returns:
         ``(..., frames)`` yaw in radians; the body faces ``(sin yaw, 0, cos yaw)``.
     """
-    across = (positions[..., CJ["UpperLeg_L"], :] - positions[..., CJ["UpperLeg_R"], :]) + (
-        positions[..., CJ["UpperArm_L"], :] - positions[..., CJ["UpperArm_R"], :]
+    across = (positions[..., JOINT_INDEX["UpperLeg_L"], :] - positions[..., JOINT_INDEX["UpperLeg_R"], :]) + (
+        positions[..., JOINT_INDEX["UpperArm_L"], :] - positions[..., JOINT_INDEX["UpperArm_R"], :]
     )
     # forward = across × up = (-a_z, 0, a_x)
     forward = np.stack([-across[..., 2], across[..., 0]], axis=-1)
     sigma = smooth_seconds * fps
     if sigma > 0 and forward.shape[-2] > 1:
         forward = gaussian_filter1d(forward, sigma, axis=-2, mode="nearest")
-    return np.arctan2(forward[..., 0], forward[..., 1])
-
-
-def _rotate_y(vectors: np.ndarray, yaw: np.ndarray) -> np.ndarray:
-    """Rotate ``(..., 3)`` vectors by ``yaw`` (broadcast over leading dims) about +Y."""
-    c, s = np.cos(yaw), np.sin(yaw)
-    x, y, z = vectors[..., 0], vectors[..., 1], vectors[..., 2]
-    return np.stack([c * x + s * z, y, -s * x + c * z], axis=-1)
-
-
-def wrap_angle(angle: np.ndarray) -> np.ndarray:
-    """Angles wrapped to ``[-π, π)``."""
-    return (angle + np.pi) % (2 * np.pi) - np.pi
+    return direction_yaw(forward)
 
 
 def positions_to_frames(
@@ -90,20 +84,20 @@ def positions_to_frames(
         where it was.
     """
     positions = np.asarray(positions, dtype=np.float64)
-    if positions.ndim != 3 or positions.shape[1:] != (21, 3):
-        raise ValueError(f"positions must be (frames, 21, 3), got {positions.shape}")
+    if positions.ndim != 3 or positions.shape[1:] != (NUM_JOINTS, 3):
+        raise ValueError(f"positions must be (frames, {NUM_JOINTS}, 3), got {positions.shape}")
     n = positions.shape[0]
     if n < 2:
         raise ValueError(f"a take needs at least 2 frames for velocities, got {n}")
     yaw = facing_yaw(positions, fps, smooth_seconds)
     root = positions[:, ROOT_JOINT, :].copy()
     root[:, 1] = 0.0
-    local = _rotate_y(positions - root[:, None, :], -yaw[:, None])
-    step = _rotate_y(root[1:] - root[:-1], -yaw[:-1]) * fps
+    local = rotate_yaw(positions - root[:, None, :], -yaw[:, None])
+    step = rotate_yaw(root[1:] - root[:-1], -yaw[:-1]) * fps
     velocity = np.concatenate([step[:, [0, 2]], step[-1:, [0, 2]]], axis=0)
     turn = wrap_angle(np.diff(yaw)) * fps
     yaw_rate = np.concatenate([turn, turn[-1:]])
-    frames = np.concatenate([local.reshape(n, 63), velocity, yaw_rate[:, None]], axis=1)
+    frames = np.concatenate([local.reshape(n, POSITION_DIM), velocity, yaw_rate[:, None]], axis=1)
     return frames.astype(np.float32), root[0, [0, 2]].copy(), float(yaw[0])
 
 
@@ -133,10 +127,8 @@ def integrate_root(
            else torch.as_tensor(start_xz, dtype=dtype, device=f.device).expand(lead + (2,)))
     turn = f[..., :-1, YAW_RATE_DIM] / fps
     yaw = torch.cat([yaw0.unsqueeze(-1), yaw0.unsqueeze(-1) + torch.cumsum(turn, dim=-1)], dim=-1)
-    cos, sin = torch.cos(yaw[..., :-1]), torch.sin(yaw[..., :-1])
     vx, vz = f[..., :-1, VELOCITY_DIMS.start] / fps, f[..., :-1, VELOCITY_DIMS.start + 1] / fps
-    # world step = R_y(yaw) (vx, 0, vz)
-    step = torch.stack([cos * vx + sin * vz, -sin * vx + cos * vz], dim=-1)
+    step = rotate_yaw_xz_torch(torch.stack([vx, vz], dim=-1), yaw[..., :-1])  # world step = R_y(yaw) (vx, 0, vz)
     root_xz = torch.cat([xz0.unsqueeze(-2), xz0.unsqueeze(-2) + torch.cumsum(step, dim=-2)], dim=-2)
     return root_xz, yaw
 
@@ -167,9 +159,8 @@ def frames_to_positions(
         dtype = torch.float64  # integrate in double precision for numpy callers
     f = f.to(dtype)
     root_xz, yaw = integrate_root(f, fps, start_xz, start_yaw)
-    local = f[..., JOINT_DIMS].reshape(f.shape[:-1] + (21, 3))
-    c, s = torch.cos(yaw).unsqueeze(-1), torch.sin(yaw).unsqueeze(-1)
-    x = c * local[..., 0] + s * local[..., 2] + root_xz[..., :1]
-    z = -s * local[..., 0] + c * local[..., 2] + root_xz[..., 1:]
+    local = rotate_yaw_torch(f[..., JOINT_DIMS].reshape(f.shape[:-1] + (NUM_JOINTS, 3)), yaw.unsqueeze(-1))
+    x = local[..., 0] + root_xz[..., :1]
+    z = local[..., 2] + root_xz[..., 1:]
     positions = torch.stack([x, local[..., 1], z], dim=-1)
     return positions.numpy() if as_numpy else positions

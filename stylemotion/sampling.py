@@ -26,7 +26,8 @@ import numpy as np
 import torch
 
 from stylemotion.primitives import restore_duration
-from stylemotion.representation import frames_to_positions
+from stylemotion.representation import FRAME_DIM, frames_to_positions
+from stylemotion.skeleton import NUM_JOINTS
 
 #: Samples decoded by the autoencoder at once (bounds peak memory: ~60 MB per 1,000 at 256 × 9).
 DEFAULT_CHUNK = 4096
@@ -102,12 +103,12 @@ def decode_features(autoencoder, features: torch.Tensor, duration_s: torch.Tenso
     if n and not bool((duration_s > 0).all()):
         raise ValueError("durations must be positive")
     normalized = torch.cat([autoencoder.decode(features[i:i + chunk_size], timeline_frames).float().cpu()
-                            for i in range(0, n, chunk_size)]) if n else torch.zeros(0, timeline_frames, 66)
+                            for i in range(0, n, chunk_size)]) if n else torch.zeros(0, timeline_frames, FRAME_DIM)
     # restore_duration's length rule, computed in double precision like Python floats
     lengths = torch.clamp(torch.round(duration_s.double() * fps).long() + 1, min=2)
     width = int(lengths.max()) if n else 2
     frames = torch.empty(n, width, normalized.shape[-1])
-    positions = torch.empty(n, width, 21, 3)
+    positions = torch.empty(n, width, NUM_JOINTS, 3)
     num_frames = torch.empty(n, dtype=torch.int64)
     normalized_np = normalized.numpy()
     for length in torch.unique(lengths).tolist():

@@ -29,6 +29,8 @@ CANONICAL_JOINTS: tuple[str, ...] = (
     "UpperLeg_L", "LowerLeg_L", "Foot_L", "Toes_L",
     "UpperLeg_R", "LowerLeg_R", "Foot_R", "Toes_R",
 )  # fmt: skip
+#: Number of canonical joints (21).
+NUM_JOINTS = len(CANONICAL_JOINTS)
 
 _CANONICAL_PARENT_NAMES: dict[str, str | None] = {
     "Hips": None, "Spine": "Hips", "Chest": "Spine", "Neck": "Chest", "Head": "Neck",
@@ -46,12 +48,12 @@ CANONICAL_PARENTS: tuple[int, ...] = tuple(
     for n in CANONICAL_JOINTS
 )
 
-#: Index of a canonical joint by name.
-CJ = {name: i for i, name in enumerate(CANONICAL_JOINTS)}
+#: Index of a canonical joint by name, e.g. ``JOINT_INDEX["Hips"] == 0``.
+JOINT_INDEX: dict[str, int] = {name: i for i, name in enumerate(CANONICAL_JOINTS)}
 
 #: Left/right joint index pairs of the canonical skeleton (for mirroring and symmetry checks).
-CANONICAL_MIRROR = tuple(CJ[n.replace("_L", "_R")] if n.endswith("_L") else
-                         CJ[n.replace("_R", "_L")] if n.endswith("_R") else CJ[n]
+CANONICAL_MIRROR = tuple(JOINT_INDEX[n.replace("_L", "_R")] if n.endswith("_L") else
+                         JOINT_INDEX[n.replace("_R", "_L")] if n.endswith("_R") else JOINT_INDEX[n]
                          for n in CANONICAL_JOINTS)  # fmt: skip
 
 

@@ -15,7 +15,7 @@ from stylemotion.export import positions_to_motion, write_motion_bvh
 from stylemotion.ik import fit_rotations, rest_offsets
 from stylemotion.io.bvh import read_bvh
 from stylemotion.io.sources import FileSource
-from stylemotion.skeleton import CANONICAL_JOINTS, CANONICAL_PARENTS, CJ, bone_lengths, forward_kinematics
+from stylemotion.skeleton import CANONICAL_JOINTS, CANONICAL_PARENTS, JOINT_INDEX, bone_lengths, forward_kinematics
 
 LEAVES = [j for j in range(len(CANONICAL_PARENTS)) if j not in CANONICAL_PARENTS]
 
@@ -86,10 +86,11 @@ def test_rest_pose_is_an_upright_t_pose() -> None:
     np.testing.assert_allclose(np.linalg.norm(offsets, axis=1)[1:], np.median(bone_lengths(positions), axis=0)[1:])
     unit = offsets / np.maximum(np.linalg.norm(offsets, axis=1, keepdims=True), 1e-12)
     for name, axis in [("Spine", 1), ("Neck", 1), ("Head", 1), ("LowerArm_L", 0), ("Toes_R", 2)]:
-        assert unit[CJ[name], axis] == pytest.approx(1.0), name
-    assert unit[CJ["LowerArm_R"], 0] == pytest.approx(-1.0) and unit[CJ["Foot_L"], 1] == pytest.approx(-1.0)
-    assert offsets[CJ["UpperLeg_L"], 0] > 0 > offsets[CJ["UpperLeg_R"], 0]  # left is +X
-    assert offsets[CJ["Shoulder_L"], 0] > 0 > offsets[CJ["Shoulder_R"], 0]
+        assert unit[JOINT_INDEX[name], axis] == pytest.approx(1.0), name
+    assert unit[JOINT_INDEX["LowerArm_R"], 0] == pytest.approx(-1.0)
+    assert unit[JOINT_INDEX["Foot_L"], 1] == pytest.approx(-1.0)
+    assert offsets[JOINT_INDEX["UpperLeg_L"], 0] > 0 > offsets[JOINT_INDEX["UpperLeg_R"], 0]  # left is +X
+    assert offsets[JOINT_INDEX["Shoulder_L"], 0] > 0 > offsets[JOINT_INDEX["Shoulder_R"], 0]
 
 
 # ---------------------------------------------------------------------------------------------
@@ -108,7 +109,7 @@ def test_bandai_take_round_trips_through_the_loader(bandai_positions: np.ndarray
     assert written.num_frames == bandai_positions.shape[0]
     motion = read_bvh(path)
     assert motion.skeleton.names == list(CANONICAL_JOINTS) and motion.fps == 30.0
-    assert motion.skeleton.channels[CJ["Hips"]] == ["Xposition", "Yposition", "Zposition",
+    assert motion.skeleton.channels[JOINT_INDEX["Hips"]] == ["Xposition", "Yposition", "Zposition",
                                                     "Zrotation", "Xrotation", "Yrotation"]
     assert sorted(motion.skeleton.end_sites) == sorted(LEAVES)
     joint_map = resolve_joint_map(None, motion)  # auto-detection picks the identity (Bandai) map, metres
@@ -153,11 +154,11 @@ def test_bad_input_is_named(tmp_path: Path) -> None:
     with pytest.raises(ValueError, match=r"shape \(frames, 21, 3\).*\(21, 3\)"):
         positions_to_motion(positions[0], fps=30.0)
     bad = positions.copy()
-    bad[3, CJ["Hand_L"], 1] = np.nan
+    bad[3, JOINT_INDEX["Hand_L"], 1] = np.nan
     with pytest.raises(ValueError, match=r"NaN.*frame 3, joint 'Hand_L'"):
         fit_rotations(bad)
     bad = positions.copy()
-    bad[5:7, CJ["Hand_L"]] = bad[5:7, CJ["LowerArm_L"]]
+    bad[5:7, JOINT_INDEX["Hand_L"]] = bad[5:7, JOINT_INDEX["LowerArm_L"]]
     with pytest.raises(ValueError, match=r"'LowerArm_L'→'Hand_L' has zero length.*2 frame\(s\), first at frame 5"):
         write_motion_bvh(bad, tmp_path / "never-written.bvh", fps=30.0)
     assert not any(tmp_path.iterdir())
@@ -166,6 +167,6 @@ def test_bad_input_is_named(tmp_path: Path) -> None:
     with pytest.raises(ValueError, match=r"offsets must have shape \(21, 3\)"):
         fit_rotations(positions, offsets=np.ones((20, 3)))
     zero_bone = rest_offsets(positions)
-    zero_bone[CJ["Toes_R"]] = 0.0
+    zero_bone[JOINT_INDEX["Toes_R"]] = 0.0
     with pytest.raises(ValueError, match=r"offsets: bone 'Foot_R'→'Toes_R' has zero length"):
         fit_rotations(positions, offsets=zero_bone)

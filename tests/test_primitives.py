@@ -10,6 +10,7 @@ import pytest
 
 from stylemotion.datasets import Take, TakeSet, load_dataset
 from stylemotion.datasets.synthetic import STYLES, SyntheticTake, generate_take
+from stylemotion.geometry import rotate_yaw
 from stylemotion.primitives import (
     PRIMITIVES,
     STANCE_FOOT,
@@ -27,7 +28,7 @@ from stylemotion.primitives import (
     time_normalize,
 )
 from stylemotion.representation import facing_yaw, frames_to_positions
-from stylemotion.skeleton import CANONICAL_MIRROR, CJ
+from stylemotion.skeleton import CANONICAL_MIRROR, JOINT_INDEX
 
 LOCOMOTION = ["walk", "walk-turn-left", "walk-turn-right", "run"]
 
@@ -100,14 +101,12 @@ def test_clip_starts_at_origin_facing_z_and_keeps_its_shape() -> None:
     clip = seg.clips[len(seg.clips) // 2]
     p = clip.positions
     assert p.shape == (clip.num_frames, 21, 3)
-    np.testing.assert_allclose(p[0, CJ["Hips"], [0, 2]], 0.0, atol=1e-5)
+    np.testing.assert_allclose(p[0, JOINT_INDEX["Hips"], [0, 2]], 0.0, atol=1e-5)
     assert abs(facing_yaw(p, clip.fps, smooth_seconds=0.0)[0]) < 0.15
     source = g.positions[clip.start:clip.stop].astype(np.float64)
     yaw0 = facing_yaw(g.positions, g.fps)[clip.start]
-    c, s = np.cos(-yaw0), np.sin(-yaw0)
-    centred = source - np.array([source[0, CJ["Hips"], 0], 0.0, source[0, CJ["Hips"], 2]])
-    rotated = np.stack([c * centred[..., 0] + s * centred[..., 2], centred[..., 1],
-                        -s * centred[..., 0] + c * centred[..., 2]], axis=-1)
+    centred = source - np.array([source[0, JOINT_INDEX["Hips"], 0], 0.0, source[0, JOINT_INDEX["Hips"], 2]])
+    rotated = rotate_yaw(centred, -yaw0)
     np.testing.assert_allclose(p, rotated, atol=2e-3)  # a rigid placement of the source frames
 
 
@@ -181,9 +180,9 @@ def test_take_too_short_no_contact_one_foot() -> None:
     one = np.repeat(pose[None], 40, 0).copy()
     angle = np.linspace(0, 4 * np.pi, 40)
     for joint in ("Foot_R", "Toes_R"):  # the right foot circles 15 cm off the ground at ~1.5 m/s
-        one[:, CJ[joint], 0] += 0.2 * np.cos(angle)
-        one[:, CJ[joint], 2] += 0.2 * np.sin(angle)
-        one[:, CJ[joint], 1] += 0.15
+        one[:, JOINT_INDEX[joint], 0] += 0.2 * np.cos(angle)
+        one[:, JOINT_INDEX[joint], 2] += 0.2 * np.sin(angle)
+        one[:, JOINT_INDEX[joint], 1] += 0.15
     only = segment_take(as_take(g, one))
     assert not only.clips and "only the left foot touches the ground" in only.rejections[0].reason
 
@@ -244,7 +243,8 @@ def test_time_normalization_keeps_duration_and_physical_velocities() -> None:
             np.testing.assert_allclose(normalized[-1, :63], clip.frames[-1, :63], atol=1e-6)
             # velocities stay m/s and rad/s: played back over the real duration the root ends where it did
             replay = frames_to_positions(normalized, playback_fps(length, clip.duration_s))
-            np.testing.assert_allclose(replay[-1, CJ["Hips"]], clip.positions[-1, CJ["Hips"]], atol=0.01)
+            hips = JOINT_INDEX["Hips"]
+            np.testing.assert_allclose(replay[-1, hips], clip.positions[-1, hips], atol=0.01)
             # (a per-frame velocity would be off by the ratio of frame rates, far beyond 1 cm)
             back = restore_duration(normalized, clip.duration_s, clip.fps)
             assert back.shape == clip.frames.shape

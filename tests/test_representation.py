@@ -10,6 +10,7 @@ import torch
 from conftest import BANDAI_MEMBERS
 
 from stylemotion.canonical import to_canonical_positions
+from stylemotion.geometry import rotation_y
 from stylemotion.io.bvh import parse_bvh, read_bvh
 from stylemotion.representation import (
     FRAME_DIM,
@@ -19,16 +20,10 @@ from stylemotion.representation import (
     frames_to_positions,
     positions_to_frames,
 )
-from stylemotion.skeleton import CANONICAL_JOINTS, CJ
+from stylemotion.skeleton import CANONICAL_JOINTS, JOINT_INDEX
 
 ROUND_TRIP_TOL_M = 1e-3
 FPS = 30.0
-
-
-def rotation_y(angle: float) -> np.ndarray:
-    """Matrix of a rotation by ``angle`` about +Y (right-handed: +Z turns towards +X)."""
-    c, s = np.cos(angle), np.sin(angle)
-    return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
 
 
 def static_pose() -> np.ndarray:
@@ -99,7 +94,7 @@ def test_round_trip_long_bandai_walk(longest_bandai_walk):
     member, positions = longest_bandai_walk
     if positions.shape[0] < 10 * FPS:
         pytest.skip(f"longest Bandai walk {member} is only {positions.shape[0] / FPS:.1f} s")
-    travelled = np.linalg.norm(positions[-1, CJ["Hips"], [0, 2]] - positions[0, CJ["Hips"], [0, 2]])
+    travelled = np.linalg.norm(positions[-1, JOINT_INDEX["Hips"], [0, 2]] - positions[0, JOINT_INDEX["Hips"], [0, 2]])
     assert travelled > 2.0  # a real walk: the root integration is exercised over metres
     err = _round_trip_error(positions)
     assert err <= ROUND_TRIP_TOL_M, f"{member}: round trip error {err:.3g} m"
@@ -213,12 +208,12 @@ def test_torch_path_is_differentiable():
     np.testing.assert_allclose(out.detach().numpy(), frames_to_positions(frames_np, FPS, xz, yaw), atol=1e-12)
     np.testing.assert_allclose(out.detach().numpy(), positions, atol=1e-5)
     # Where the last frame's hand is depends on every earlier velocity and yaw rate.
-    out[-1, CJ["Hand_L"]].sum().backward()
+    out[-1, JOINT_INDEX["Hand_L"]].sum().backward()
     grad = frames.grad
     assert grad is not None and torch.isfinite(grad).all()
     assert torch.all(grad[:-1, VELOCITY_DIMS].abs().sum(dim=-1) > 0)
     assert torch.all(grad[:-1, YAW_RATE_DIM].abs() > 0)
-    assert grad[-1, 3 * CJ["Hand_L"] : 3 * CJ["Hand_L"] + 3].abs().sum() > 0
+    assert grad[-1, 3 * JOINT_INDEX["Hand_L"] : 3 * JOINT_INDEX["Hand_L"] + 3].abs().sum() > 0
     assert grad[-1, VELOCITY_DIMS].abs().sum() == 0  # the last frame's velocity is not integrated
     assert start_xz.grad.abs().sum() > 0 and start_yaw.grad.abs() > 0
 

@@ -51,6 +51,7 @@ from stylemotion.primitives import (
     segment_takes,
     time_normalize,
 )
+from stylemotion.representation import FRAME_DIM
 
 log = logging.getLogger(__name__)
 
@@ -80,7 +81,7 @@ class ClipDataset(Dataset):
         self.length = length
         style_index = {s: i for i, s in enumerate(style_names)}
         frames = [time_normalize(c.frames, length) for c in self.clips]
-        self.frames = torch.from_numpy(np.stack(frames)) if frames else torch.zeros(0, length, 66)
+        self.frames = torch.from_numpy(np.stack(frames)) if frames else torch.zeros(0, length, FRAME_DIM)
         self.duration_s = torch.tensor([c.duration_s for c in self.clips], dtype=torch.float32)
         self.style = torch.tensor([style_index[c.style] for c in self.clips], dtype=torch.int64)
         self.primitive = torch.tensor([PRIMITIVES.index(c.primitive) for c in self.clips], dtype=torch.int64)

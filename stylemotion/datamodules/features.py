@@ -52,7 +52,7 @@ from stylemotion.models.checkpoints import autoencoder_info, load_autoencoder
 from stylemotion.primitives import ACTIONS, PRIMITIVES, Clip, time_normalize
 from stylemotion.representation import FRAME_DIM, REPRESENTATION
 from stylemotion.sampling import pad_motions
-from stylemotion.skeleton import CANONICAL_JOINTS
+from stylemotion.skeleton import CANONICAL_JOINTS, NUM_JOINTS
 
 log = logging.getLogger(__name__)
 
@@ -151,7 +151,7 @@ class FeatureDataset(Dataset):
         if self.clips:
             self.positions, self.num_frames = pad_motions([c.positions for c in self.clips])
         else:
-            self.positions, self.num_frames = torch.zeros(0, 2, 21, 3), torch.zeros(0, dtype=torch.int64)
+            self.positions, self.num_frames = torch.zeros(0, 2, NUM_JOINTS, 3), torch.zeros(0, dtype=torch.int64)
         assert features.shape[1:] == (channels, steps) or not self.clips
 
     def __len__(self) -> int:

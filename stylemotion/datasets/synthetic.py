@@ -38,7 +38,16 @@ import numpy as np
 from scipy.interpolate import CubicSpline
 from scipy.special import logsumexp
 
-from stylemotion.skeleton import CANONICAL_PARENTS, CJ, forward_kinematics
+from stylemotion.geometry import (
+    facing_direction,
+    left_direction,
+    local_rotations,
+    rotation_x,
+    rotation_y,
+    rotation_z,
+    two_bone_ik,
+)
+from stylemotion.skeleton import CANONICAL_PARENTS, JOINT_INDEX, NUM_JOINTS, forward_kinematics
 
 CONTENTS: tuple[str, ...] = ("walk", "walk-turn-left", "walk-turn-right", "run")
 
@@ -304,16 +313,6 @@ def _heading_for(content: str, duration: float, rng: np.random.Generator) -> _He
     )
 
 
-def _forward(yaw: np.ndarray) -> np.ndarray:
-    """Ground direction ``(..., 2)`` (x, z) faced at ``yaw`` ``(...)``."""
-    return np.stack([np.sin(yaw), np.cos(yaw)], axis=-1)
-
-
-def _left(yaw: np.ndarray) -> np.ndarray:
-    """Ground direction ``(..., 2)`` (x, z) of the body's left at ``yaw`` ``(...)``."""
-    return np.stack([np.cos(yaw), -np.sin(yaw)], axis=-1)
-
-
 def _plan_steps(gait: _Gait, heading: _Heading, start: float, end: float, rng: np.random.Generator) -> _Steps:
     """Footfalls covering ``[start, end]`` seconds with per-step random length, width and timing."""
     s = gait.style
@@ -327,9 +326,9 @@ def _plan_steps(gait: _Gait, heading: _Heading, start: float, end: float, rng: n
     stance = 2 * gait.stance * durations
     over = times + gait.pelvis_over * stance
     yaw = heading(over) + 0.02 * noise[3]
-    advance = lengths[1:, None] * _forward(heading((over[:-1] + over[1:]) / 2))
+    advance = lengths[1:, None] * facing_direction(heading((over[:-1] + over[1:]) / 2))
     centre = np.concatenate([np.zeros((1, 2)), np.cumsum(advance, axis=0)])
-    lateral = sides[:, None] * _left(yaw)
+    lateral = sides[:, None] * left_direction(yaw)
     return _Steps(
         times=times,
         lift_off=times + stance,
@@ -384,7 +383,7 @@ def _foot_track(steps: _Steps, side: float, t: np.ndarray, gait: _Gait) -> _Foot
     foot_yaw = yaw[j] + progress * (yaw[j + 1] - yaw[j])
     clearance = max(0.0, _FEET_CLEARANCE * gait.scale - gait.style.step_width)
     ground = feet[j] + progress[:, None] * (feet[j + 1] - feet[j])
-    ground += side * clearance * np.sin(np.pi * u)[:, None] * _left(foot_yaw)
+    ground += side * clearance * np.sin(np.pi * u)[:, None] * left_direction(foot_yaw)
     peak_u = u ** (np.log(0.5) / np.log(gait.lift_peak))  # maps lift_peak to 0.5
     ankle_y = gait.scale * _ANKLE_HEIGHT + gait.style.lift * 16 * peak_u**2 * (1 - peak_u) ** 2
     ankle = np.stack([ground[:, 0], ankle_y, ground[:, 1]], axis=-1)
@@ -401,43 +400,25 @@ def _toes(ankle: np.ndarray, foot_yaw: np.ndarray, swing: np.ndarray, gait: _Gai
     length, rest_angle = np.hypot(foot[1], foot[2]), np.arctan2(-foot[1], foot[2])
     lowest = np.arcsin(np.clip((ankle[:, 1] - gait.scale * _TOE_HEIGHT) / length, -1, 1)) - rest_angle
     pitch = np.minimum(gait.toe_pitch * np.sin(2 * np.pi * swing), lowest)
-    return ankle + np.einsum("nab,b->na", _rot_y(foot_yaw) @ _rot_x(pitch), foot)
-
-
-def _rot_x(a: np.ndarray) -> np.ndarray:
-    """Rotations ``(..., 3, 3)`` about +X by ``a`` (positive tips +Y towards +Z: leaning forward)."""
-    c, s, o, i = np.cos(a), np.sin(a), np.zeros_like(a), np.ones_like(a)
-    return np.stack([i, o, o, o, c, -s, o, s, c], axis=-1).reshape(np.shape(a) + (3, 3))
-
-
-def _rot_y(a: np.ndarray) -> np.ndarray:
-    """Rotations ``(..., 3, 3)`` about +Y by ``a`` (positive turns +Z towards +X: a left turn)."""
-    c, s, o, i = np.cos(a), np.sin(a), np.zeros_like(a), np.ones_like(a)
-    return np.stack([c, o, s, o, i, o, -s, o, c], axis=-1).reshape(np.shape(a) + (3, 3))
-
-
-def _rot_z(a: np.ndarray) -> np.ndarray:
-    """Rotations ``(..., 3, 3)`` about +Z by ``a`` (positive raises +X: the body's left side)."""
-    c, s, o, i = np.cos(a), np.sin(a), np.zeros_like(a), np.ones_like(a)
-    return np.stack([c, -s, o, s, c, o, o, o, i], axis=-1).reshape(np.shape(a) + (3, 3))
+    return ankle + np.einsum("nab,b->na", rotation_y(foot_yaw) @ rotation_x(pitch), foot)
 
 
 def _rest_offsets(gait: _Gait) -> np.ndarray:
     """``(21, 3)`` rest offsets of each joint from its parent, metres, scaled to the take's body."""
     s = gait.style
-    offsets = np.zeros((21, 3))
+    offsets = np.zeros((NUM_JOINTS, 3))
     for side, suffix in ((1.0, "_L"), (-1.0, "_R")):
         mirror = np.array([side, 1.0, 1.0])
-        offsets[CJ["Shoulder" + suffix]] = _CLAVICLE_BASE * mirror
-        offsets[CJ["UpperArm" + suffix]] = [side * s.clavicle, 0.0, 0.0]
-        offsets[CJ["LowerArm" + suffix]] = [0.0, -_UPPER_ARM, 0.0]
-        offsets[CJ["Hand" + suffix]] = [0.0, -_FOREARM, 0.0]
-        offsets[CJ["UpperLeg" + suffix]] = [side * s.hip_width, -_PELVIS_DROP, 0.0]
-        offsets[CJ["LowerLeg" + suffix]] = [0.0, -_THIGH, 0.0]
-        offsets[CJ["Foot" + suffix]] = [0.0, -_SHIN, 0.0]
-        offsets[CJ["Toes" + suffix]] = _FOOT
-    offsets[CJ["Spine"]], offsets[CJ["Chest"]] = _SPINE, _CHEST
-    offsets[CJ["Neck"]], offsets[CJ["Head"]] = _NECK, _HEAD
+        offsets[JOINT_INDEX["Shoulder" + suffix]] = _CLAVICLE_BASE * mirror
+        offsets[JOINT_INDEX["UpperArm" + suffix]] = [side * s.clavicle, 0.0, 0.0]
+        offsets[JOINT_INDEX["LowerArm" + suffix]] = [0.0, -_UPPER_ARM, 0.0]
+        offsets[JOINT_INDEX["Hand" + suffix]] = [0.0, -_FOREARM, 0.0]
+        offsets[JOINT_INDEX["UpperLeg" + suffix]] = [side * s.hip_width, -_PELVIS_DROP, 0.0]
+        offsets[JOINT_INDEX["LowerLeg" + suffix]] = [0.0, -_THIGH, 0.0]
+        offsets[JOINT_INDEX["Foot" + suffix]] = [0.0, -_SHIN, 0.0]
+        offsets[JOINT_INDEX["Toes" + suffix]] = _FOOT
+    offsets[JOINT_INDEX["Spine"]], offsets[JOINT_INDEX["Chest"]] = _SPINE, _CHEST
+    offsets[JOINT_INDEX["Neck"]], offsets[JOINT_INDEX["Head"]] = _NECK, _HEAD
     return offsets * gait.scale
 
 
@@ -453,7 +434,7 @@ def _pelvis_rotation(gait: _Gait, yaw: np.ndarray, phase: np.ndarray) -> np.ndar
     forward with a third of the torso lean.
     """
     twist = -gait.style.pelvis_twist * np.cos(2 * np.pi * phase)  # left hip forward at left footfall
-    return _rot_y(yaw + twist) @ _rot_z(_pelvis_roll(gait, phase)) @ _rot_x(0.3 * gait.style.lean)
+    return rotation_y(yaw + twist) @ rotation_z(_pelvis_roll(gait, phase)) @ rotation_x(0.3 * gait.style.lean)
 
 
 def _global_rotations(gait: _Gait, yaw: np.ndarray, phase: np.ndarray) -> np.ndarray:
@@ -467,25 +448,26 @@ def _global_rotations(gait: _Gait, yaw: np.ndarray, phase: np.ndarray) -> np.nda
     s = gait.style
     cycle = np.cos(2 * np.pi * phase)  # +1 when the left foot lands (left leg forward)
     chest_yaw = yaw + s.chest_twist * cycle  # shoulders counter-rotate
-    rotations = np.empty(yaw.shape + (21, 3, 3))
-    rotations[:, CJ["Hips"]] = _pelvis_rotation(gait, yaw, phase)
-    rotations[:, CJ["Spine"]] = _rot_y(yaw + (s.chest_twist - s.pelvis_twist) / 2 * cycle) @ _rot_x(0.5 * s.lean)
+    rotations = np.empty(yaw.shape + (NUM_JOINTS, 3, 3))
+    rotations[:, JOINT_INDEX["Hips"]] = _pelvis_rotation(gait, yaw, phase)
+    spine_yaw = yaw + (s.chest_twist - s.pelvis_twist) / 2 * cycle
+    rotations[:, JOINT_INDEX["Spine"]] = rotation_y(spine_yaw) @ rotation_x(0.5 * s.lean)
     pelvis_roll = _pelvis_roll(gait, phase)
-    chest = _rot_y(chest_yaw) @ _rot_z(-0.5 * pelvis_roll) @ _rot_x(s.lean)
-    rotations[:, CJ["Chest"]] = chest
-    rotations[:, CJ["Neck"]] = _rot_y(yaw + 0.3 * s.chest_twist * cycle) @ _rot_x(s.lean + s.head_drop)
-    rotations[:, CJ["Head"]] = rotations[:, CJ["Neck"]]
+    chest = rotation_y(chest_yaw) @ rotation_z(-0.5 * pelvis_roll) @ rotation_x(s.lean)
+    rotations[:, JOINT_INDEX["Chest"]] = chest
+    rotations[:, JOINT_INDEX["Neck"]] = rotation_y(yaw + 0.3 * s.chest_twist * cycle) @ rotation_x(s.lean + s.head_drop)
+    rotations[:, JOINT_INDEX["Head"]] = rotations[:, JOINT_INDEX["Neck"]]
     for side, suffix in ((1.0, "_L"), (-1.0, "_R")):
-        shoulder = chest @ _rot_y(-side * s.shoulder_protraction) @ _rot_z(-side * s.shoulder_droop)
+        shoulder = chest @ rotation_y(-side * s.shoulder_protraction) @ rotation_z(-side * s.shoulder_droop)
         flexion = s.arm_forward - side * s.arm_swing * cycle  # left arm back when the left leg leads
-        upper = _rot_y(chest_yaw) @ _rot_z(side * s.arm_abduction * np.ones_like(yaw)) @ _rot_x(-flexion)
-        lower = upper @ _rot_x(-(s.elbow + 0.5 * np.maximum(flexion, 0.0)))
-        rotations[:, CJ["Shoulder" + suffix]] = shoulder
-        rotations[:, CJ["UpperArm" + suffix]] = upper
-        rotations[:, CJ["LowerArm" + suffix]] = lower
-        rotations[:, CJ["Hand" + suffix]] = lower
+        upper = rotation_y(chest_yaw) @ rotation_z(side * s.arm_abduction * np.ones_like(yaw)) @ rotation_x(-flexion)
+        lower = upper @ rotation_x(-(s.elbow + 0.5 * np.maximum(flexion, 0.0)))
+        rotations[:, JOINT_INDEX["Shoulder" + suffix]] = shoulder
+        rotations[:, JOINT_INDEX["UpperArm" + suffix]] = upper
+        rotations[:, JOINT_INDEX["LowerArm" + suffix]] = lower
+        rotations[:, JOINT_INDEX["Hand" + suffix]] = lower
         for leg in ("UpperLeg", "LowerLeg", "Foot", "Toes"):
-            rotations[:, CJ[leg + suffix]] = rotations[:, CJ["Hips"]]
+            rotations[:, JOINT_INDEX[leg + suffix]] = rotations[:, JOINT_INDEX["Hips"]]
     return rotations
 
 
@@ -540,7 +522,7 @@ def _pelvis_height(
         + _bob(gait, pelvis.phase(t))
     ]  # fmt: skip
     for foot, joint in zip(feet, ("UpperLeg_L", "UpperLeg_R"), strict=True):
-        offset = offsets[CJ[joint]]
+        offset = offsets[JOINT_INDEX[joint]]
         planted = _pelvis_limit(gait, pelvis, t, offset, foot.spots[0])
         lifted = _pelvis_limit(gait, pelvis, foot.lift_time, offset, foot.spots[0])
         landing = _pelvis_limit(gait, pelvis, foot.land_time, offset, foot.spots[1])
@@ -563,41 +545,17 @@ def _within_reach(foot: _Foot, hip: np.ndarray, legs: float, gait: _Gait) -> _Fo
     return dataclasses.replace(foot, ankle=ankle, toes=_toes(ankle, foot.yaw, foot.swing, gait))
 
 
-def _two_bone_ik(hip: np.ndarray, ankle: np.ndarray, pole: np.ndarray, upper: float, lower: float) -> np.ndarray:
-    """Knee positions ``(n, 3)`` with ``|knee − hip| = upper`` and ``|ankle − knee| = lower``.
-
-    The knee bends towards ``pole`` ``(n, 3)`` (a direction). ``hip`` and ``ankle`` are ``(n, 3)``
-    positions at most ``upper + lower`` apart.
-    """
-    reach = ankle - hip
-    dist = np.linalg.norm(reach, axis=-1, keepdims=True)
-    axis = reach / dist
-    along = (upper**2 - lower**2 + dist**2) / (2 * dist)
-    across = np.sqrt(np.maximum(upper**2 - along**2, 0.0))
-    bend = pole - np.sum(pole * axis, axis=-1, keepdims=True) * axis
-    bend /= np.linalg.norm(bend, axis=-1, keepdims=True)
-    return hip + along * axis + across * bend
-
-
-def _local_rotations(global_rot: np.ndarray) -> np.ndarray:
-    """Local rotations ``(n, 21, 3, 3)`` from global ones on the canonical skeleton."""
-    parents = np.array([max(p, 0) for p in CANONICAL_PARENTS])
-    local = np.swapaxes(global_rot[:, parents], -1, -2) @ global_rot
-    local[:, CJ["Hips"]] = global_rot[:, CJ["Hips"]]
-    return local
-
-
 def _pose_legs(positions: np.ndarray, feet: list[_Foot], gait: _Gait) -> None:
     """Write knees, ankles and toes into ``positions`` ``(n, 21, 3)`` (hip joints already posed)."""
     for foot, suffix in zip(feet, ("_L", "_R"), strict=True):
-        hip = positions[:, CJ["UpperLeg" + suffix]]
+        hip = positions[:, JOINT_INDEX["UpperLeg" + suffix]]
         foot = _within_reach(foot, hip, (_THIGH + _SHIN) * gait.scale, gait)
         pole = np.stack([np.sin(foot.yaw), np.zeros_like(foot.yaw), np.cos(foot.yaw)], axis=-1)
-        positions[:, CJ["LowerLeg" + suffix]] = _two_bone_ik(
-            hip, foot.ankle, pole, _THIGH * gait.scale, _SHIN * gait.scale
-        )
-        positions[:, CJ["Foot" + suffix]] = foot.ankle
-        positions[:, CJ["Toes" + suffix]] = foot.toes
+        positions[:, JOINT_INDEX["LowerLeg" + suffix]] = two_bone_ik(
+            hip, foot.ankle, pole, _THIGH * gait.scale, _SHIN * gait.scale, law="distances"
+        )[0]
+        positions[:, JOINT_INDEX["Foot" + suffix]] = foot.ankle
+        positions[:, JOINT_INDEX["Toes" + suffix]] = foot.toes
 
 
 def generate_take(
@@ -638,11 +596,11 @@ def generate_take(
     global_rot = _global_rotations(gait, heading(t), pelvis.phase(t))
     ground = pelvis.ground(t)
     height = _pelvis_height(gait, pelvis, t, feet, offsets)
-    translations = np.broadcast_to(offsets, (num_frames, 21, 3)).copy()
-    translations[:, CJ["Hips"]] = np.stack([ground[:, 0], height, ground[:, 1]], axis=-1)
-    positions = forward_kinematics(_local_rotations(global_rot), translations, CANONICAL_PARENTS)
+    translations = np.broadcast_to(offsets, (num_frames, NUM_JOINTS, 3)).copy()
+    translations[:, JOINT_INDEX["Hips"]] = np.stack([ground[:, 0], height, ground[:, 1]], axis=-1)
+    positions = forward_kinematics(local_rotations(global_rot, CANONICAL_PARENTS), translations, CANONICAL_PARENTS)
     _pose_legs(positions, feet, gait)
-    positions[:, :, [0, 2]] -= positions[0, CJ["Hips"], [0, 2]]
+    positions[:, :, [0, 2]] -= positions[0, JOINT_INDEX["Hips"], [0, 2]]
     return SyntheticTake(
         name=f"synthetic_{content}_{style}_{index:03d}",
         positions=positions.astype(np.float32),

@@ -15,6 +15,8 @@ from scipy import linalg
 from scipy.spatial.distance import pdist
 
 from stylemotion.contacts import foot_contacts, planted_point_speed
+from stylemotion.representation import FRAME_DIM, JOINT_DIMS
+from stylemotion.skeleton import NUM_JOINTS
 
 #: Planted-point speed (m/s) above which a foot in contact counts as skating.
 SKATE_SPEED_MPS = 0.2
@@ -79,9 +81,9 @@ def pose_sequences(normalized_frames: np.ndarray) -> np.ndarray:
         metres (frame values ``[0:63]``; the root path is left out).
     """
     f = np.asarray(normalized_frames, dtype=np.float64)
-    if f.ndim != 3 or f.shape[-1] != 66:
-        raise ValueError(f"normalized frames must be (n, length, 66), got {f.shape}")
-    return f[..., :63].reshape(len(f), -1)
+    if f.ndim != 3 or f.shape[-1] != FRAME_DIM:
+        raise ValueError(f"normalized frames must be (n, length, {FRAME_DIM}), got {f.shape}")
+    return f[..., JOINT_DIMS].reshape(len(f), -1)
 
 
 def nearest_distances(query: np.ndarray, reference: np.ndarray, chunk: int = 1024) -> np.ndarray:
@@ -171,8 +173,8 @@ def foot_skating(positions: np.ndarray, num_frames: np.ndarray, fps: float, rest
     """
     p = np.asarray(positions, dtype=np.float64)
     lengths = np.asarray(num_frames, dtype=np.int64).reshape(-1)
-    if p.ndim != 4 or p.shape[2:] != (21, 3) or len(p) != len(lengths):
-        raise ValueError(f"positions must be (n, frames, 21, 3) with one num_frames each, got {p.shape} "
+    if p.ndim != 4 or p.shape[2:] != (NUM_JOINTS, 3) or len(p) != len(lengths):
+        raise ValueError(f"positions must be (n, frames, {NUM_JOINTS}, 3) with one num_frames each, got {p.shape} "
                          f"and {lengths.shape}")
     if len(p) == 0 or lengths.min() < 2 or lengths.max() > p.shape[1]:
         raise ValueError(f"need ≥ 1 motion with 2 ≤ num_frames ≤ {p.shape[1]}, got {lengths.tolist()[:8]}")

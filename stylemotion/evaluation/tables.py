@@ -36,7 +36,7 @@ import numpy as np
 import torch
 
 from stylemotion.models.style import feature_style_distance, gram_factor, mean_gram
-from stylemotion.representation import ROOT_JOINT, VELOCITY_DIMS, YAW_RATE_DIM
+from stylemotion.representation import FRAME_DIM, JOINT_DIMS, ROOT_JOINT, VELOCITY_DIMS, YAW_RATE_DIM
 
 #: Names of the variance statistics, in table order.
 VARIANCE_KEYS = ("pose_sd", "v_sd", "step_sd")
@@ -47,7 +47,7 @@ def mean_motion(normalized_frames: np.ndarray) -> np.ndarray:
     """The frame-wise mean ``(length, 66)`` float32 of clips ``(n, length, 66)`` on one timeline."""
     f = np.asarray(normalized_frames, dtype=np.float64)
     if f.ndim != 3 or len(f) == 0:
-        raise ValueError(f"need (n ≥ 1, length, 66) frames for a mean motion, got {f.shape}")
+        raise ValueError(f"need (n ≥ 1, length, {FRAME_DIM}) frames for a mean motion, got {f.shape}")
     return f.mean(0).astype(np.float32)
 
 
@@ -140,7 +140,7 @@ def variance_stats(frames: np.ndarray, positions: np.ndarray, num_frames: np.nda
                          f"frames each")
     width = f.shape[1]
     mask = np.arange(width)[None, :] < n_valid[:, None]  # valid frames
-    poses = f[..., :63][mask]  # (poses, 63)
+    poses = f[..., JOINT_DIMS][mask]  # (poses, 63)
     pose_sd = np.sqrt(((poses - poses.mean(0)) ** 2).sum() / (len(poses) - 1))
     moving = np.arange(width)[None, :] < (n_valid - 1)[:, None]  # forward differences of valid frames
     speed = np.linalg.norm(f[..., VELOCITY_DIMS], axis=-1)

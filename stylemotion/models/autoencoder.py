@@ -32,8 +32,8 @@ import torch.nn.functional as F
 from torch import nn
 
 from stylemotion.models.normalization import Normalizer
-from stylemotion.representation import FRAME_DIM, REPRESENTATION, frames_to_positions
-from stylemotion.skeleton import CANONICAL_JOINTS, CANONICAL_PARENTS
+from stylemotion.representation import FRAME_DIM, JOINT_DIMS, REPRESENTATION, frames_to_positions
+from stylemotion.skeleton import CANONICAL_JOINTS, CANONICAL_PARENTS, NUM_JOINTS
 
 POOLING = ("avg", "max")
 
@@ -142,7 +142,7 @@ def local_mpjpe(pred_frames: torch.Tensor, true_frames: torch.Tensor) -> torch.T
     Joints relative to the root's ground projection, facing +Z (frame values ``[0:63]``): the pose
     alone, without the root trajectory (so no drift from velocity errors).
     """
-    diff = (pred_frames[..., :63] - true_frames[..., :63]).contiguous().unflatten(-1, (21, 3))
+    diff = (pred_frames[..., JOINT_DIMS] - true_frames[..., JOINT_DIMS]).contiguous().unflatten(-1, (NUM_JOINTS, 3))
     return torch.linalg.vector_norm(diff, dim=-1).mean()
 
 

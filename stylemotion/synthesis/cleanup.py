@@ -8,10 +8,10 @@ shape and its roll from heel to ball). When the foot lifts off, the accumulated 
 released over ``release_frames`` frames of the swing (smoothstep), so the foot rejoins its own
 swing without a jump.
 
-The corrected ankle is then reached by an analytic two-bone solve of the leg: hip fixed, thigh and
-shin lengths of that frame kept, the knee in the plane spanned by the hip→ankle line and the
-original knee (the original knee direction is the pole). An ankle out of reach is pulled towards
-the hip until the leg is straight.
+The corrected ankle is then reached by the analytic two-bone solve of the leg
+(:func:`stylemotion.geometry.two_bone_ik`): hip fixed, thigh and shin lengths of that frame kept,
+the knee in the plane spanned by the hip→ankle line and the original knee (the original knee
+direction is the pole). An ankle out of reach is pulled towards the hip until the leg is straight.
 """
 
 from __future__ import annotations
@@ -19,11 +19,16 @@ from __future__ import annotations
 import numpy as np
 
 from stylemotion.contacts import FOOT_POINTS, contact_intervals, foot_contacts, horizontal_speed
-from stylemotion.skeleton import CJ
+from stylemotion.geometry import two_bone_ik
+from stylemotion.skeleton import JOINT_INDEX, NUM_JOINTS
+
+#: Closest a solved leg comes to fully straight or fully folded: the hip–ankle distance stays this
+#: far inside ``[|thigh − shin|, thigh + shin]``, metres.
+REACH_MARGIN_M = 1e-6
 
 #: ``(hip, knee, ankle, toes)`` joint indices of the left and the right leg.
-LEGS = ((CJ["UpperLeg_L"], CJ["LowerLeg_L"], CJ["Foot_L"], CJ["Toes_L"]),
-        (CJ["UpperLeg_R"], CJ["LowerLeg_R"], CJ["Foot_R"], CJ["Toes_R"]))
+LEGS = ((JOINT_INDEX["UpperLeg_L"], JOINT_INDEX["LowerLeg_L"], JOINT_INDEX["Foot_L"], JOINT_INDEX["Toes_L"]),
+        (JOINT_INDEX["UpperLeg_R"], JOINT_INDEX["LowerLeg_R"], JOINT_INDEX["Foot_R"], JOINT_INDEX["Toes_R"]))
 
 
 def planted_drift(positions: np.ndarray, fps: float, contact: np.ndarray, foot: int,
@@ -62,16 +67,7 @@ def solve_knee(hip: np.ndarray, knee: np.ndarray, ankle: np.ndarray, target: np.
     """
     thigh = np.linalg.norm(knee - hip, axis=-1, keepdims=True)
     shin = np.linalg.norm(ankle - knee, axis=-1, keepdims=True)
-    to_target = target - hip
-    dist = np.linalg.norm(to_target, axis=-1, keepdims=True)
-    u = to_target / np.maximum(dist, 1e-9)
-    reach = np.clip(dist, np.abs(thigh - shin) + 1e-6, thigh + shin - 1e-6)
-    reached = hip + u * reach
-    pole = (knee - hip) - ((knee - hip) * u).sum(-1, keepdims=True) * u
-    v = pole / np.maximum(np.linalg.norm(pole, axis=-1, keepdims=True), 1e-9)
-    cos_a = np.clip((thigh ** 2 + reach ** 2 - shin ** 2) / (2 * thigh * reach), -1.0, 1.0)
-    new_knee = hip + thigh * (cos_a * u + np.sqrt(1.0 - cos_a ** 2) * v)
-    return new_knee, reached
+    return two_bone_ik(hip, target, knee - hip, thigh, shin, law="cosines", margin=REACH_MARGIN_M)
 
 
 def clean_foot_skating(positions: np.ndarray, fps: float, release_frames: int = 4,
@@ -88,8 +84,8 @@ def clean_foot_skating(positions: np.ndarray, fps: float, release_frames: int = 
         ``(frames, 21, 3)`` float64 corrected positions (only knees, ankles and toes move).
     """
     p = np.array(positions, dtype=np.float64)
-    if p.ndim != 3 or p.shape[1:] != (21, 3) or len(p) < 2:
-        raise ValueError(f"positions must be (frames ≥ 2, 21, 3), got {p.shape}")
+    if p.ndim != 3 or p.shape[1:] != (NUM_JOINTS, 3) or len(p) < 2:
+        raise ValueError(f"positions must be (frames ≥ 2, {NUM_JOINTS}, 3), got {p.shape}")
     contact = foot_contacts(p, fps, rest_heights=rest_heights)
     for foot, (hip, knee, ankle, toes) in enumerate(LEGS):
         shift = planted_drift(p, fps, contact[:, foot], foot, release_frames)

@@ -40,7 +40,9 @@ from dataclasses import dataclass, field
 import numpy as np
 import torch
 
+from stylemotion.geometry import wrap_angle_torch
 from stylemotion.representation import JOINT_DIMS, VELOCITY_DIMS, frames_to_positions, integrate_root
+from stylemotion.skeleton import NUM_JOINTS
 from stylemotion.synthesis.graph import MotionGraph
 from stylemotion.synthesis.path import GroundPath
 from stylemotion.synthesis.stitching import append_clip
@@ -153,10 +155,6 @@ class SynthesizedMotion:
         return self.positions[:, 0, [0, 2]].astype(np.float64)
 
 
-def _wrap(angle: torch.Tensor) -> torch.Tensor:
-    return torch.remainder(angle + math.pi, 2 * math.pi) - math.pi
-
-
 @dataclass
 class _StepGoal:
     start_xz: torch.Tensor   # (2,)
@@ -176,12 +174,12 @@ def step_cost(model, z: torch.Tensor, goal: _StepGoal, settings: FollowSettings
     root, yaw = integrate_root(frames, playback, goal.start_xz, goal.start_yaw)
     terms = {
         "position": ((root[:, -1] - goal.target_xz) ** 2).sum(-1) / settings.position_scale_m ** 2,
-        "heading": _wrap(yaw[:, -1] - goal.target_yaw) ** 2 / settings.heading_scale_rad ** 2,
+        "heading": wrap_angle_torch(yaw[:, -1] - goal.target_yaw) ** 2 / settings.heading_scale_rad ** 2,
         "prior": settings.prior_weight * 0.5 * (z ** 2).sum(-1),
     }
     if goal.previous_pose is not None:
-        first = frames[:, 0, JOINT_DIMS].unflatten(-1, (21, 3))
-        gap = ((first - goal.previous_pose.view(21, 3)) ** 2).sum(-1).mean(-1)
+        first = frames[:, 0, JOINT_DIMS].unflatten(-1, (NUM_JOINTS, 3))
+        gap = ((first - goal.previous_pose.view(NUM_JOINTS, 3)) ** 2).sum(-1).mean(-1)
         terms["pose"] = gap / settings.pose_scale_m ** 2
         speed = frames[:, :-1, VELOCITY_DIMS].norm(dim=-1).mean(-1)
         terms["speed"] = (speed - goal.previous_speed) ** 2 / settings.speed_scale_mps ** 2

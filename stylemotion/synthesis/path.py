@@ -22,6 +22,8 @@ from pathlib import Path
 import numpy as np
 from scipy.interpolate import CubicSpline
 
+from stylemotion.geometry import direction_yaw, wrap_angle
+
 #: Spacing of the dense polyline a spline is sampled to, metres.
 SPLINE_SPACING_M = 0.02
 
@@ -116,7 +118,7 @@ class GroundPath:
         """Heading (yaw, radians) of the path's direction at arc length ``s``."""
         _, seg = self._segment(s)
         d = self.points[seg + 1] - self.points[seg]
-        return np.arctan2(d[..., 0], d[..., 1])
+        return direction_yaw(d)
 
     def project(self, xz: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Closest points of the path to ``xz`` ``(..., 2)``: their arc lengths and distances, metres."""
@@ -135,7 +137,7 @@ class GroundPath:
         """``(n,)`` absolute heading change over ``window_m`` metres of path ahead of each vertex, radians."""
         s = self.arc
         h0, h1 = self.heading_at(s), self.heading_at(np.minimum(s + window_m, self.length - 1e-9))
-        return np.abs((h1 - h0 + np.pi) % (2 * np.pi) - np.pi)
+        return np.abs(wrap_angle(h1 - h0))
 
 
 def s_curve(length_m: float = 10.0, amplitude_m: float = 1.0, waves: float = 1.0) -> GroundPath:

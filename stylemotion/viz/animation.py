@@ -27,8 +27,9 @@ from lightning.pytorch.utilities import rank_zero_only
 from matplotlib.animation import PillowWriter
 from matplotlib.figure import Figure
 
+from stylemotion.geometry import rotate_yaw
 from stylemotion.sampling import MotionSamples
-from stylemotion.skeleton import CJ
+from stylemotion.skeleton import JOINT_INDEX
 from stylemotion.viz.stick import TRUNK_COLOR, StickFigure, draw_pose, project
 
 log = logging.getLogger(__name__)
@@ -46,10 +47,9 @@ def oblique(points: np.ndarray, yaw_deg: float = 20.0, pitch_deg: float = 12.0) 
     ``pitch_deg`` so that the ``front`` view of :func:`stylemotion.viz.stick.project` (looking at
     the body from +Z) sees them from the front, a little to the side and from above: forward (+Z)
     points towards the viewer and down the page."""
-    yaw, pitch = np.radians(yaw_deg), np.radians(pitch_deg)
-    c, s = np.cos(yaw), np.sin(yaw)
-    x, y, z = points[..., 0], points[..., 1], points[..., 2]
-    x, z = c * x + s * z, -s * x + c * z
+    turned = rotate_yaw(points, np.radians(yaw_deg))
+    x, y, z = turned[..., 0], turned[..., 1], turned[..., 2]
+    pitch = np.radians(pitch_deg)
     cp, sp = np.cos(pitch), np.sin(pitch)
     y, z = cp * y - sp * z, sp * y + cp * z  # nearer points (larger z) drop: seen from above
     return np.stack([x, y, z], axis=-1)
@@ -85,7 +85,7 @@ def _frame_axes(ax, scene: np.ndarray) -> None:
 def _paths(ax, world: np.ndarray, frames: np.ndarray) -> None:
     """Faint root paths on the ground (y = 0) of lined-up world positions."""
     for sample, n in zip(world, frames):
-        root = sample[:n, CJ["Hips"]].copy()
+        root = sample[:n, JOINT_INDEX["Hips"]].copy()
         root[:, 1] = 0.0
         ground = project(oblique(root), "front")
         ax.plot(ground[:, 0], ground[:, 1], color=TRUNK_COLOR, lw=0.7, alpha=0.5)

@@ -21,7 +21,7 @@ import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
-from stylemotion.skeleton import CANONICAL_JOINTS, CANONICAL_PARENTS, CJ
+from stylemotion.skeleton import CANONICAL_JOINTS, CANONICAL_PARENTS, JOINT_INDEX
 
 #: ``(parent, child)`` joint index pairs of the canonical skeleton.
 BONES: tuple[tuple[int, int], ...] = tuple((p, j) for j, p in enumerate(CANONICAL_PARENTS) if p >= 0)
@@ -88,15 +88,17 @@ def draw_clip(ax: Axes, positions: np.ndarray, view: str = "side", poses: int = 
     """
     positions = np.asarray(positions)
     n = positions.shape[0]
-    feet = ((CJ["Foot_L"], CJ["Toes_L"], LEFT_COLOR), (CJ["Foot_R"], CJ["Toes_R"], RIGHT_COLOR))
+    feet = ((JOINT_INDEX["Foot_L"], JOINT_INDEX["Toes_L"], LEFT_COLOR),
+            (JOINT_INDEX["Foot_R"], JOINT_INDEX["Toes_R"], RIGHT_COLOR))
     if view == "top":
-        root = project(positions[:, CJ["Hips"]], view)
+        root = project(positions[:, JOINT_INDEX["Hips"]], view)
         ax.plot(root[:, 0], root[:, 1], color=TRUNK_COLOR, lw=0.8)
         for f, alpha in ((0, 0.35), (n - 1, 1.0)):
             for a, b in (("UpperLeg_L", "UpperLeg_R"), ("UpperArm_L", "UpperArm_R")):
-                seg = project(positions[f, [CJ[a], CJ[b]]], view)
+                seg = project(positions[f, [JOINT_INDEX[a], JOINT_INDEX[b]]], view)
                 ax.plot(seg[:, 0], seg[:, 1], color=TRUNK_COLOR, lw=1.2, alpha=alpha)
-        shown = positions[:, [CJ["Hips"], CJ["UpperArm_L"], CJ["UpperArm_R"]] + [j for f in feet for j in f[:2]]]
+        trunk = [JOINT_INDEX["Hips"], JOINT_INDEX["UpperArm_L"], JOINT_INDEX["UpperArm_R"]]
+        shown = positions[:, trunk + [j for f in feet for j in f[:2]]]
     else:
         for k, f in enumerate(np.linspace(0, n - 1, max(poses, 1)).round().astype(int)):
             draw_pose(ax, positions[f], view, alpha=0.25 + 0.75 * (k + 1) / max(poses, 1), linewidth=1.2)

@@ -15,7 +15,7 @@ import numpy as np
 from matplotlib.animation import FFMpegWriter, PillowWriter, writers
 from matplotlib.figure import Figure
 
-from stylemotion.skeleton import CJ
+from stylemotion.skeleton import JOINT_INDEX
 from stylemotion.viz.animation import oblique, pose_at
 from stylemotion.viz.stick import StickFigure, project
 
@@ -52,7 +52,7 @@ def save_walk_animation(positions: np.ndarray, fps: float, path_xz: np.ndarray, 
         raise RuntimeError(f"{out}: writing MP4 needs ffmpeg on PATH (or write a .gif)")
     world = np.asarray(positions, dtype=np.float64)
     ground_path = np.stack([path_xz[:, 0], np.zeros(len(path_xz)), path_xz[:, 1]], axis=-1)
-    root = world[:, CJ["Hips"]].copy()
+    root = world[:, JOINT_INDEX["Hips"]].copy()
     root[:, 1] = 0.0
 
     def page(points: np.ndarray) -> np.ndarray:

@@ -20,7 +20,7 @@ from stylemotion.evaluation.tables import diagonal_minima, distance_table, mean_
 from stylemotion.models.style import gram
 from stylemotion.primitives import segment_takes
 from stylemotion.representation import frames_to_positions
-from stylemotion.skeleton import CJ
+from stylemotion.skeleton import JOINT_INDEX
 
 
 def test_frechet_distance_of_known_gaussians() -> None:
@@ -86,7 +86,7 @@ def test_variance_stats_of_constructed_motions() -> None:
     frames = np.zeros((4, width, 66))
     frames[..., 1] = 1.0  # the root 1 m up, every other joint at the root
     frames[..., 64] = speeds[:, None]  # forward velocity, m/s
-    frames[2:, :, 3 * CJ["Head"] + 1] = 0.02  # two motions hold the head 2 cm higher
+    frames[2:, :, 3 * JOINT_INDEX["Head"] + 1] = 0.02  # two motions hold the head 2 cm higher
     positions = frames_to_positions(frames, fps)
     for i, n in enumerate(frames_n):  # pad by holding the last frame, as MotionSamples does
         frames[i, n:], positions[i, n:] = frames[i, n - 1], positions[i, n - 1]
@@ -119,7 +119,7 @@ def test_foot_skating_separates_planted_sliding_and_floating_feet(walk_clips) ->
     assert 0.4 < clean.contact_share < 0.9
     sliding = real.positions.numpy().copy()  # the planted left foot drifts forward at 0.3 m/s
     drift = np.arange(sliding.shape[1]) * 0.3 / real.fps
-    sliding[:, :, [CJ["Foot_L"], CJ["Toes_L"]], 2] += drift[None, :, None]
+    sliding[:, :, [JOINT_INDEX["Foot_L"], JOINT_INDEX["Toes_L"]], 2] += drift[None, :, None]
     slid = foot_skating(sliding, *args, stance_foot=0)
     assert slid.ratio > clean.ratio + 0.2 or slid.no_plant_share > 0.5
     assert slid.planted_mid_mps == pytest.approx(clean.planted_mid_mps + 0.3, abs=0.02)
