@@ -98,13 +98,15 @@ def run_evaluation(data_cfg: Mapping[str, Any], checkpoints: Sequence[str], eval
     else:
         check_one_autoencoder(models)
         autoencoder = models[0].source.autoencoder  # embedded in its checkpoint (or found on disk)
-        info = {**autoencoder_info(autoencoder, None), "path": models[0].autoencoder.get("path")}
+        info = autoencoder_info(autoencoder, models[0].source.autoencoder_path or models[0].autoencoder.get("path"))
     for m in models:
         m.source.attach_autoencoder(autoencoder)
     info = {**info, "path": recorded_path(info["path"], base)}
     takeset = build_dataset(data_cfg)
     results = evaluate_models(models, takeset, autoencoder, settings, split=data_cfg.get("split"),
                               autoencoder_info=info, progress=progress)
+    for entry in results.get("models", []):
+        entry["checkpoint"] = recorded_path(entry.get("checkpoint"), base)
     results["meta"] = {
         "data": data_cfg, "data_name": takeset.name, "seed": int(seed),
         "samples": {"table_5_1": settings.table_samples, "variance": settings.variance_samples,

@@ -182,14 +182,16 @@ def load_autoencoder(path: str | os.PathLike, expected: Mapping[str, Any] | None
     """Load a frozen :class:`MotionAutoencoder` (eval mode, no gradients) on the CPU.
 
     Args:
-        path: its Lightning checkpoint (``~`` expanded).
+        path: its Lightning checkpoint (``~`` expanded), or the checkpoint of a PrimitiveVAE/StyleCVAE
+            that embeds it.
         expected: an :func:`autoencoder_info` dict; when given, the loaded weights must have the
             same fingerprint (they are the ones a VAE was trained on).
 
     Raises:
         FileNotFoundError: no such file.
-        IncompatibleModelError: not an autoencoder checkpoint, a representation or skeleton this
-            code does not compute, no normalization statistics, or a different fingerprint.
+        IncompatibleModelError: not an autoencoder checkpoint (nor a model embedding one), a
+            representation or skeleton this code does not compute, no normalization statistics, or
+            a different fingerprint.
     """
     path = Path(path).expanduser()
     if not path.is_file():
@@ -198,10 +200,13 @@ def load_autoencoder(path: str | os.PathLike, expected: Mapping[str, Any] | None
                                 "checkpoints/best.ckpt as autoencoder_ckpt=...")
     checkpoint = read_checkpoint(path, "autoencoder checkpoint")
     saved = checkpoint.get("hyper_parameters") or {}
-    if checkpoint_kind(saved) != "autoencoder":
+    kind = checkpoint_kind(saved)
+    if kind in ("vae", "cvae") and isinstance(checkpoint.get(EMBEDDED_AUTOENCODER), Mapping):
+        return autoencoder_from_record(checkpoint[EMBEDDED_AUTOENCODER], str(path), expected)
+    if kind != "autoencoder":
         raise IncompatibleModelError(f"{path} is not a MotionAutoencoder checkpoint (its hyperparameters lack "
                                      f"{[k for k in AUTOENCODER_KEYS if k not in saved] or ['nothing']}; it has "
-                                     f"{sorted(saved)[:12]})")
+                                     f"{sorted(saved)[:12]}) nor a model checkpoint that embeds one")
     return _frozen(restore(MotionAutoencoder, checkpoint, str(path)), str(path), expected)
 
 
@@ -237,8 +242,9 @@ def _relocations(recorded: Path, checkpoint: Path) -> Iterator[Path]:
 
 
 def resolve_autoencoder(info: Mapping[str, Any], record: Mapping[str, Any] | None = None,
-                        checkpoint: str | os.PathLike | None = None) -> MotionAutoencoder:
-    """The autoencoder a generative model was trained with (frozen, CPU), checked by fingerprint.
+                        checkpoint: str | os.PathLike | None = None) -> tuple[MotionAutoencoder, str | None]:
+    """The autoencoder a generative model was trained with (frozen, CPU), checked by fingerprint, and
+    the file it came from (``checkpoint`` itself when embedded; None when that is unknown).
 
     Tried in order: the ``record`` embedded in the model's checkpoint; the path recorded in
     ``info``; the same file relocated below a folder above ``checkpoint`` (e.g. a moved
@@ -256,7 +262,7 @@ def resolve_autoencoder(info: Mapping[str, Any], record: Mapping[str, Any] | Non
     """
     where = str(checkpoint) if checkpoint is not None else "the model's checkpoint"
     if record is not None:
-        return autoencoder_from_record(record, where, info)
+        return autoencoder_from_record(record, where, info), None if checkpoint is None else str(checkpoint)
     tried: list[str] = []
     recorded = Path(str(info["path"])).expanduser() if info.get("path") else None
     candidates: list[Path] = [] if recorded is None else [recorded]
@@ -267,7 +273,7 @@ def resolve_autoencoder(info: Mapping[str, Any], record: Mapping[str, Any] | Non
             tried.append(f"{candidate} (no such file)")
             continue
         try:
-            return load_autoencoder(candidate, expected=info)
+            return load_autoencoder(candidate, expected=info), str(candidate)
         except IncompatibleModelError as err:
             tried.append(f"{candidate} ({err})")
     if recorded is not None and checkpoint is not None:

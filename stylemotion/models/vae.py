@@ -180,6 +180,8 @@ class PrimitiveVAE(pl.LightningModule):
         object.__setattr__(self, "_autoencoder_record", None)  # the one embedded in a loaded checkpoint
         #: the checkpoint file this model was loaded from, when known (finds an old checkpoint's autoencoder)
         self.checkpoint_file: str | None = None
+        #: the file the autoencoder was loaded from (a model checkpoint when embedded there), when known
+        self.autoencoder_path: str | None = None
         if spec is not None:
             self._build(spec)
 
@@ -258,8 +260,10 @@ class PrimitiveVAE(pl.LightningModule):
         """The frozen autoencoder that decodes features: the attached one, else the one embedded in
         the checkpoint, else the recorded file (see :func:`~stylemotion.models.checkpoints.resolve_autoencoder`)."""
         if self._autoencoder is None:
-            autoencoder = resolve_autoencoder(self.spec["autoencoder"], self._autoencoder_record, self.checkpoint_file)
+            autoencoder, path = resolve_autoencoder(self.spec["autoencoder"], self._autoencoder_record,
+                                                    self.checkpoint_file)
             self.attach_autoencoder(autoencoder)
+            self.autoencoder_path = path
         if self._autoencoder.net.encoder.weight.device != self.device:
             self._autoencoder.to(self.device)
         return self._autoencoder
@@ -269,12 +273,14 @@ class PrimitiveVAE(pl.LightningModule):
         features came from (same weight fingerprint), e.g. after the checkpoint file moved."""
         info = self.spec["autoencoder"]
         if isinstance(autoencoder, (str, Path)):
-            autoencoder = load_autoencoder(autoencoder, expected=info)
+            path, autoencoder = str(autoencoder), load_autoencoder(autoencoder, expected=info)
+            self.autoencoder_path = path
         else:
             got = fingerprint(autoencoder)
             if got != info["fingerprint"]:
                 raise IncompatibleModelError(f"this autoencoder (weights {got}) is not the one the model "
                                              f"was trained with (weights {info['fingerprint']}, {info['path']})")
+            self.autoencoder_path = None
         autoencoder.eval().requires_grad_(False)
         object.__setattr__(self, "_autoencoder", autoencoder.to(self.device))
 

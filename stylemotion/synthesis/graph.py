@@ -20,6 +20,7 @@ mapping.
 from __future__ import annotations
 
 import json
+import os
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -168,7 +169,7 @@ def recorded(path: str | Path, run: str | Path, meta: dict | None = None) -> str
     if path.is_absolute():
         return relocated(path, run)
     base = Path(run).expanduser() / "report" / str((meta or {}).get("paths_relative_to", ".."))
-    return str(base / path)
+    return os.path.normpath(base / path)
 
 
 def relocated(path: str | Path, run: str | Path) -> str:
