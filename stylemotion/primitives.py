@@ -35,6 +35,15 @@ _SIDE = ("Left", "Right")
 _FOOT = ("left", "right")
 
 
+def parse_primitive(name: str) -> tuple[str, str]:
+    """``"walk_leftStance"`` → ``("walk", "leftStance")``, or a ValueError listing valid names."""
+    action, _, primitive = str(name).partition("_")
+    if action not in ACTIONS or primitive not in PRIMITIVES:
+        valid = [f"{a}_{p}" for a in ACTIONS for p in PRIMITIVES]
+        raise ValueError(f"unknown motion primitive {name!r}; use <action>_<primitive>, one of {valid}")
+    return action, primitive
+
+
 def check_primitive(primitive: str) -> str:
     """``primitive`` itself, or a ValueError naming the six valid primitives."""
     if primitive not in PRIMITIVES:

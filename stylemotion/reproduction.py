@@ -53,12 +53,11 @@ import torch
 from hydra import compose
 from omegaconf import DictConfig, OmegaConf, open_dict
 
-from stylemotion.datamodules.features import parse_primitive
 from stylemotion.datasets import build_dataset
 from stylemotion.evaluation.run import recorded_path, run_evaluation, summary_lines
 from stylemotion.io.atomic import atomic_write_bytes
 from stylemotion.io.outputs import inside, safe_name
-from stylemotion.primitives import SegmentSettings, action_of, segment_takes
+from stylemotion.primitives import SegmentSettings, action_of, parse_primitive, segment_takes
 
 log = logging.getLogger(__name__)
 

@@ -114,6 +114,9 @@ class ClipDataModule(pl.LightningDataModule):
         eval_batch_size: validation/test batch size; None = ``batch_size``.
         num_workers: DataLoader worker processes.
         split: split settings (``seed``, ``val_fraction``, ``test_fraction``); None = ``data.split``.
+        segmentation: the takeset's ``action`` takes already segmented with these ``segment``
+            settings (Python use, e.g. one segmentation shared by the primitives of an evaluation);
+            None segments them in :meth:`setup`.
     """
 
     def __init__(
@@ -131,6 +134,7 @@ class ClipDataModule(pl.LightningDataModule):
         eval_batch_size: int | None = None,
         num_workers: int = 0,
         split: Mapping[str, Any] | None = None,
+        segmentation: Segmentation | None = None,
     ):
         super().__init__()
         if data is None and takeset is None:
@@ -155,7 +159,7 @@ class ClipDataModule(pl.LightningDataModule):
                              f"{self.example_cfg['split']!r}")
         if batch_size < 1:
             raise ValueError(f"batch_size must be ≥ 1, got {batch_size}")
-        self.save_hyperparameters(ignore=["takeset"])
+        self.save_hyperparameters(ignore=["takeset", "segmentation"])
         self.data_cfg = dict(data) if data is not None else None
         self.split_cfg = dict(split if split is not None else (self.data_cfg or {}).get("split") or {})
         self._takeset = takeset
@@ -171,6 +175,7 @@ class ClipDataModule(pl.LightningDataModule):
         self.eval_batch_size = eval_batch_size or batch_size
         self.num_workers = num_workers
         self.segmentation: Segmentation | None = None
+        self._given_segmentation = segmentation
         self.split_of: dict[str, str] = {}
         self.clips: dict[str, list[Clip]] = {}
         self.datasets: dict[str, ClipDataset] = {}
@@ -207,8 +212,11 @@ class ClipDataModule(pl.LightningDataModule):
         for style in wanted + (self.requested_example_styles or []):
             if style not in dataset_styles:
                 raise NoClipsError(f"style {style!r} is not in dataset {takeset.name!r} (styles: {dataset_styles})")
-        takes = [t for t in takeset.takes if action_of(t.content, self.segment_settings.actions) == self.action]
-        self.segmentation = segment_takes(takes, self.segment_settings)
+        if self._given_segmentation is not None:
+            self.segmentation = self._given_segmentation
+        else:
+            takes = [t for t in takeset.takes if action_of(t.content, self.segment_settings.actions) == self.action]
+            self.segmentation = segment_takes(takes, self.segment_settings)
         for part, members in takeset.split(**self.split_cfg).items():
             for take in members:
                 self.split_of[take.name] = part

@@ -49,7 +49,7 @@ from stylemotion.datamodules.clips import ClipDataModule, NoClipsError
 from stylemotion.datasets import TakeSet
 from stylemotion.models.autoencoder import MotionAutoencoder
 from stylemotion.models.checkpoints import autoencoder_info, load_autoencoder
-from stylemotion.primitives import ACTIONS, PRIMITIVES, Clip, time_normalize
+from stylemotion.primitives import Clip, parse_primitive, time_normalize
 from stylemotion.representation import FRAME_DIM, REPRESENTATION
 from stylemotion.sampling import pad_motions
 from stylemotion.skeleton import CANONICAL_JOINTS, NUM_JOINTS
@@ -71,15 +71,6 @@ class TooFewClipsError(ValueError):
 class ReceptiveFieldError(ValueError):
     """A style example (or the canonical length of the content clips) is shorter than the
     autoencoder's receptive field."""
-
-
-def parse_primitive(name: str) -> tuple[str, str]:
-    """``"walk_leftStance"`` → ``("walk", "leftStance")``, or a ValueError listing valid names."""
-    action, _, primitive = str(name).partition("_")
-    if action not in ACTIONS or primitive not in PRIMITIVES:
-        valid = [f"{a}_{p}" for a in ACTIONS for p in PRIMITIVES]
-        raise ValueError(f"unknown motion primitive {name!r}; use <action>_<primitive>, one of {valid}")
-    return action, primitive
 
 
 def receptive_field(autoencoder: MotionAutoencoder) -> int:

@@ -47,7 +47,7 @@ from stylemotion.evaluation.metrics import (
     pooled_skating,
     pose_sequences,
 )
-from stylemotion.evaluation.reference import PrimitiveData, primitive_data
+from stylemotion.evaluation.reference import PrimitiveData, primitive_data, segment_action
 from stylemotion.evaluation.sources import (
     NEUTRAL,
     EvalModel,
@@ -58,6 +58,7 @@ from stylemotion.evaluation.sources import (
 from stylemotion.evaluation.tables import diagonal_minima, distance_table, example_gram, mean_motion, variance_stats
 from stylemotion.models.autoencoder import local_mpjpe, mpjpe
 from stylemotion.models.style import mean_gram
+from stylemotion.primitives import Segmentation, parse_primitive
 from stylemotion.sampling import MotionSamples
 
 log = logging.getLogger(__name__)
@@ -153,9 +154,13 @@ def evaluate_models(models: Sequence[EvalModel], takeset: TakeSet, autoencoder, 
     if autoencoder_info is not None:
         results["autoencoder"].update(path=autoencoder_info.get("path"),
                                       fingerprint=autoencoder_info.get("fingerprint"))
+    segmentations: dict[str, Segmentation] = {}  # the takes of each action are segmented once
     for primitive in sorted(by_primitive):
-        group = by_primitive[primitive]
-        out = _evaluate_primitive(primitive, group, takeset, autoencoder, settings, split, say)
+        action = parse_primitive(primitive)[0]
+        if action not in segmentations:
+            segmentations[action] = segment_action(takeset, action, settings.segment)
+        out = _evaluate_primitive(primitive, by_primitive[primitive], takeset, autoencoder, settings, split, say,
+                                  segmentations[action])
         for key in results:
             if key in out:
                 results[key][primitive] = out[key]
@@ -256,7 +261,7 @@ class RealSide:
 
 
 def _canonical_length(primitive: str, models: Sequence[EvalModel], takeset: TakeSet, settings: EvalSettings,
-                      split: Mapping[str, Any] | None) -> int:
+                      split: Mapping[str, Any] | None, segmentation: Segmentation | None = None) -> int:
     """The models' (one) canonical timeline; for sources without one, the median neutral train clip."""
     lengths = {m.timeline_frames for m in models if m.timeline_frames is not None}
     if len(lengths) > 1:
@@ -264,21 +269,25 @@ def _canonical_length(primitive: str, models: Sequence[EvalModel], takeset: Take
                          "trained on different data")
     if lengths:
         return lengths.pop()
-    probe = primitive_data(takeset, primitive, 2, settings.neutral_style, settings.segment, split)
+    probe = primitive_data(takeset, primitive, 2, settings.neutral_style, settings.segment, split, segmentation)
     return int(round(float(np.median([c.num_frames for c in probe.training_data()]))))
 
 
 def real_side(primitive: str, models: Sequence[EvalModel], takeset: TakeSet, settings: EvalSettings,
-              split: Mapping[str, Any] | None, say: Callable[[str], None]) -> RealSide:
-    """Segment and split the data once for ``primitive``, fit the style classifier, gather the ground truths.
+              split: Mapping[str, Any] | None, say: Callable[[str], None],
+              segmentation: Segmentation | None = None) -> RealSide:
+    """Split the (segmented) data for ``primitive``, fit the style classifier, gather the ground truths.
+
+    ``segmentation``: the primitive's action already segmented with ``settings.segment``
+    (:func:`~.reference.segment_action`), shared by the primitives of one evaluation; None segments here.
 
     Raises:
         MissingExampleError: a model's style is not in the data, or its example clip is missing.
         ValueError: a model has fewer than 2 ground-truth clips.
     """
-    length = _canonical_length(primitive, models, takeset, settings, split)
+    length = _canonical_length(primitive, models, takeset, settings, split, segmentation)
     say(f"{primitive}: real clips")
-    data = primitive_data(takeset, primitive, length, settings.neutral_style, settings.segment, split)
+    data = primitive_data(takeset, primitive, length, settings.neutral_style, settings.segment, split, segmentation)
     for m in models:
         if m.style not in data.styles:
             raise MissingExampleError(f"{m.checkpoint or m.label} models style {m.style!r}, which dataset "
@@ -450,8 +459,8 @@ def _example_gram(autoencoder, data: PrimitiveData, model: EvalModel, clips: lis
 
 def _evaluate_primitive(primitive: str, models: list[EvalModel], takeset: TakeSet, autoencoder,
                         settings: EvalSettings, split: Mapping[str, Any] | None,
-                        say: Callable[[str], None]) -> dict[str, Any]:
-    real = real_side(primitive, models, takeset, settings, split, say)
+                        say: Callable[[str], None], segmentation: Segmentation | None = None) -> dict[str, Any]:
+    real = real_side(primitive, models, takeset, settings, split, say, segmentation)
     variance = real_variance(real)
     train_poses = pose_sequences(real.training.normalized_frames.numpy())
     out: dict[str, Any] = {"frechet": {}, "frechet_reference": {}, "diversity": {}, "foot_skating_detail": {},

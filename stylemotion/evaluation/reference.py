@@ -23,10 +23,17 @@ import numpy as np
 
 from stylemotion.contacts import foot_signals
 from stylemotion.datamodules.clips import ClipDataModule
-from stylemotion.datamodules.features import parse_primitive
 from stylemotion.datasets import TakeSet
 from stylemotion.evaluation.sources import EvalModel, MissingExampleError
-from stylemotion.primitives import STANCE_FOOT, Clip, action_of
+from stylemotion.primitives import (
+    STANCE_FOOT,
+    Clip,
+    Segmentation,
+    SegmentSettings,
+    action_of,
+    parse_primitive,
+    segment_takes,
+)
 
 
 @dataclass
@@ -100,7 +107,8 @@ class PrimitiveData:
 
 
 def primitive_data(takeset: TakeSet, primitive: str, length: int, neutral_style: str = "normal",
-                   segment: Mapping[str, Any] | None = None, split: Mapping[str, Any] | None = None) -> PrimitiveData:
+                   segment: Mapping[str, Any] | None = None, split: Mapping[str, Any] | None = None,
+                   segmentation: Segmentation | None = None) -> PrimitiveData:
     """Segment, split and time-normalize the real clips of ``primitive`` (see :class:`PrimitiveData`).
 
     Args:
@@ -110,10 +118,13 @@ def primitive_data(takeset: TakeSet, primitive: str, length: int, neutral_style:
         neutral_style: the neutral style label; must be a style of the data.
         segment: segmentation overrides (as for training).
         split: split settings (as for training; the data config's ``split``).
+        segmentation: the action's takes already segmented with ``segment`` (see
+            :func:`segment_action`); None segments them here.
     """
     action, name = parse_primitive(primitive)
     module = ClipDataModule(takeset=takeset, action=action, primitives=[name], styles=None, timeline=int(length),
-                            example_styles=[], segment=dict(segment or {}), split=dict(split or {}))
+                            example_styles=[], segment=dict(segment or {}), split=dict(split or {}),
+                            segmentation=segmentation)
     module.setup()
     if neutral_style not in module.style_names:
         raise ValueError(f"the neutral style {neutral_style!r} is not a style of dataset {takeset.name!r} "
@@ -124,3 +135,9 @@ def primitive_data(takeset: TakeSet, primitive: str, length: int, neutral_style:
         raise ValueError(f"dataset {takeset.name!r} has no {action} take in the train split")
     rest = np.median(np.stack([foot_signals(t.positions, takeset.fps).rest_heights for t in takes]), axis=0)
     return PrimitiveData(primitive, int(length), float(takeset.fps), neutral_style, module, rest)
+
+
+def segment_action(takeset: TakeSet, action: str, segment: Mapping[str, Any] | None = None) -> Segmentation:
+    """The takes of ``action`` segmented once (to share between the primitives of one evaluation)."""
+    settings = SegmentSettings.from_dict(dict(segment or {}))
+    return segment_takes([t for t in takeset.takes if action_of(t.content, settings.actions) == action], settings)

@@ -13,11 +13,12 @@ import pytest
 import torch
 from vae_fixtures import TINY_HIDDEN, feature_module, fit, tiny_autoencoder_ckpt, tiny_takeset, validate
 
-from stylemotion.datamodules.features import FeatureDataModule, TooFewClipsError, parse_primitive
+from stylemotion.datamodules.features import FeatureDataModule, TooFewClipsError
 from stylemotion.models.autoencoder import IncompatibleModelError, MotionAutoencoder
 from stylemotion.models.checkpoints import fingerprint, load_autoencoder
 from stylemotion.models.style import feature_style_distance, gram, gram_factor, mean_gram, style_distance
 from stylemotion.models.vae import MLPVAE, PrimitiveVAE, kl_divergence, reconstruction_loss
+from stylemotion.primitives import parse_primitive
 
 torch.set_num_threads(1)
 
