@@ -35,12 +35,12 @@ from collections import Counter
 from collections.abc import Mapping, Sequence
 from typing import Any
 
-import lightning.pytorch as pl
 import numpy as np
 import torch
-from torch.utils.data import DataLoader, Dataset
+from torch.utils.data import Dataset
 
-from stylemotion.datasets import TakeSet, build_dataset
+from stylemotion.datamodules.base import SplitDataModule
+from stylemotion.datasets import TakeSet
 from stylemotion.primitives import (
     PRIMITIVES,
     Clip,
@@ -94,7 +94,7 @@ class ClipDataset(Dataset):
                 "style": self.style[index], "primitive": self.primitive[index]}
 
 
-class ClipDataModule(pl.LightningDataModule):
+class ClipDataModule(SplitDataModule):
     """Train/val/test primitive clips of one action, filtered by primitive and style.
 
     Args:
@@ -136,9 +136,7 @@ class ClipDataModule(pl.LightningDataModule):
         split: Mapping[str, Any] | None = None,
         segmentation: Segmentation | None = None,
     ):
-        super().__init__()
-        if data is None and takeset is None:
-            raise ValueError("ClipDataModule needs a data config or a takeset")
+        super().__init__(data, takeset, batch_size, eval_batch_size, num_workers, split)
         primitives = [primitives] if isinstance(primitives, str) else list(primitives)
         if not primitives:
             raise ValueError(f"select at least one primitive of {list(PRIMITIVES)}")
@@ -157,12 +155,7 @@ class ClipDataModule(pl.LightningDataModule):
         if self.example_cfg["split"] not in ("all",) + SPLITS:
             raise ValueError(f"example split must be 'all' or one of {list(SPLITS)}, got "
                              f"{self.example_cfg['split']!r}")
-        if batch_size < 1:
-            raise ValueError(f"batch_size must be ≥ 1, got {batch_size}")
         self.save_hyperparameters(ignore=["takeset", "segmentation"])
-        self.data_cfg = dict(data) if data is not None else None
-        self.split_cfg = dict(split if split is not None else (self.data_cfg or {}).get("split") or {})
-        self._takeset = takeset
         self.action = action
         self.primitives = primitives
         self.requested_styles = None if styles is None else ([styles] if isinstance(styles, str) else list(styles))
@@ -171,34 +164,17 @@ class ClipDataModule(pl.LightningDataModule):
         self.segment_settings = SegmentSettings.from_dict(dict(segment or {}))
         if action not in self.segment_settings.actions:
             raise ValueError(f"unknown action {action!r}; segmented actions: {list(self.segment_settings.actions)}")
-        self.batch_size = batch_size
-        self.eval_batch_size = eval_batch_size or batch_size
-        self.num_workers = num_workers
         self.segmentation: Segmentation | None = None
         self._given_segmentation = segmentation
         self.split_of: dict[str, str] = {}
         self.clips: dict[str, list[Clip]] = {}
-        self.datasets: dict[str, ClipDataset] = {}
         self.length: int | None = None
         self.style_names: list[str] = []
         self._examples: dict[str, Clip] = {}
 
     @property
-    def takeset(self) -> TakeSet:
-        if self._takeset is None:
-            self._takeset = build_dataset(self.data_cfg)
-        return self._takeset
-
-    @property
-    def fps(self) -> float:
-        return float(self.takeset.fps)
-
-    @property
     def example_primitive(self) -> str:
         return self.example_cfg["primitive"] or self.primitives[0]
-
-    def prepare_data(self) -> None:
-        _ = self.takeset
 
     # -- building
 
@@ -301,20 +277,7 @@ class ClipDataModule(pl.LightningDataModule):
 
     # -- loaders
 
-    def _loader(self, part: str, shuffle: bool) -> DataLoader:
-        if part not in self.datasets:
-            raise RuntimeError("call setup() before asking for a DataLoader")
+    def check_part(self, part: str) -> None:
         if not len(self.datasets[part]):
             raise NoClipsError(self._empty_message(part, self.requested_styles or self.style_names))
-        return DataLoader(self.datasets[part], batch_size=self.batch_size if part == "train" else self.eval_batch_size,
-                          shuffle=shuffle, num_workers=self.num_workers, persistent_workers=self.num_workers > 0)
-
-    def train_dataloader(self) -> DataLoader:
-        return self._loader("train", shuffle=True)
-
-    def val_dataloader(self) -> DataLoader:
-        return self._loader("val", shuffle=False)
-
-    def test_dataloader(self) -> DataLoader:
-        return self._loader("test", shuffle=False)
 

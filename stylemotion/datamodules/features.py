@@ -40,11 +40,11 @@ import logging
 from collections.abc import Mapping, Sequence
 from typing import Any
 
-import lightning.pytorch as pl
 import numpy as np
 import torch
-from torch.utils.data import DataLoader, Dataset
+from torch.utils.data import Dataset
 
+from stylemotion.datamodules.base import SplitDataModule
 from stylemotion.datamodules.clips import ClipDataModule, NoClipsError
 from stylemotion.datasets import TakeSet
 from stylemotion.models.autoencoder import MotionAutoencoder
@@ -159,7 +159,7 @@ def _clip_module(**kwargs: Any) -> ClipDataModule:
     return ClipDataModule(**kwargs)
 
 
-class FeatureDataModule(pl.LightningDataModule):
+class FeatureDataModule(SplitDataModule):
     """Autoencoder features of one primitive's clips, plus the style example(s) of one style.
 
     Args:
@@ -204,7 +204,7 @@ class FeatureDataModule(pl.LightningDataModule):
         std_floor: float = 1e-3,
         split: Mapping[str, Any] | None = None,
     ):
-        super().__init__()
+        super().__init__(data, takeset, batch_size, eval_batch_size, num_workers, split)
         self.action, self.primitive_name = parse_primitive(primitive)
         if autoencoder is None and not autoencoder_ckpt:
             raise ValueError("FeatureDataModule needs autoencoder_ckpt=<path of a trained MotionAutoencoder "
@@ -223,9 +223,6 @@ class FeatureDataModule(pl.LightningDataModule):
         self.style = style
         self.example_specs = [dict(e) for e in examples] if examples else [{}]
         self.example_length = example_length
-        self.batch_size = batch_size
-        self.eval_batch_size = eval_batch_size or batch_size
-        self.num_workers = num_workers
         self.min_train_clips = min_train_clips
         self.feature_scale = feature_scale
         self.std_floor = std_floor
@@ -253,6 +250,10 @@ class FeatureDataModule(pl.LightningDataModule):
     @property
     def autoencoder_info(self) -> dict[str, Any]:
         return autoencoder_info(self.autoencoder, self.autoencoder_ckpt)
+
+    @property
+    def takeset(self) -> TakeSet:
+        return self.clip_data.takeset
 
     @property
     def fps(self) -> float:
@@ -341,20 +342,7 @@ class FeatureDataModule(pl.LightningDataModule):
 
     # -- loaders
 
-    def _loader(self, part: str, shuffle: bool) -> DataLoader:
-        if part not in self.datasets:
-            raise RuntimeError("call setup() before asking for a DataLoader")
+    def check_part(self, part: str) -> None:
         if not len(self.datasets[part]):
             raise TooFewClipsError(f"the {part!r} split of primitive {self.primitive} holds no clip of style(s) "
                                    f"{self.content_styles}")
-        return DataLoader(self.datasets[part], batch_size=self.batch_size if part == "train" else self.eval_batch_size,
-                          shuffle=shuffle, num_workers=self.num_workers, persistent_workers=self.num_workers > 0)
-
-    def train_dataloader(self) -> DataLoader:
-        return self._loader("train", shuffle=True)
-
-    def val_dataloader(self) -> DataLoader:
-        return self._loader("val", shuffle=False)
-
-    def test_dataloader(self) -> DataLoader:
-        return self._loader("test", shuffle=False)

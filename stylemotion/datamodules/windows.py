@@ -17,13 +17,13 @@ import logging
 from collections.abc import Mapping, Sequence
 from typing import Any
 
-import lightning.pytorch as pl
 import numpy as np
 import torch
-from torch.utils.data import DataLoader, Dataset
+from torch.utils.data import Dataset
 
+from stylemotion.datamodules.base import SplitDataModule
 from stylemotion.datamodules.normalization import DEFAULT_STD_FLOOR, channel_stats
-from stylemotion.datasets import Take, TakeSet, build_dataset
+from stylemotion.datasets import Take, TakeSet
 from stylemotion.representation import FRAME_DIM, REPRESENTATION
 
 log = logging.getLogger(__name__)
@@ -85,7 +85,7 @@ class WindowDataset(Dataset):
         return self.frames[start:start + self.window]
 
 
-class MotionWindowDataModule(pl.LightningDataModule):
+class MotionWindowDataModule(SplitDataModule):
     """Train/val/test windows of a dataset, with train-split normalization statistics.
 
     Args:
@@ -119,20 +119,11 @@ class MotionWindowDataModule(pl.LightningDataModule):
         std_floor: float = DEFAULT_STD_FLOOR,
         split: Mapping[str, Any] | None = None,
     ):
-        super().__init__()
-        if data is None and takeset is None:
-            raise ValueError("MotionWindowDataModule needs a data config or a takeset")
-        if window_frames < 2 or stride < 1 or batch_size < 1:
-            raise ValueError(f"need window_frames ≥ 2, stride ≥ 1, batch_size ≥ 1; got {window_frames}, "
-                             f"{stride}, {batch_size}")
+        super().__init__(data, takeset, batch_size, eval_batch_size, num_workers, split)
+        if window_frames < 2 or stride < 1:
+            raise ValueError(f"need window_frames ≥ 2 and stride ≥ 1; got {window_frames}, {stride}")
         self.save_hyperparameters(ignore=["takeset"])
-        self.data_cfg = dict(data) if data is not None else None
-        self.split_cfg = dict(split if split is not None else (self.data_cfg or {}).get("split") or {})
-        self._takeset = takeset
         self.window_frames, self.stride, self.cover_tail = window_frames, stride, cover_tail
-        self.batch_size = batch_size
-        self.eval_batch_size = eval_batch_size or batch_size
-        self.num_workers = num_workers
         self.std_floor = std_floor
         self.datasets: dict[str, WindowDataset] = {}
         self.split_takes: dict[str, list[Take]] = {}
@@ -141,25 +132,11 @@ class MotionWindowDataModule(pl.LightningDataModule):
         self.summary: dict[str, Any] = {}
 
     @property
-    def takeset(self) -> TakeSet:
-        if self._takeset is None:
-            self._takeset = build_dataset(self.data_cfg)
-        return self._takeset
-
-    @property
-    def fps(self) -> float:
-        return float(self.takeset.fps)
-
-    @property
     def normalization(self) -> tuple[np.ndarray, np.ndarray]:
         """``(mean, std)``, each ``(66,)``, of the train split's frames (after :meth:`setup`)."""
         if self.mean is None or self.std is None:
             raise RuntimeError("call setup() before asking for normalization statistics")
         return self.mean, self.std
-
-    def prepare_data(self) -> None:
-        """Build (and cache on disk) the dataset once, on the first process of each machine."""
-        _ = self.takeset
 
     def setup(self, stage: str | None = None) -> None:
         takeset = self.takeset
@@ -195,22 +172,3 @@ class MotionWindowDataModule(pl.LightningDataModule):
             "window."
         )
 
-    def _loader(self, name: str, shuffle: bool) -> DataLoader:
-        if name not in self.datasets:
-            raise RuntimeError("call setup() before asking for a DataLoader")
-        return DataLoader(
-            self.datasets[name], batch_size=self.batch_size if name == "train" else self.eval_batch_size,
-            shuffle=shuffle, num_workers=self.num_workers, persistent_workers=self.num_workers > 0,
-        )
-
-    def train_dataloader(self) -> DataLoader:
-        return self._loader("train", shuffle=True)
-
-    def val_dataloader(self) -> DataLoader:
-        return self._loader("val", shuffle=False)
-
-    def test_dataloader(self) -> DataLoader:
-        return self._loader("test", shuffle=False)
-
-    def predict_dataloader(self) -> DataLoader:
-        return self._loader("test", shuffle=False)
