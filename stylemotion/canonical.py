@@ -8,6 +8,8 @@ This is the single code path used by the datasets and by ``stylemotion-convert``
 
 from __future__ import annotations
 
+import numbers
+import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass
 from importlib import resources
@@ -16,7 +18,8 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from stylemotion.io.errors import MotionDataError
+from stylemotion.io.bvh import DEFAULT_MAX_JOINT_FRAMES, check_joint_frames
+from stylemotion.io.errors import LimitError, MotionDataError, MotionDataWarning
 from stylemotion.motion import Motion
 from stylemotion.skeleton import CANONICAL_JOINTS
 
@@ -154,12 +157,73 @@ _UP_TO_Y = {
 }
 
 
+#: Default cap on the frames of one take after resampling (3 hours at 30 fps).
+DEFAULT_MAX_FRAMES = 324_000
+#: The body's height axis is "evidently" another axis when it is this many times longer there.
+_UP_AXIS_RATIO = 2.0
+#: ... and at least this long (metres): a head this far from the feet is a body's height, not noise.
+_MIN_BODY_HEIGHT_M = 0.3
+_AXES = "xyz"
+
+
+def check_resampled_length(motion: Motion, fps: float, max_frames: int | None,
+                           max_joint_frames: int | None) -> None:
+    """Refuse, before resampling, a motion that would become longer than the limits.
+
+    Raises:
+        LimitError: naming ``data.max_frames`` or ``data.max_joint_frames`` and the file.
+    """
+    finite = bool(np.isfinite(motion.duration * fps))
+    n_new = motion.resampled_length(fps) if finite else None
+    if max_frames is not None and (n_new is None or n_new > max_frames):
+        raise LimitError(
+            motion.source,
+            f"{motion.num_frames} frames at {motion.fps:g} fps ({motion.duration:g} s) resampled to {fps:g} fps "
+            f"would be {n_new if finite else 'infinitely many'} frames, more than the limit "
+            f"data.max_frames={max_frames} (raise it for longer takes; a Frame Time in milliseconds instead of "
+            "seconds also does this)",
+        )
+    if n_new is not None:
+        check_joint_frames(n_new, motion.skeleton.num_joints, max_joint_frames, motion.source,
+                           f"after resampling to {fps:g} fps")
+
+
+def check_up_axis(positions: np.ndarray, up_axis: str, source: str) -> None:
+    """Warn if the body's height (head above feet) evidently runs along another axis than ``up_axis``.
+
+    Args:
+        positions: ``(frames, 21, 3)`` canonical positions in the file's axes.
+        up_axis: the declared up axis, ``"y"`` or ``"z"``.
+        source: the file, for the message.
+    """
+    head = positions[:, CANONICAL_JOINTS.index("Head")]
+    feet = positions[:, [CANONICAL_JOINTS.index("Foot_L"), CANONICAL_JOINTS.index("Foot_R")]].mean(axis=1)
+    height = np.median(head - feet, axis=0)  # (3,) typical head-over-feet vector
+    if not np.all(np.isfinite(height)):
+        return
+    declared = _AXES.index(up_axis)
+    axis = int(np.argmax(np.abs(height)))
+    if axis != declared and abs(height[axis]) > max(_UP_AXIS_RATIO * abs(height[declared]), _MIN_BODY_HEIGHT_M):
+        sign = "+" if height[axis] > 0 else "-"
+        hint = f"set data.up_axis={_AXES[axis]}" if _AXES[axis] in _UP_TO_Y and sign == "+" else \
+            "check the file's axes"
+        warnings.warn(
+            f"{source}: read as {up_axis.upper()}-up but the body's height (head above feet) runs along "
+            f"{sign}{_AXES[axis].upper()} ({abs(height[axis]):.2f} m against {abs(height[declared]):.2f} m "
+            f"along {up_axis.upper()}); the file looks {_AXES[axis].upper()}-up: {hint} "
+            "(or ignore this for a take where the body lies down)",
+            MotionDataWarning, stacklevel=3,
+        )
+
+
 def to_canonical_positions(
     motion: Motion,
     joint_map: str | Mapping[str, str] | JointMap | None = None,
     fps: float | None = 30.0,
     unit_scale: float | str | None = None,
     up_axis: str = "y",
+    max_frames: int | None = DEFAULT_MAX_FRAMES,
+    max_joint_frames: int | None = DEFAULT_MAX_JOINT_FRAMES,
 ) -> np.ndarray:
     """Canonical global joint positions of ``motion``.
 
@@ -169,9 +233,18 @@ def to_canonical_positions(
         fps: target frame rate (slerp resampling), or None to keep the file's.
         unit_scale: metres per file unit, a unit name from :data:`UNIT_SCALES`, or None to detect.
         up_axis: the file's up axis, ``"y"`` or ``"z"``.
+        max_frames: refuse (before resampling) a take longer than this many frames at ``fps``.
+        max_joint_frames: refuse (before resampling) more frames × skeleton joints than this.
 
     Returns:
         ``(frames, 21, 3)`` float32 global positions in metres, Y up, canonical joint order.
+
+    Raises:
+        MotionDataError: naming the file, for unusable skeletons, units, axes or positions that
+            overflow to inf/NaN; :class:`LimitError` for a motion over the limits.
+
+    Warns:
+        MotionDataWarning: the body's height runs along another axis than ``up_axis``.
     """
     jm = resolve_joint_map(joint_map, motion)
     idx = source_indices(motion, jm)
@@ -187,8 +260,31 @@ def to_canonical_positions(
     if up_axis not in _UP_TO_Y:
         raise MotionDataError(motion.source, f"up_axis must be one of {sorted(_UP_TO_Y)}, got {up_axis!r}")
     if fps is not None:
+        if isinstance(fps, bool) or not isinstance(fps, numbers.Real) or not np.isfinite(fps) or fps <= 0:
+            raise ValueError(f"{motion.source}: fps must be a positive finite number of frames per second, "
+                             f"got {fps!r}")
+        check_resampled_length(motion, fps, max_frames, max_joint_frames)
         motion = motion.resample(fps)
-    positions = motion.global_positions()[:, idx] * scale
-    if up_axis != "y":
-        positions = positions @ _UP_TO_Y[up_axis].T
-    return positions.astype(np.float32)
+    with np.errstate(over="ignore", invalid="ignore"):  # overflow is reported below, naming the file
+        in_file_axes = motion.global_positions()[:, idx] * scale
+        _check_finite(in_file_axes, motion, scale)
+        positions = in_file_axes @ _UP_TO_Y[up_axis].T if up_axis != "y" else in_file_axes
+        positions = positions.astype(np.float32)
+    _check_finite(positions, motion, scale)
+    check_up_axis(in_file_axes, up_axis, motion.source)
+    return positions
+
+
+def _check_finite(positions: np.ndarray, motion: Motion, scale: float) -> None:
+    """Raise naming the file, frame and joint if ``positions`` hold inf/NaN (values too large)."""
+    bad = ~np.isfinite(positions)
+    if not bad.any():
+        return
+    frame, joint = (int(i) for i in np.argwhere(bad.any(axis=-1))[0])
+    largest = float(np.abs(motion.translations).max())
+    raise MotionDataError(
+        motion.source,
+        f"joint positions overflow to inf/NaN (frame {frame}, canonical joint {CANONICAL_JOINTS[joint]!r} "
+        f"in {positions.dtype}): the file's values are too large (largest translation {largest:.3g} file "
+        f"units × {scale:g} m per unit)",
+    )

@@ -51,6 +51,12 @@ class Motion:
         """``(frames, joints, 3)`` global joint positions in file units (numpy FK)."""
         return forward_kinematics(self.rotation_matrices(), self.translations, self.skeleton.parents)
 
+    def resampled_length(self, fps: float) -> int:
+        """Frames that :meth:`resample` to ``fps`` gives (computed without resampling)."""
+        if abs(fps - self.fps) < 1e-9 * fps or self.num_frames < 2:
+            return self.num_frames
+        return int(np.floor(self.duration * fps + 1e-6)) + 1
+
     def resample(self, fps: float) -> Motion:
         """Resample to ``fps``: slerp for rotations, linear interpolation for translations.
 
@@ -63,7 +69,7 @@ class Motion:
             # Same rate, or a single pose (nothing to interpolate): only the stated fps changes.
             return replace(self, fps=float(fps))
         times = np.arange(self.num_frames) / self.fps
-        n_new = int(np.floor(self.duration * fps + 1e-6)) + 1
+        n_new = self.resampled_length(fps)
         new_times = np.minimum(np.arange(n_new) / fps, times[-1])
         rotations = np.empty((n_new,) + self.rotations.shape[1:])
         for j in range(self.skeleton.num_joints):

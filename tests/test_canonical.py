@@ -20,7 +20,7 @@ from stylemotion.canonical import (
 )
 from stylemotion.io.bvh import parse_bvh, read_bvh
 from stylemotion.io.errors import MotionDataError
-from stylemotion.skeleton import CANONICAL_JOINTS, CJ, bone_lengths
+from stylemotion.skeleton import CANONICAL_JOINTS, JOINT_INDEX, bone_lengths
 
 pytestmark = pytest.mark.realdata
 
@@ -31,7 +31,7 @@ EXPECTED = {
     "cmu21_female_walk": ("cmu21", "cm"),
     "xia_cmu31": ("cmu31", "cmu"),
 }
-FEET = [CJ[n] for n in ("Foot_L", "Foot_R", "Toes_L", "Toes_R")]
+FEET = [JOINT_INDEX[n] for n in ("Foot_L", "Foot_R", "Toes_L", "Toes_R")]
 
 
 @pytest.fixture(scope="module")
@@ -55,20 +55,20 @@ def test_auto_detected_joint_map_and_unit(motions, name):
 def test_plausible_heights(motions, name):
     pos = to_canonical_positions(motions[name])
     assert pos.dtype == np.float32 and pos.shape[1:] == (21, 3)
-    head = pos[:, CJ["Head"], 1]
+    head = pos[:, JOINT_INDEX["Head"], 1]
     assert 1.2 <= head.min() and head.max() <= 1.9, (head.min(), head.max())
     lowest_foot = pos[:, FEET, 1].min()
     assert abs(lowest_foot) <= 0.15, lowest_foot
     # Hips between feet and head in every frame: the up axis is right.
-    assert np.all(pos[:, CJ["Hips"], 1] > pos[:, FEET, 1].max(axis=1))
-    assert np.all(pos[:, CJ["Hips"], 1] < head)
+    assert np.all(pos[:, JOINT_INDEX["Hips"], 1] > pos[:, FEET, 1].max(axis=1))
+    assert np.all(pos[:, JOINT_INDEX["Hips"], 1] < head)
 
 
 def test_xia_maps_neck_not_neck1(motions):
     motion = motions["xia_cmu31"]
     jm = resolve_joint_map(None, motion)
     idx = source_indices(motion, jm)
-    assert motion.skeleton.names[idx[CJ["Neck"]]] == "Neck"
+    assert motion.skeleton.names[idx[JOINT_INDEX["Neck"]]] == "Neck"
     assert [motion.skeleton.names[i] for i in idx] == [jm.joints[c] for c in CANONICAL_JOINTS]
 
 
@@ -171,9 +171,9 @@ def test_custom_joint_map_yaml(motions, tmp_path):
     fk = motion.global_positions() * UNIT_SCALES["cmu"]
     names = motion.skeleton.names
     for canonical in ("Neck", "Chest", "Spine", "Head"):
-        np.testing.assert_allclose(pos[:, CJ[canonical]], fk[:, names.index(joints[canonical])], atol=1e-5)
+        np.testing.assert_allclose(pos[:, JOINT_INDEX[canonical]], fk[:, names.index(joints[canonical])], atol=1e-5)
     builtin = to_canonical_positions(motion, fps=None)
-    assert np.abs(pos[:, CJ["Neck"]] - builtin[:, CJ["Neck"]]).max() > 0.01
+    assert np.abs(pos[:, JOINT_INDEX["Neck"]] - builtin[:, JOINT_INDEX["Neck"]]).max() > 0.01
     # A mapping works the same as its YAML file.
     np.testing.assert_array_equal(to_canonical_positions(motion, joint_map=joints, fps=None), pos)
 
@@ -239,3 +239,65 @@ def test_z_up_input(motions):
                                atol=1e-5)
     with pytest.raises(MotionDataError, match="up_axis"):
         to_canonical_positions(motion, up_axis="x")
+
+
+def _z_up(motion):
+    """``motion`` turned so that its body stands along +Z (a Z-up file)."""
+    to_z_up = np.array([[1.0, 0, 0], [0, 0, -1], [0, 1, 0]])
+    from scipy.spatial.transform import Rotation
+
+    rot = motion.rotations.copy()
+    rot[:, 0] = (Rotation.from_matrix(to_z_up) * Rotation.from_quat(rot[:, 0])).as_quat()
+    trans = motion.translations.copy()
+    trans[:, 0] = trans[:, 0] @ to_z_up.T
+    return replace(motion, rotations=rot, translations=trans)
+
+
+def test_z_up_file_read_as_y_up_warns_naming_it(motions):
+    import warnings
+
+    from stylemotion.io.errors import MotionDataWarning
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", MotionDataWarning)
+        for motion in motions.values():  # upright real files, declared right: quiet
+            to_canonical_positions(motion)
+        to_canonical_positions(_z_up(motions["cmu21_walk"]), up_axis="z")
+    z_up = _z_up(motions["cmu21_walk"])
+    with pytest.warns(MotionDataWarning) as record:
+        lying = to_canonical_positions(z_up)
+    (message,) = [str(w.message) for w in record if issubclass(w.category, MotionDataWarning)]
+    assert message.startswith(f"{z_up.source}: read as Y-up") and "set data.up_axis=z" in message
+    head_over_feet = lying[:, JOINT_INDEX["Head"]] - lying[:, FEET[:2]].mean(axis=1)
+    assert np.median(head_over_feet[:, 2]) > 1.0  # the warning is right: the body lies along Z
+
+
+def test_positions_that_overflow_are_an_error_naming_the_file(motions):
+    motion = motions["cmu21_walk"]
+    huge = replace(motion, translations=motion.translations * 1e306)
+    with pytest.raises(MotionDataError) as err:
+        to_canonical_positions(huge, unit_scale=1000.0)
+    assert str(err.value).startswith(f"{motion.source}: joint positions overflow to inf/NaN (frame 0")
+    with pytest.raises(MotionDataError, match="overflow to inf/NaN .* in float32"):
+        to_canonical_positions(replace(motion, translations=motion.translations * 1e38), unit_scale=1.0)
+
+
+def test_resampled_length_is_limited_before_resampling(motions, monkeypatch):
+    from stylemotion.io.errors import LimitError
+    from stylemotion.motion import Motion
+
+    slow = replace(motions["cmu21_walk"], fps=1e-4)  # a Frame Time of 10000 s
+    expected = slow.resampled_length(30.0)
+    monkeypatch.setattr(Motion, "resample", lambda self, fps: pytest.fail("resampled before the check"))
+    with pytest.raises(LimitError) as err:
+        to_canonical_positions(slow)
+    assert f"would be {expected} frames, more than the limit data.max_frames=324000" in str(err.value)
+    assert str(err.value).startswith(f"{slow.source}: ")
+    endless = replace(motions["cmu21_walk"], fps=1e-308)  # Frame Time 1e308 s: an infinite duration
+    with pytest.raises(LimitError, match="would be infinitely many frames"):
+        to_canonical_positions(endless)
+    with pytest.raises(LimitError, match=r"data\.max_joint_frames=1000 "):
+        to_canonical_positions(motions["cmu21_walk"], max_joint_frames=1000)
+    monkeypatch.undo()
+    assert to_canonical_positions(motions["cmu21_walk"], fps=30.0).shape[0] == \
+        motions["cmu21_walk"].resampled_length(30.0)

@@ -3,7 +3,8 @@
 File names are ``dataset-2_{content}_{style}_{take}.bvh`` with a ``.json`` label file beside each
 (``{"content": i, "style": j}``), whose indices refer to ``cfg/content_label.txt`` and
 ``cfg/style_label.txt`` (lines like ``dataset-2_walk``). Both must agree; a disagreement is an
-error naming the file and the key.
+error naming the file and the key. Take names are the file stems (safe file names as they
+are); the same stem in two folders of the dataset is refused, naming both paths.
 """
 
 from __future__ import annotations
@@ -14,8 +15,15 @@ import re
 from pathlib import Path
 
 from stylemotion.datasets.base import TakeSet
-from stylemotion.datasets.loading import ConversionSettings, TakeSpec, build_takeset
+from stylemotion.datasets.loading import (
+    ConversionSettings,
+    TakeSpec,
+    build_takeset,
+    check_workers,
+    describe_failure,
+)
 from stylemotion.io.errors import MotionDataError
+from stylemotion.io.outputs import safe_name
 from stylemotion.io.sources import FileSource, list_sources
 
 FILE_NAME = re.compile(r"^(?P<prefix>dataset-\d+)_(?P<content>[a-z-]+)_(?P<style>[a-z]+)_(?P<take>\d+)$")
@@ -34,8 +42,12 @@ def find_label_tables(root: Path, label_dir: str | os.PathLike | None = None) ->
 
 
 def _read_table(path: Path) -> list[str]:
+    try:
+        text = path.read_bytes().decode("utf-8-sig")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise MotionDataError(str(path), f"cannot read label table ({exc})") from None
     names = []
-    for lineno, line in enumerate(path.read_text().splitlines(), start=1):
+    for lineno, line in enumerate(text.splitlines(), start=1):
         line = line.strip()
         if not line:
             continue
@@ -46,7 +58,8 @@ def _read_table(path: Path) -> list[str]:
     return names
 
 
-def bandai_labels(source: FileSource, contents: list[str], styles: list[str]) -> dict[str, str]:
+def bandai_labels(source: FileSource, contents: list[str], styles: list[str],
+                  max_file_mb: float | None = None) -> dict[str, str]:
     """Labels of one file from its name, checked against its JSON label file."""
     match = FILE_NAME.match(source.stem)
     if match is None:
@@ -56,14 +69,19 @@ def bandai_labels(source: FileSource, contents: list[str], styles: list[str]) ->
     if not json_source.exists():
         raise MotionDataError(json_source.name, "label file missing")
     try:
-        data = json.loads(json_source.read_bytes())
+        data = json.loads(json_source.read_bytes(max_file_mb))
     except json.JSONDecodeError as exc:
         raise MotionDataError(json_source.name, f"label file is not valid JSON ({exc.msg})", exc.lineno) from None
+    except UnicodeDecodeError as exc:
+        raise MotionDataError(json_source.name, f"label file is not UTF-8 text ({exc.reason})") from None
+    if not isinstance(data, dict):
+        raise MotionDataError(json_source.name, f"label file holds a {type(data).__name__}, expected an object "
+                              '{"content": i, "style": j}')
     for key, table in (("content", contents), ("style", styles)):
         if key not in data:
             raise MotionDataError(json_source.name, f"key {key!r} missing")
         index = data[key]
-        if not isinstance(index, int) or not 0 <= index < len(table):
+        if isinstance(index, bool) or not isinstance(index, int) or not 0 <= index < len(table):
             raise MotionDataError(json_source.name, f"key {key!r} = {index!r} is not an index into the "
                                   f"{len(table)} {key} labels")
         if table[index] != labels[key]:
@@ -92,22 +110,24 @@ def load_bandai(
         settings: conversion settings (default 30 fps, detected units and joint map).
         skip_broken, cache_dir, use_cache, workers: see :func:`build_takeset`.
     """
-    root = Path(root)
+    check_workers(workers)
+    root = Path(root).expanduser()
     content_table, style_table = find_label_tables(root if root.is_dir() else root.parent, label_dir)
     for key, wanted, table in (("content", contents, content_table), ("style", styles, style_table)):
         unknown = sorted(set(wanted or []) - set(table))
         if unknown:
             raise MotionDataError(str(root), f"unknown {key} {unknown}; the dataset has {table}")
+    settings = settings or ConversionSettings()
     specs: list[TakeSpec] = []
     failures: list[tuple[str, str]] = []
     for source in list_sources(root, "*.bvh"):
         try:
-            labels = bandai_labels(source, content_table, style_table)
-        except MotionDataError as exc:
-            failures.append((source.name, str(exc)))
+            labels = bandai_labels(source, content_table, style_table, settings.max_file_mb)
+            name = safe_name(source.stem, f"take name of {source.name}")
+        except Exception as exc:  # noqa: BLE001 - one file's failure of any kind is reported for that file
+            failures.append((source.name, describe_failure(source.name, exc)))
             continue
         if (contents and labels["content"] not in contents) or (styles and labels["style"] not in styles):
             continue
-        specs.append(TakeSpec(source.stem, source, labels))
-    return build_takeset("bandai", specs, settings or ConversionSettings(), failures, skip_broken,
-                         cache_dir, use_cache, workers)
+        specs.append(TakeSpec(name, source, labels))
+    return build_takeset("bandai", specs, settings, failures, skip_broken, cache_dir, use_cache, workers)

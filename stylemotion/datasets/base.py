@@ -20,7 +20,8 @@ class Take:
     """One recording on the canonical skeleton.
 
     Attributes:
-        name: unique id within its dataset (e.g. the file stem).
+        name: unique id within its dataset (e.g. the file stem), a safe file-name component
+            (:func:`stylemotion.io.outputs.safe_name`).
         positions: ``(frames, 21, 3)`` float32 global positions, metres, Y up.
         fps: frames per second.
         labels: at least ``content`` and ``style``; ``take`` identifies the recording.
@@ -60,12 +61,14 @@ class TakeSet:
         takes: all takes, sorted by name.
         fps: the common frame rate of all takes.
         skipped: ``[(source, reason)]`` for inputs that were skipped (only with skip_broken).
+        warnings: messages about inputs that loaded but look wrong (each names its file).
     """
 
     name: str
     takes: list[Take]
     fps: float
     skipped: list[tuple[str, str]] = field(default_factory=list)
+    warnings: list[str] = field(default_factory=list)
 
     def __len__(self) -> int:
         return len(self.takes)

@@ -15,7 +15,7 @@ DatasetLoader = Callable[..., TakeSet]
 DATASETS: dict[str, DatasetLoader] = {}
 
 #: Keys of a data config that are conversion settings rather than loader arguments.
-_CONVERSION_KEYS = ("fps", "joint_map", "unit_scale", "up_axis")
+_CONVERSION_KEYS = ("fps", "joint_map", "unit_scale", "up_axis", "max_file_mb", "max_frames", "max_joint_frames")
 #: Keys of a data config used by the data modules, not by the loaders.
 _MODULE_KEYS = ("name", "split")
 
@@ -52,8 +52,10 @@ def load_synthetic(
 def load_dataset(name: str, **options: Any) -> TakeSet:
     """Build dataset ``name`` with loader ``options``; unknown names or keys get a clear error.
 
-    Conversion keys (``fps``, ``joint_map``, ``unit_scale``, ``up_axis``) are gathered into a
-    :class:`ConversionSettings` for the loaders that convert files.
+    Conversion keys (``fps``, ``joint_map``, ``unit_scale``, ``up_axis`` and the limits
+    ``max_file_mb``, ``max_frames``, ``max_joint_frames``) are gathered into a
+    :class:`ConversionSettings` for the loaders that convert files; a bad value is a ValueError
+    naming its ``data.`` key.
     """
     if name not in DATASETS:
         raise KeyError(f"unknown dataset {name!r}; registered: {sorted(DATASETS)}")

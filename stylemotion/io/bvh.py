@@ -17,7 +17,8 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from stylemotion.io.atomic import atomic_write_bytes
-from stylemotion.io.errors import BvhError
+from stylemotion.io.errors import BvhError, LimitError, MotionDataWarning
+from stylemotion.io.sources import check_file_size
 from stylemotion.motion import Motion
 from stylemotion.skeleton import Skeleton
 
@@ -74,8 +75,60 @@ class _Tokens:
         return value
 
 
+def _parse_channels(tokens: _Tokens, name: str) -> list[str]:
+    """The channel names after ``CHANNELS`` (the keyword already consumed), checked."""
+    chan_line = tokens.items[tokens.pos - 1][1]
+    count = tokens.number(f"joint {name!r} channel count")
+    if count != int(count) or count < 0:
+        raise BvhError(tokens.source, f"joint {name!r}: bad channel count {count}, expected a "
+                       "non-negative integer", chan_line)
+    channels: list[str] = []
+    for k in range(int(count)):
+        ch_line = tokens.line
+        ch = tokens.items[tokens.pos][0] if tokens.pos < len(tokens.items) else None
+        valid = ch in _ROTATION_CHANNELS or ch in _POSITION_CHANNELS
+        if not valid and (ch is None or ch_line != chan_line):
+            # The channel list ran out of names: the count is larger than the list.
+            raise BvhError(tokens.source, f"joint {name!r}: CHANNELS declares {int(count)} channels but "
+                           f"lists {k}, expected {int(count)} channel names", chan_line)
+        tokens.next(f"joint {name!r} channel name")
+        if not valid:
+            raise BvhError(
+                tokens.source,
+                f"joint {name!r}: channel {ch!r} is not one of "
+                f"{sorted(_POSITION_CHANNELS) + sorted(_ROTATION_CHANNELS)} (declared {int(count)} channels)",
+                ch_line,
+            )
+        channels.append(ch)
+    if tokens.pos < len(tokens.items) and (
+        tokens.items[tokens.pos][0] in _ROTATION_CHANNELS or tokens.items[tokens.pos][0] in _POSITION_CHANNELS
+    ):
+        raise BvhError(
+            tokens.source,
+            f"joint {name!r}: CHANNELS declares {int(count)} channels but lists more "
+            f"({tokens.items[tokens.pos][0]!r} is extra), expected exactly {int(count)} names",
+            chan_line,
+        )
+    axes = [_ROTATION_CHANNELS[c] for c in channels if c in _ROTATION_CHANNELS]
+    positions = [c for c in channels if c in _POSITION_CHANNELS]
+    if (axes and sorted(axes) != ["X", "Y", "Z"]) or len(set(positions)) != len(positions):
+        raise BvhError(
+            tokens.source,
+            f"joint {name!r}: channels {' '.join(channels)} are not supported, expected no rotation "
+            "channels or exactly one each of Xrotation, Yrotation, Zrotation (and no repeated position channel)",
+            chan_line,
+        )
+    return channels
+
+
 def _parse_hierarchy(tokens: _Tokens) -> Skeleton:
+    """The skeleton of the HIERARCHY section.
+
+    Iterative (an explicit stack of open joints), so any nesting depth parses: a chain of
+    thousands of joints is bounded by memory, not by Python's recursion limit.
+    """
     names: list[str] = []
+    seen: set[str] = set()
     parents: list[int] = []
     offsets: list[list[float]] = []
     channels: list[list[str]] = []
@@ -85,87 +138,45 @@ def _parse_hierarchy(tokens: _Tokens) -> Skeleton:
         tokens.expect("OFFSET")
         return [tokens.number(f"{what} OFFSET {axis}") for axis in "xyz"]
 
-    def joint(parent: int) -> None:
+    def open_joint(parent: int) -> int:
+        """Read a joint's name, '{', OFFSET and CHANNELS; returns its index."""
         line = tokens.line
         name = tokens.next("a joint name")
-        if name in names:
+        if name in seen:
             raise BvhError(tokens.source, f"joint name {name!r} appears twice", line)
         tokens.expect("{")
         index = len(names)
         names.append(name)
+        seen.add(name)
         parents.append(parent)
         offsets.append(offset(f"joint {name!r}"))
-        channels.append([])
+        chans: list[str] = []
         if tokens.pos < len(tokens.items) and tokens.items[tokens.pos][0] == "CHANNELS":
-            chan_line = tokens.line
             tokens.next("CHANNELS")
-            count = tokens.number(f"joint {name!r} channel count")
-            if count != int(count) or count < 0:
-                raise BvhError(tokens.source, f"joint {name!r}: bad channel count {count}, expected a "
-                               "non-negative integer", chan_line)
-            for k in range(int(count)):
-                ch_line = tokens.line
-                ch = tokens.items[tokens.pos][0] if tokens.pos < len(tokens.items) else None
-                valid = ch in _ROTATION_CHANNELS or ch in _POSITION_CHANNELS
-                if not valid and (ch is None or ch_line != chan_line):
-                    # The channel list ran out of names: the count is larger than the list.
-                    raise BvhError(
-                        tokens.source,
-                        f"joint {name!r}: CHANNELS declares {int(count)} channels but lists {k}, "
-                        f"expected {int(count)} channel names",
-                        chan_line,
-                    )
-                tokens.next(f"joint {name!r} channel name")
-                if not valid:
-                    raise BvhError(
-                        tokens.source,
-                        f"joint {name!r}: channel {ch!r} is not one of "
-                        f"{sorted(_POSITION_CHANNELS) + sorted(_ROTATION_CHANNELS)} "
-                        f"(declared {int(count)} channels)",
-                        ch_line,
-                    )
-                channels[index].append(ch)
-            if tokens.pos < len(tokens.items) and (
-                tokens.items[tokens.pos][0] in _ROTATION_CHANNELS
-                or tokens.items[tokens.pos][0] in _POSITION_CHANNELS
-            ):
-                raise BvhError(
-                    tokens.source,
-                    f"joint {name!r}: CHANNELS declares {int(count)} channels but lists more "
-                    f"({tokens.items[tokens.pos][0]!r} is extra), expected exactly {int(count)} names",
-                    chan_line,
-                )
-            axes = [_ROTATION_CHANNELS[c] for c in channels[index] if c in _ROTATION_CHANNELS]
-            positions = [c for c in channels[index] if c in _POSITION_CHANNELS]
-            if (axes and sorted(axes) != ["X", "Y", "Z"]) or len(set(positions)) != len(positions):
-                raise BvhError(
-                    tokens.source,
-                    f"joint {name!r}: channels {' '.join(channels[index])} are not supported, expected "
-                    "no rotation channels or exactly one each of Xrotation, Yrotation, Zrotation "
-                    "(and no repeated position channel)",
-                    chan_line,
-                )
-        while True:
-            line = tokens.line
-            tok = tokens.next(f"JOINT, End Site or '}}' closing joint {name!r}")
-            if tok == "JOINT":
-                joint(index)
-            elif tok == "End":
-                tokens.expect("Site")
-                tokens.expect("{")
-                end_sites[index] = np.array(offset(f"End Site of {name!r}"))
-                tokens.expect("}")
-            elif tok == "}":
-                return
-            else:
-                raise BvhError(
-                    tokens.source, f"unexpected {tok!r} in joint {name!r}, expected JOINT, End Site or '}}'",
-                    line,
-                )
+            chans = _parse_channels(tokens, name)
+        channels.append(chans)
+        return index
 
     tokens.expect("HIERARCHY")
     tokens.expect("ROOT")
-    joint(-1)
+    stack = [open_joint(-1)]  # joints whose '}' has not been read yet, innermost last
+    while stack:
+        current = stack[-1]
+        name = names[current]
+        line = tokens.line
+        tok = tokens.next(f"JOINT, End Site or '}}' closing joint {name!r}")
+        if tok == "JOINT":
+            stack.append(open_joint(current))
+        elif tok == "End":
+            tokens.expect("Site")
+            tokens.expect("{")
+            end_sites[current] = np.array(offset(f"End Site of {name!r}"))
+            tokens.expect("}")
+        elif tok == "}":
+            stack.pop()
+        else:
+            raise BvhError(tokens.source, f"unexpected {tok!r} in joint {name!r}, expected JOINT, End Site or "
+                           "'}'", line)
     return Skeleton(names, np.array(parents), np.array(offsets), channels, end_sites)
 
 
@@ -183,14 +194,52 @@ def _token_counts_per_line(data: bytes) -> np.ndarray:
     return np.add.reduceat(starts.astype(np.int64), line_starts)
 
 
-def parse_bvh(data: bytes | str, source: str = "<memory>") -> Motion:
+#: Default cap on frames × joints of one parsed motion (its per-joint arrays; ≈ 2–3 GB while parsing).
+DEFAULT_MAX_JOINT_FRAMES = 20_000_000
+#: A Frame Time at least this long (seconds) over at least this many frames looks like milliseconds.
+_MS_FRAME_TIME_S, _MS_MIN_FRAMES = 1.0, 10
+_UTF8_BOM = b"\xef\xbb\xbf"
+
+
+def normalize_text(raw: bytes, source: str) -> bytes:
+    """``raw`` with a UTF-8 byte-order mark dropped and CR-LF or CR-only line ends made LF.
+
+    Line numbers are kept: each CR-LF, CR or LF ends one line.
+
+    Raises:
+        BvhError: for UTF-16/32 text (a byte-order mark other than UTF-8's), naming line 1.
+    """
+    if raw.startswith(_UTF8_BOM):
+        raw = raw[len(_UTF8_BOM):]
+    elif raw.startswith((b"\xff\xfe", b"\xfe\xff")):
+        raise BvhError(source, "file is UTF-16 or UTF-32 text (byte-order mark); expected ASCII or UTF-8, "
+                       "re-save it as UTF-8", 1)
+    if b"\r" in raw:
+        raw = raw.replace(b"\r\n", b"\n").replace(b"\r", b"\n")
+    return raw
+
+
+def parse_bvh(data: bytes | str, source: str = "<memory>",
+              max_joint_frames: int | None = DEFAULT_MAX_JOINT_FRAMES) -> Motion:
     """Parse BVH text into a :class:`Motion` (file units, file fps).
+
+    LF, CR-LF and CR-only line ends and a UTF-8 byte-order mark are accepted.
+
+    Args:
+        data: the file's bytes (or text).
+        source: what messages call the file.
+        max_joint_frames: refuse a motion of more frames × joints than this, before allocating
+            its arrays (None: no limit).
 
     Raises:
         BvhError: naming ``source`` and the line, for any malformed content.
+        LimitError: the motion is larger than ``max_joint_frames``.
+
+    Warns:
+        MotionDataWarning: the Frame Time looks like milliseconds (≥ 1 s over ≥ 10 frames).
     """
-    raw = data.encode() if isinstance(data, str) else data
-    match = re.search(rb"^[ \t]*MOTION[ \t\r]*$", raw, flags=re.MULTILINE)
+    raw = normalize_text(data.encode() if isinstance(data, str) else data, source)
+    match = re.search(rb"^[ \t]*MOTION[ \t]*$", raw, flags=re.MULTILINE)
     if match is None:
         # Parse what there is so that the error says where the file stops making sense.
         _raise_missing_motion(raw, source)
@@ -198,7 +247,8 @@ def parse_bvh(data: bytes | str, source: str = "<memory>") -> Motion:
     try:
         header = raw[: match.start()].decode("utf-8")
     except UnicodeDecodeError as exc:
-        raise BvhError(source, f"hierarchy is not text ({exc})") from None
+        line = raw[: exc.start].count(b"\n") + 1
+        raise BvhError(source, f"hierarchy is not UTF-8 text (byte {raw[exc.start]:#04x})", line) from None
     tokens = _Tokens(header, source, motion_line)
     if not tokens.items:
         raise BvhError(source, "empty hierarchy, expected 'HIERARCHY'", 1)
@@ -240,13 +290,28 @@ def parse_bvh(data: bytes | str, source: str = "<memory>") -> Motion:
     body_line = first_line + 2
     num_channels = sum(len(c) for c in skeleton.channels)
     values = _parse_rows(body, num_frames, num_channels, source, body_line)
+    check_joint_frames(num_frames, skeleton.num_joints, max_joint_frames, source, "in the file")
+    if frame_time >= _MS_FRAME_TIME_S and num_frames >= _MS_MIN_FRAMES:
+        warnings.warn(
+            f"{source}:{first_line + 1}: Frame Time {time_m.group(1)} s ({1.0 / frame_time:.3g} fps) over "
+            f"{num_frames} frames looks like milliseconds; BVH Frame Time is in seconds (for "
+            f"{frame_time:g} ms write Frame Time: {frame_time / 1000:g})",
+            MotionDataWarning, stacklevel=2,
+        )
     return _motion_from_channels(skeleton, values, snap_fps(1.0 / frame_time), source)
+
+
+def check_joint_frames(num_frames: int, num_joints: int, limit: int | None, source: str, when: str) -> None:
+    """Raise :class:`LimitError` if ``num_frames × num_joints`` exceeds ``limit`` (None: no limit)."""
+    if limit is not None and num_frames * num_joints > limit:
+        raise LimitError(source, f"{num_frames} frames × {num_joints} joints {when} = {num_frames * num_joints} "
+                         f"joint-frames, more than the limit data.max_joint_frames={limit} "
+                         "(raise it for longer or larger motions)")
 
 
 def _raise_missing_motion(raw: bytes, source: str) -> None:
     """Raise the error for a file without a MOTION line, at the line where it was expected."""
-    header = raw.decode("utf-8", "replace")
-    tokens = _Tokens(header, source)
+    tokens = _Tokens(raw.decode("utf-8", "replace"), source)
     if not tokens.items:
         raise BvhError(source, "empty file, expected 'HIERARCHY'", 1)
     _parse_hierarchy(tokens)  # raises, naming the line, when the file ends inside the hierarchy
@@ -350,14 +415,16 @@ def _motion_from_channels(skeleton: Skeleton, values: np.ndarray, fps: float, so
     return Motion(skeleton, rotations, translations, fps, source)
 
 
-def read_bvh(path: str | os.PathLike) -> Motion:
-    """Read one BVH file from disk."""
+def read_bvh(path: str | os.PathLike, max_file_mb: float | None = None,
+             max_joint_frames: int | None = DEFAULT_MAX_JOINT_FRAMES) -> Motion:
+    """Read one BVH file from disk (see :func:`parse_bvh`); ``max_file_mb`` caps its size."""
     path = Path(path)
     try:
+        check_file_size(path.stat().st_size, max_file_mb, str(path))
         data = path.read_bytes()
     except OSError as exc:
         raise BvhError(str(path), f"cannot read file ({exc.strerror or exc})") from None
-    return parse_bvh(data, str(path))
+    return parse_bvh(data, str(path), max_joint_frames)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -365,32 +432,40 @@ def read_bvh(path: str | os.PathLike) -> Motion:
 
 
 def format_bvh(motion: Motion, precision: int = 6) -> str:
-    """BVH text for ``motion``, keeping its skeleton's channels and rotation orders."""
+    """BVH text for ``motion``, keeping its skeleton's channels and rotation orders.
+
+    The hierarchy is written iteratively (an explicit stack), so any nesting depth works.
+    """
     sk = motion.skeleton
-    out = io.StringIO()
-    out.write("HIERARCHY\n")
-    children: dict[int, list[int]] = {j: sk.children(j) for j in range(sk.num_joints)}
+    roots = [j for j in range(sk.num_joints) if sk.parents[j] < 0]
+    if len(roots) != 1:
+        raise ValueError(f"{motion.source}: a BVH file needs exactly one root joint, found {len(roots)}")
+    children: list[list[int]] = [[] for _ in range(sk.num_joints)]
+    for j, p in enumerate(sk.parents):
+        if p >= 0:
+            children[p].append(j)
     fmt = f"{{:.{precision}f}}"
 
     def vec(v: np.ndarray) -> str:
         return " ".join(fmt.format(float(x)) for x in v)
 
-    def write_joint(j: int, depth: int) -> None:
+    out = io.StringIO()
+    out.write("HIERARCHY\n")
+    stack: list[tuple[int, int, bool]] = [(roots[0], 0, False)]  # (joint, depth, closing)
+    while stack:
+        j, depth, closing = stack.pop()
         ind = "\t" * depth
+        if closing:
+            if j in sk.end_sites:
+                out.write(f"{ind}\tEnd Site\n{ind}\t{{\n{ind}\t\tOFFSET {vec(sk.end_sites[j])}\n{ind}\t}}\n")
+            out.write(f"{ind}}}\n")
+            continue
         out.write(f"{ind}{'ROOT' if sk.parents[j] < 0 else 'JOINT'} {sk.names[j]}\n{ind}{{\n")
         out.write(f"{ind}\tOFFSET {vec(sk.offsets[j])}\n")
         if sk.channels[j]:
             out.write(f"{ind}\tCHANNELS {len(sk.channels[j])} {' '.join(sk.channels[j])}\n")
-        for c in children[j]:
-            write_joint(c, depth + 1)
-        if j in sk.end_sites:
-            out.write(f"{ind}\tEnd Site\n{ind}\t{{\n{ind}\t\tOFFSET {vec(sk.end_sites[j])}\n{ind}\t}}\n")
-        out.write(f"{ind}}}\n")
-
-    roots = [j for j in range(sk.num_joints) if sk.parents[j] < 0]
-    if len(roots) != 1:
-        raise ValueError(f"{motion.source}: a BVH file needs exactly one root joint, found {len(roots)}")
-    write_joint(roots[0], 0)
+        stack.append((j, depth, True))
+        stack.extend((c, depth + 1, False) for c in reversed(children[j]))
     out.write(f"MOTION\nFrames: {motion.num_frames}\nFrame Time: {1.0 / motion.fps:.8f}\n")
     out.write(_format_rows(motion, precision))
     return out.getvalue()

@@ -1,4 +1,4 @@
-"""Errors that name where bad input was found."""
+"""Errors and warnings that name where bad input was found."""
 
 from __future__ import annotations
 
@@ -16,3 +16,11 @@ class MotionDataError(ValueError):
 
 class BvhError(MotionDataError):
     """A malformed BVH file."""
+
+
+class LimitError(MotionDataError):
+    """An input exceeds a configured size limit (the message names the key and its value)."""
+
+
+class MotionDataWarning(UserWarning):
+    """Input that loads but is probably wrong (axes, units of time); the message names the file."""

@@ -1,36 +1,83 @@
 """Where motion files come from: a file, a folder (recursive), or members of a ``.zip``.
 
-Zip members are read straight from the archive, never unpacked to disk. Each source has a cheap
-fingerprint (zip CRC-32 and size; file size and modification time) used to key caches.
+Zip members are read straight from the archive, never unpacked to disk. Each source has a
+fingerprint of its content used to key caches: a zip member's CRC-32 and size from the central
+directory (no decompression), a file's SHA-256 (memoized within one process while its size,
+times and inode stay the same). Sizes are checked before anything is read or inflated.
 """
 
 from __future__ import annotations
 
 import fnmatch
+import hashlib
 import os
 import zipfile
 import zlib
 from dataclasses import dataclass
 from pathlib import Path, PurePosixPath
 
-from stylemotion.io.errors import MotionDataError
+from stylemotion.io.errors import LimitError, MotionDataError
 
-_OPEN_ZIPS: dict[tuple[str, int], zipfile.ZipFile] = {}
+#: (path, pid) → (archive's (size, mtime_ns, ctime_ns, inode, device), open ZipFile).
+_OPEN_ZIPS: dict[tuple[str, int], tuple[tuple[int, ...], zipfile.ZipFile]] = {}
+#: path → ((size, mtime_ns, ctime_ns, inode, device), hex digest) of files hashed in this process.
+_DIGESTS: dict[str, tuple[tuple[int, ...], str]] = {}
+_HASH_CHUNK = 1 << 20
 
 
-def _zip(path: str) -> zipfile.ZipFile:
+def check_file_size(num_bytes: int, max_file_mb: float | None, source: str) -> None:
+    """Raise :class:`LimitError` naming ``data.max_file_mb`` if ``num_bytes`` exceeds it (None: no limit)."""
+    if max_file_mb is not None and num_bytes > max_file_mb * 1e6:
+        raise LimitError(source, f"file is {num_bytes / 1e6:.1f} MB (uncompressed), more than the limit "
+                         f"data.max_file_mb={max_file_mb:g} (raise it for larger files)")
+
+
+def _stamp(path: str) -> tuple[int, ...]:
+    """What changes when a file is written or replaced: size, mtime, ctime, inode, device."""
+    st = os.stat(path)
+    return (st.st_size, st.st_mtime_ns, st.st_ctime_ns, st.st_ino, st.st_dev)
+
+
+def _file_digest(path: str, stamp: tuple[int, ...]) -> str:
+    """SHA-256 of a file's bytes, memoized while its :func:`_stamp` is ``stamp``.
+
+    ctime is in the stamp because it changes on every write, even one that restores the mtime.
+    """
+    memo = _DIGESTS.get(path)
+    if memo is not None and memo[0] == stamp:
+        return memo[1]
+    digest = hashlib.sha256()
+    with open(path, "rb") as fh:
+        while chunk := fh.read(_HASH_CHUNK):
+            digest.update(chunk)
+    _DIGESTS[path] = (stamp, digest.hexdigest())
+    return _DIGESTS[path][1]
+
+
+def _zip(path: str, fresh: bool = False) -> zipfile.ZipFile:
     """An open ZipFile per archive and process (reading the central directory once).
 
-    Keyed by process id too: a forked worker must not share its parent's file position.
+    Keyed by process id too: a forked worker must not share its parent's file position. With
+    ``fresh`` (listing members, fingerprints) the archive is reopened if it changed on disk since,
+    so its CRCs (the cache key) are never stale.
     """
     key = (path, os.getpid())
-    archive = _OPEN_ZIPS.get(key)
-    if archive is None:
-        try:
-            archive = zipfile.ZipFile(path)
-        except (OSError, zipfile.BadZipFile) as exc:
-            raise MotionDataError(path, f"cannot open zip archive ({exc})") from None
-        _OPEN_ZIPS[key] = archive
+    cached = _OPEN_ZIPS.get(key)
+    if cached is not None and not fresh:
+        return cached[1]
+    try:
+        stamp = _stamp(path)
+    except OSError as exc:
+        raise MotionDataError(path, f"cannot open zip archive ({exc.strerror or exc})") from None
+    if cached is not None and cached[0] == stamp:
+        return cached[1]
+    try:
+        archive = zipfile.ZipFile(path)
+    except (OSError, zipfile.BadZipFile, ValueError) as exc:
+        raise MotionDataError(path, f"cannot open zip archive ({exc})") from None
+    if cached is not None:
+        cached[1].close()
+    _OPEN_ZIPS[key] = (stamp, archive)
     return archive
 
 
@@ -50,12 +97,33 @@ class FileSource:
     def stem(self) -> str:
         return PurePosixPath(self.member).stem if self.member is not None else Path(self.path).stem
 
-    def read_bytes(self) -> bytes:
+    def size(self) -> int:
+        """Size in bytes (uncompressed, from the zip's central directory for a member)."""
         if self.member is None:
             try:
-                return Path(self.path).read_bytes()
+                return os.stat(self.path).st_size
             except OSError as exc:
                 raise MotionDataError(self.name, f"cannot read file ({exc.strerror or exc})") from None
+        try:
+            return _zip(self.path).getinfo(self.member).file_size
+        except KeyError:
+            raise MotionDataError(self.name, "no such member in the archive") from None
+
+    def read_bytes(self, max_file_mb: float | None = None) -> bytes:
+        """The content; :class:`LimitError` before reading if it is larger than ``max_file_mb``."""
+        size = self.size()
+        check_file_size(size, max_file_mb, self.name)
+        if self.member is None:
+            cap = None if max_file_mb is None else int(max_file_mb * 1e6) + 1
+            try:
+                with open(self.path, "rb") as fh:
+                    data = fh.read(size + 1 if cap is None else min(size + 1, cap))
+                    if len(data) > size:  # grew since, or no regular file (size 0): read on, bounded
+                        data += fh.read() if cap is None else fh.read(cap - len(data))
+            except OSError as exc:
+                raise MotionDataError(self.name, f"cannot read file ({exc.strerror or exc})") from None
+            check_file_size(len(data), max_file_mb, self.name)
+            return data
         try:
             return _zip(self.path).read(self.member)
         except KeyError:
@@ -63,13 +131,24 @@ class FileSource:
         except (OSError, zipfile.BadZipFile, zlib.error, EOFError, RuntimeError, ValueError) as exc:
             raise MotionDataError(self.name, f"cannot read zip member ({exc})") from None
 
-    def fingerprint(self) -> str:
-        """Changes whenever the content does (CRC-32+size in a zip; size+mtime on disk)."""
-        if self.member is None:
-            st = os.stat(self.path)
-            return f"{st.st_size}:{st.st_mtime_ns}"
-        info = _zip(self.path).getinfo(self.member)
-        return f"{info.CRC:08x}:{info.file_size}"
+    def fingerprint(self, max_file_mb: float | None = None) -> str:
+        """Changes whenever the content does: CRC-32 and size of a zip member, SHA-256 of a file.
+
+        A file larger than ``max_file_mb`` is not hashed (it is refused by size, whatever it holds).
+        """
+        if self.member is not None:
+            try:
+                info = _zip(self.path, fresh=True).getinfo(self.member)
+            except KeyError:
+                raise MotionDataError(self.name, "no such member in the archive") from None
+            return f"{info.CRC:08x}:{info.file_size}"
+        try:
+            stamp = _stamp(self.path)
+            if max_file_mb is not None and stamp[0] > max_file_mb * 1e6:
+                return f"{stamp[0]}:over-limit"
+            return f"sha256:{_file_digest(self.path, stamp)}"
+        except OSError as exc:
+            raise MotionDataError(self.name, f"cannot read file ({exc.strerror or exc})") from None
 
     def sibling(self, suffix: str) -> FileSource:
         """The source with the same stem and another suffix (e.g. the ``.json`` label file)."""
@@ -97,7 +176,7 @@ def list_sources(root: str | os.PathLike, pattern: str = "*.bvh") -> list[FileSo
     if not root.exists():
         raise MotionDataError(str(root), "no such file or folder")
     if root.is_file() and root.suffix.lower() == ".zip":
-        members = sorted(m for m in _zip(str(root)).namelist()
+        members = sorted(m for m in _zip(str(root), fresh=True).namelist()
                          if not m.endswith("/") and fnmatch.fnmatch(PurePosixPath(m).name, pattern))
         sources = [FileSource(str(root), m) for m in members]
     elif root.is_file():

@@ -9,7 +9,7 @@ import pytest
 
 from stylemotion.datasets.synthetic import CONTENTS, STYLES, SyntheticTake, generate_take, generate_takes
 from stylemotion.representation import frames_to_positions, positions_to_frames
-from stylemotion.skeleton import CJ, bone_lengths
+from stylemotion.skeleton import JOINT_INDEX, bone_lengths
 
 FEET = (("Foot_L", "Toes_L"), ("Foot_R", "Toes_R"))  # contact columns 0 (left) and 1 (right)
 
@@ -52,7 +52,7 @@ def stride_length(take: SyntheticTake) -> float:
     lengths = []
     for column, (ankle, _) in enumerate(FEET):
         strikes = np.nonzero(np.diff(take.contacts[:, column].astype(int)) == 1)[0] + 1
-        spots = take.positions[strikes, CJ[ankle]][:, [0, 2]]
+        spots = take.positions[strikes, JOINT_INDEX[ankle]][:, [0, 2]]
         lengths.extend(np.linalg.norm(np.diff(spots, axis=0), axis=1))
     return float(np.mean(lengths))
 
@@ -60,24 +60,24 @@ def stride_length(take: SyntheticTake) -> float:
 def arm_swing(take: SyntheticTake) -> float:
     """Standard deviation of the hands' forward position relative to the body, metres."""
     local = local_frames(take)[:, :63].reshape(-1, 21, 3)
-    return float(np.mean([local[:, CJ[h], 2].std() for h in ("Hand_L", "Hand_R")]))
+    return float(np.mean([local[:, JOINT_INDEX[h], 2].std() for h in ("Hand_L", "Hand_R")]))
 
 
 def torso_lean(take: SyntheticTake) -> float:
     """Mean forward offset of the neck over the hips, metres."""
     local = local_frames(take)[:, :63].reshape(-1, 21, 3)
-    return float((local[:, CJ["Neck"], 2] - local[:, CJ["Hips"], 2]).mean())
+    return float((local[:, JOINT_INDEX["Neck"], 2] - local[:, JOINT_INDEX["Hips"], 2]).mean())
 
 
 def head_drop(take: SyntheticTake) -> float:
     """Mean forward offset of the head over the neck, metres."""
     local = local_frames(take)[:, :63].reshape(-1, 21, 3)
-    return float((local[:, CJ["Head"], 2] - local[:, CJ["Neck"], 2]).mean())
+    return float((local[:, JOINT_INDEX["Head"], 2] - local[:, JOINT_INDEX["Neck"], 2]).mean())
 
 
 def foot_lift(take: SyntheticTake) -> float:
     """Mean of the highest ankle height in each take's swings, metres (95th percentile)."""
-    heights = [take.positions[~take.contacts[:, c], CJ[a], 1] for c, (a, _) in enumerate(FEET)]
+    heights = [take.positions[~take.contacts[:, c], JOINT_INDEX[a], 1] for c, (a, _) in enumerate(FEET)]
     return float(np.percentile(np.concatenate(heights), 95))
 
 
@@ -137,10 +137,10 @@ def test_bone_lengths_are_constant(takes):
 
 
 def test_body_size_is_adult_and_varies_per_take(takes):
-    heads = [t.positions[:, CJ["Head"], 1].mean() for t in takes[("walk", "normal")]]
-    heads += [t.positions[:, CJ["Head"], 1].mean() for t in takes[("walk", "masculine")]]
+    heads = [t.positions[:, JOINT_INDEX["Head"], 1].mean() for t in takes[("walk", "normal")]]
+    heads += [t.positions[:, JOINT_INDEX["Head"], 1].mean() for t in takes[("walk", "masculine")]]
     assert all(1.35 < h < 1.65 for h in heads)
-    thighs = [bone_lengths(t.positions[0])[CJ["LowerLeg_L"]] for t in all_takes(takes)]
+    thighs = [bone_lengths(t.positions[0])[JOINT_INDEX["LowerLeg_L"]] for t in all_takes(takes)]
     assert np.ptp(thighs) > 0.02 and all(0.40 < x < 0.46 for x in thighs)
 
 
@@ -151,18 +151,18 @@ def test_planted_feet_are_still_on_the_ground_and_nothing_goes_below_it(takes):
             planted = take.contacts[:-1, column] & take.contacts[1:, column]
             assert planted.mean() > 0.2, take.name
             for joint, height in ((ankle, 0.09), (toes, 0.03)):
-                track = take.positions[:, CJ[joint]]
+                track = take.positions[:, JOINT_INDEX[joint]]
                 speed = np.linalg.norm(np.diff(track[:, [0, 2]], axis=0), axis=1) * take.fps
                 assert speed[planted].max() < 0.02, (take.name, joint)
                 assert track[take.contacts[:, column], 1].max() < height, (take.name, joint)
             swinging = ~take.contacts[:, column]
-            assert take.positions[swinging, CJ[ankle], 1].max() > 0.1, take.name
+            assert take.positions[swinging, JOINT_INDEX[ankle], 1].max() > 0.1, take.name
 
 
 def test_a_plain_speed_threshold_finds_the_contacts_within_one_frame(takes):
     for take in all_takes(takes):
         for column, joints in enumerate(FEET):
-            tracks = take.positions[:, [CJ[j] for j in joints]]
+            tracks = take.positions[:, [JOINT_INDEX[j] for j in joints]]
             speed = (np.linalg.norm(np.diff(tracks, axis=0), axis=-1) * take.fps).max(axis=1)
             detected = np.concatenate([speed, speed[-1:]]) < 0.2
             truth = take.contacts[:, column]
@@ -228,7 +228,7 @@ def test_step_width_differs_between_masculine_and_feminine(takes):
     def width(take: SyntheticTake) -> float:
         """Mean sideways distance between the ankles, metres."""
         local = local_frames(take)[:, :63].reshape(-1, 21, 3)
-        return float(np.abs(local[:, CJ["Foot_L"], 0] - local[:, CJ["Foot_R"], 0]).mean())
+        return float(np.abs(local[:, JOINT_INDEX["Foot_L"], 0] - local[:, JOINT_INDEX["Foot_R"], 0]).mean())
 
     assert mean_over(takes, "walk", "feminine", width) + 0.08 < mean_over(takes, "walk", "masculine", width)
 
