@@ -1,12 +1,20 @@
-"""Where the Hydra configs live and small helpers shared by the entry points.
+"""Where the Hydra configs live, and the checks and resolvers every entry point shares.
 
 The configs ship inside the package (``stylemotion/configs``, package data), so every command works
-from a wheel or a non-editable install as well as from a clone.
+from a wheel or a non-editable install as well as from a clone. Values a user types on the command
+line are checked here before any work (:func:`positive_int`, :func:`set_torch_threads`,
+:func:`check_trainer_numbers`); a bad one is a :class:`ConfigError` naming the key and the value.
+Resolvers registered on import: ``${cpu_precision:}`` and ``${unique_id:}`` (run ids).
 """
 
 from __future__ import annotations
 
+import math
+import secrets
+from collections.abc import Mapping
+from datetime import datetime
 from pathlib import Path
+from typing import Any
 
 #: The packaged Hydra configs, as a folder on disk.
 CONFIG_DIR = Path(__file__).resolve().parent / "configs"
@@ -22,6 +30,89 @@ def config_dir() -> str:
             "(the wheel must include stylemotion/configs/**/*.yaml); reinstall it"
         )
     return str(CONFIG_DIR)
+
+
+class ConfigError(ValueError):
+    """A config value that cannot be used; the message names the key and the value."""
+
+
+def _is_int(value: Any) -> bool:
+    return isinstance(value, int) and not isinstance(value, bool)
+
+
+def _is_number(value: Any) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool)
+
+
+def positive_int(value: Any, key: str) -> int:
+    """``value`` as an int ≥ 1 (an int, or a string of one); :class:`ConfigError` naming ``key`` otherwise.
+
+    Booleans, fractions, ``abc``, 0 and negative numbers are refused.
+    """
+    number = value
+    if isinstance(value, str):
+        try:
+            number = int(value.strip())
+        except ValueError:
+            number = None
+    if not _is_int(number) or number < 1:
+        raise ConfigError(f"{key} must be a whole number ≥ 1, got {value!r}")
+    return int(number)
+
+
+def set_torch_threads(value: Any, key: str = "threads") -> int | None:
+    """``torch.set_num_threads(value)`` after :func:`positive_int`; ``None`` keeps torch's default.
+
+    Returns the number of threads set, or None.
+    """
+    if value is None:
+        return None
+    threads = positive_int(value, key)
+    import torch
+
+    torch.set_num_threads(threads)
+    return threads
+
+
+#: Numeric keys of a Lightning ``Trainer`` node: key → (kind, smallest value allowed).
+#: Kinds: ``int``; ``number`` (int or float); ``batches`` (an int count, or a float fraction in [0, 1]).
+TRAINER_NUMBERS: dict[str, tuple[str, float]] = {
+    "max_epochs": ("int", -1), "min_epochs": ("int", 0), "max_steps": ("int", -1), "min_steps": ("int", 0),
+    "num_nodes": ("int", 1), "check_val_every_n_epoch": ("int", 1), "num_sanity_val_steps": ("int", -1),
+    "log_every_n_steps": ("int", 0), "accumulate_grad_batches": ("int", 1), "gradient_clip_val": ("number", 0),
+    "limit_train_batches": ("batches", 0), "limit_val_batches": ("batches", 0), "limit_test_batches": ("batches", 0),
+    "limit_predict_batches": ("batches", 0), "val_check_interval": ("batches", 0),
+}
+
+
+def check_trainer_numbers(trainer: Mapping[str, Any], prefix: str = "trainer") -> None:
+    """Check the numeric keys of a ``Trainer`` config node (:data:`TRAINER_NUMBERS`) before it is built.
+
+    ``null`` means Lightning's default and is accepted. Raises :class:`ConfigError` naming
+    ``<prefix>.<key>`` and the value (``trainer.max_steps=abc`` fails here, not inside Lightning).
+    """
+    for key, (kind, low) in TRAINER_NUMBERS.items():
+        value = trainer.get(key)
+        if value is None:
+            continue
+        full = f"{prefix}.{key}"
+        if kind == "int":
+            if not _is_int(value) or value < low:
+                raise ConfigError(f"{full} must be a whole number ≥ {low:g}, got {value!r}")
+        elif not _is_number(value) or not math.isfinite(value) or value < low:
+            raise ConfigError(f"{full} must be a finite number ≥ {low:g}, got {value!r}")
+        elif kind == "batches" and isinstance(value, float) and value > 1.0:
+            raise ConfigError(f"{full} must be a whole number of batches or a fraction in [0, 1], got {value!r}")
+
+
+def unique_id() -> str:
+    """A run id: local time to the microsecond and 4 random hex digits, e.g. ``2025-06-01_12-30-45_123456_9f3a``.
+
+    Ids sort by time (fixed-width fields), and two runs started in the same microsecond, or on two
+    machines at once, still differ. The ``${unique_id:}`` resolver caches it, so one run (and all
+    jobs of one sweep) sees one id.
+    """
+    return datetime.now().strftime("%Y-%m-%d_%H-%M-%S_%f") + "_" + secrets.token_hex(2)
 
 
 def cpu_precision(cpuinfo: str | Path = "/proc/cpuinfo") -> str:
@@ -43,6 +134,8 @@ def _register_resolvers() -> None:
 
     if not OmegaConf.has_resolver("cpu_precision"):
         OmegaConf.register_new_resolver("cpu_precision", cpu_precision)
+    if not OmegaConf.has_resolver("unique_id"):
+        OmegaConf.register_new_resolver("unique_id", unique_id, use_cache=True)
 
 
 _register_resolvers()

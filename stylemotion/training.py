@@ -5,13 +5,36 @@
     stylemotion-train experiment=smoke -m model.kernel_size=9,15,25 # a sweep (basic launcher)
     stylemotion-train ... -m hydra/launcher=joblib                  # the sweep's jobs in parallel
     stylemotion-train ... trainer=ddp trainer.devices=2             # DistributedDataParallel
-    stylemotion-train ... run_id=<id of an earlier run> ckpt_path=last   # resume that run
+    stylemotion-train ... hydra.run.dir=<run folder> ckpt_path=last # resume that run
+    stylemotion-train ... hydra.run.dir=<run folder> ckpt_path=auto # resume if it has last.ckpt, else start
 
 The entry point only composes and instantiates: ``cfg.datamodule`` receives the data config
 (``cfg.data``) as ``data=``; ``cfg.model`` is any LightningModule; ``cfg.trainer``, ``cfg.logger``
 and ``cfg.callbacks`` are Lightning objects. Each run writes into one folder (``output_dir``): the
-config as composed (``.hydra/``) and resolved (``config_resolved.yaml``), ``tensorboard/``,
-``checkpoints/{best,last}.ckpt`` and ``metrics.json`` (test metrics of the best checkpoint).
+config as composed (``.hydra/``) and resolved (``config_resolved.yaml``), ``run.json`` (package
+version, git commit, command and time of every start), ``tensorboard/`` (metrics, learning rate, and
+the hyperparameters with the best monitored value in the HPARAMS tab), ``checkpoints/{best,last}.ckpt``
+and ``metrics.json`` (test metrics of the best checkpoint, version and commit).
+
+A run never writes over another run's results. Before any work, :func:`prepare_output` looks for
+results in the folder (checkpoints, ``metrics.json``, logger files; Hydra's own ``.hydra/`` and
+``<job>.log`` do not count) and refuses with :class:`~stylemotion.io.outputs.OutputExistsError`
+unless the run resumes (``ckpt_path=last|auto|<file>``) or ``force=true``, which **deletes** the
+old checkpoints, ``metrics.json`` and logger files (event files, ``hparams.yaml``, ``metrics.csv``)
+and starts afresh. ``ckpt_path``:
+
+* ``null``: start (refused where results exist, see above);
+* ``last``: resume from ``<output_dir>/checkpoints/last.ckpt``, which must exist;
+* ``auto``: resume from it if it exists, else start (for requeued cluster jobs); logger files of an
+  attempt that saved no checkpoint are deleted, other results are refused;
+* a path: resume from that checkpoint.
+
+``last.ckpt`` is written by Lightning's public checkpointing API: the ``checkpoint_last`` callback (a
+``ModelCheckpoint`` named ``last`` without a monitor, ``save_on_exception=True``) after every epoch
+(or every N steps) and on Ctrl+C or an exception, and :class:`CheckpointAtTrainEnd` when fitting ends
+(``trainer.save_checkpoint``). Neither ``save_last`` (which copies only when its callback saves: in
+Lightning 2.6 only when the best score improves) nor ``OnExceptionCheckpoint`` (which deletes its
+file when a fit ends normally) can keep ``last.ckpt`` alone.
 """
 
 from __future__ import annotations
@@ -19,61 +42,147 @@ from __future__ import annotations
 import json
 import logging
 import math
+from collections.abc import Iterable, Sequence
+from datetime import datetime
 from pathlib import Path
 from typing import Any
 
 import lightning.pytorch as pl
 import torch
 from hydra.utils import instantiate
-from lightning.pytorch.callbacks import ModelCheckpoint
-from lightning.pytorch.trainer.states import TrainerFn
+from lightning.pytorch.callbacks import LearningRateMonitor, ModelCheckpoint, OnExceptionCheckpoint
+from lightning.pytorch.loggers import TensorBoardLogger
 from lightning.pytorch.utilities import rank_zero_only
 from omegaconf import DictConfig, OmegaConf
 
+from stylemotion.config import ConfigError, check_trainer_numbers, set_torch_threads
 from stylemotion.io.atomic import atomic_write_bytes
+from stylemotion.io.outputs import OutputExistsError
+from stylemotion.provenance import provenance
 
 log = logging.getLogger(__name__)
 
+#: Values of ``ckpt_path`` that mean "start afresh".
+NO_CHECKPOINT = (None, "", "null", "none", "None")
+#: Files a logger leaves in its folder (TensorBoard, CSV); ``hparams.yaml`` is cleared, not looked for.
+LOGGER_RESULTS = ("events.out.tfevents.*", "metrics.csv")
+LOGGER_FILES = (*LOGGER_RESULTS, "hparams.yaml")
 
-class LastCheckpoint(ModelCheckpoint):
-    """``last.ckpt``: the latest state, saved on the callback's schedule (every N steps or epochs),
-    when training ends, and on Ctrl+C (KeyboardInterrupt), so ``ckpt_path=last`` resumes from it.
 
-    Configure it with ``filename="last"``, ``monitor=None`` and ``save_top_k=1`` (the latest
-    replaces the previous one).
-    """
+class CheckpointNotFoundError(FileNotFoundError):
+    """``ckpt_path`` names a checkpoint that does not exist."""
+
+
+class CheckpointAtTrainEnd(pl.Callback):
+    """Saves ``<dirpath>/<filename>.ckpt`` when fitting ends (``trainer.save_checkpoint``), so a run that
+    stops between two scheduled saves (every N steps, with max_steps, max_time or early stopping in
+    between) still leaves its final state in ``last.ckpt``. Not called after an exception."""
+
+    def __init__(self, dirpath: str | Path, filename: str = "last"):
+        self.dirpath, self.filename = str(dirpath), filename
 
     def on_train_end(self, trainer: pl.Trainer, pl_module: pl.LightningModule) -> None:
-        super().on_train_end(trainer, pl_module)
-        self._save_now(trainer)
+        trainer.save_checkpoint(Path(self.dirpath) / f"{self.filename}.ckpt")
 
-    def on_exception(self, trainer: pl.Trainer, pl_module: pl.LightningModule, exception: BaseException) -> None:
-        super().on_exception(trainer, pl_module, exception)
-        if isinstance(exception, KeyboardInterrupt):
-            self._save_now(trainer)
 
-    def _save_now(self, trainer: pl.Trainer) -> None:
-        if trainer.sanity_checking or trainer.global_step == self._last_global_step_saved:
-            return
-        if trainer.state.fn == TrainerFn.FITTING:
-            self._save_topk_checkpoint(trainer, self._monitor_candidates(trainer))
+def last_checkpoint(output_dir: str | Path) -> Path:
+    """Where a run folder's latest checkpoint lives: ``<output_dir>/checkpoints/last.ckpt``."""
+    return Path(output_dir) / "checkpoints" / "last.ckpt"
 
 
 def resolve_ckpt_path(ckpt_path: str | None, output_dir: Path) -> str | None:
-    """``last`` → ``<output_dir>/checkpoints/last.ckpt`` (which must exist); other paths unchanged."""
-    if ckpt_path in (None, "", "null"):
+    """The checkpoint to resume from: ``last`` → ``<output_dir>/checkpoints/last.ckpt`` (which must
+    exist); ``auto`` → the same if it exists, else None (start); other values must be files.
+
+    Raises:
+        CheckpointNotFoundError: ``last`` or a path that is not a file, naming it.
+    """
+    if ckpt_path in NO_CHECKPOINT:
         return None
+    last = last_checkpoint(output_dir)
+    if ckpt_path == "auto":
+        return str(last) if last.is_file() else None
     if ckpt_path == "last":
-        path = output_dir / "checkpoints" / "last.ckpt"
-        if not path.is_file():
-            raise FileNotFoundError(
-                f"ckpt_path=last but there is no {path}; to resume a run pass its folder "
-                "(run_id=<id> or hydra.run.dir=<folder>), or drop ckpt_path to start afresh"
-            )
-        return str(path)
+        if not last.is_file():
+            raise CheckpointNotFoundError(
+                f"ckpt_path=last but there is no {last}; to resume a run pass its folder "
+                "(hydra.run.dir=<folder> or output_dir=<folder>), use ckpt_path=auto to start when there is "
+                "nothing to resume, or drop ckpt_path to start afresh")
+        return str(last)
     if not Path(ckpt_path).is_file():
-        raise FileNotFoundError(f"ckpt_path {ckpt_path!r} is not a file")
+        raise CheckpointNotFoundError(f"ckpt_path {ckpt_path!r} is not a file")
     return str(ckpt_path)
+
+
+def result_locations(output_dir: Path, callbacks: Iterable[pl.Callback],
+                     loggers: Iterable[Any]) -> tuple[list[Path], list[Path]]:
+    """The folders a run's results go to: checkpoint folders (those of the checkpoint callbacks, and
+    ``<output_dir>/checkpoints``) and logger folders (each logger's ``log_dir``)."""
+    ckpt_dirs = {output_dir / "checkpoints"}
+    ckpt_dirs |= {Path(cb.dirpath) for cb in callbacks
+                  if isinstance(cb, (ModelCheckpoint, OnExceptionCheckpoint, CheckpointAtTrainEnd)) and cb.dirpath}
+    log_dirs = {Path(lg.log_dir) for lg in loggers if getattr(lg, "log_dir", None)}
+    return sorted(ckpt_dirs), sorted(log_dirs)
+
+
+def find_results(output_dir: Path, ckpt_dirs: Sequence[Path], log_dirs: Sequence[Path],
+                 logger_patterns: Sequence[str] = LOGGER_RESULTS) -> dict[str, list[Path]]:
+    """Results of an earlier run: ``{"checkpoints": [*.ckpt], "metrics": [metrics.json], "logs": [...]}``."""
+    metrics = output_dir / "metrics.json"
+    return {
+        "checkpoints": sorted(p for d in ckpt_dirs if d.is_dir() for p in d.glob("*.ckpt")),
+        "metrics": [metrics] if metrics.is_file() else [],
+        "logs": sorted(p for d in log_dirs if d.is_dir() for pattern in logger_patterns for p in d.glob(pattern)),
+    }
+
+
+def _delete(paths: Iterable[Path], why: str) -> None:
+    paths = list(paths)
+    for path in paths:
+        path.unlink(missing_ok=True)
+    if paths:
+        log.warning("%s: deleted %d file(s): %s", why, len(paths), ", ".join(str(p) for p in paths[:5])
+                    + (" …" if len(paths) > 5 else ""))
+
+
+def prepare_output(output_dir: Path, ckpt_path: str | None, force: bool, ckpt_dirs: Sequence[Path],
+                   log_dirs: Sequence[Path]) -> str | None:
+    """Check (and with ``force`` clear) the run folder; returns the checkpoint to resume from, or None.
+
+    See the module doc for the rules. Only global rank zero looks at and clears the folder (other
+    ranks start after it); every rank resolves ``ckpt_path`` alike.
+
+    Raises:
+        ConfigError: ``force=true`` together with ``ckpt_path``.
+        OutputExistsError: the folder holds results and the run neither resumes nor forces.
+        CheckpointNotFoundError: see :func:`resolve_ckpt_path`.
+    """
+    if force and ckpt_path not in NO_CHECKPOINT:
+        raise ConfigError(f"force=true starts afresh (deleting {output_dir}'s checkpoints) and ckpt_path={ckpt_path} "
+                          "resumes: pass one of them")
+    resume = resolve_ckpt_path(ckpt_path, output_dir)
+    if resume is not None or getattr(rank_zero_only, "rank", 0) != 0:
+        return resume
+    results = find_results(output_dir, ckpt_dirs, log_dirs)
+    if force:
+        cleared = find_results(output_dir, ckpt_dirs, log_dirs, LOGGER_FILES)
+        _delete([p for paths in cleared.values() for p in paths], f"force=true, starting afresh in {output_dir}")
+        return None
+    if ckpt_path == "auto" and not results["checkpoints"] and not results["metrics"]:
+        # a requeued job whose first attempt saved no checkpoint: its logs would mix with this one's
+        _delete(find_results(output_dir, ckpt_dirs, log_dirs, LOGGER_FILES)["logs"],
+                f"ckpt_path=auto, no {last_checkpoint(output_dir).name} to resume: starting afresh")
+        return None
+    found = [p for paths in results.values() for p in paths]
+    if found:
+        shown = ", ".join(str(p.relative_to(output_dir)) if p.is_relative_to(output_dir) else str(p)
+                          for p in found[:4]) + (" …" if len(found) > 4 else "")
+        hint = ("resume it with ckpt_path=last (or ckpt_path=auto)" if last_checkpoint(output_dir).is_file()
+                else f"it has no {last_checkpoint(output_dir)} to resume from (ckpt_path=<checkpoint> resumes another)")
+        raise OutputExistsError(
+            f"{output_dir} already holds a run's results ({shown}); {hint}, pass force=true to delete them and "
+            "start afresh, or choose another folder (hydra.run.dir=… on the command line, output_dir=… in Python)")
+    return None
 
 
 def _instantiate_all(node: DictConfig | None) -> list[Any]:
@@ -94,16 +203,61 @@ def build(cfg: DictConfig) -> tuple[pl.LightningDataModule, pl.LightningModule]:
     return datamodule, model
 
 
-def run(cfg: DictConfig, extra_callbacks: list[pl.Callback] | None = None) -> dict[str, Any]:
-    """Train (and test) as ``cfg`` says; returns ``{"trainer", "model", "datamodule", "metrics"}``."""
-    output_dir = Path(cfg.output_dir)
-    if cfg.get("threads"):
-        torch.set_num_threads(int(cfg.threads))
-    pl.seed_everything(cfg.seed, workers=True)
+def hyperparameters(cfg: DictConfig) -> dict[str, Any]:
+    """What TensorBoard's HPARAMS tab shows of a run: the model and DataModule settings (without
+    ``_target_``), the trainer's length and precision, the seed and the data set's name."""
+    def plain(node: Any) -> dict[str, Any]:
+        values = OmegaConf.to_container(node, resolve=True) if node is not None else {}
+        return {k: v for k, v in (values or {}).items() if k != "_target_"}
 
-    datamodule, model = build(cfg)
+    trainer = cfg.get("trainer") or {}
+    return {"model": plain(cfg.get("model")), "datamodule": plain(cfg.get("datamodule")),
+            "trainer": {k: trainer.get(k) for k in ("max_epochs", "max_steps", "precision", "accumulate_grad_batches",
+                                                    "gradient_clip_val")},
+            "seed": cfg.get("seed"), "data": (cfg.get("data") or {}).get("name")}
+
+
+class HyperparametersWithMetric(pl.Callback):
+    """At the end of fitting, every TensorBoard logger gets ``params`` with the best value of the
+    monitored metric as ``hp/<monitor>`` (``log_hyperparams(params, metrics=…)``), so the HPARAMS tab
+    lists runs side by side with their score. (A separate tag: the metric's own curve stays clean.)"""
+
+    def __init__(self, params: dict[str, Any], monitor: str):
+        self.params, self.monitor = params, monitor
+
+    def on_train_end(self, trainer: pl.Trainer, pl_module: pl.LightningModule) -> None:
+        value = _best_score(trainer)
+        if value is None:
+            value = trainer.callback_metrics.get(self.monitor)
+        if value is None:
+            return
+        for logger in trainer.loggers:
+            if isinstance(logger, TensorBoardLogger):
+                logger.log_hyperparams(self.params, metrics={f"hp/{self.monitor}": float(_plain(value))})
+
+
+def run(cfg: DictConfig, extra_callbacks: list[pl.Callback] | None = None) -> dict[str, Any]:
+    """Train (and test) as ``cfg`` says; returns ``{"trainer", "model", "datamodule", "metrics"}``.
+
+    Bad values (``threads``, the trainer's numbers, ``force`` with ``ckpt_path``) and a folder that
+    holds another run's results are refused before any work (see the module doc).
+    """
+    output_dir = Path(cfg.output_dir)
+    set_torch_threads(cfg.get("threads"))
+    check_trainer_numbers(cfg.trainer)
     callbacks = _instantiate_all(cfg.get("callbacks")) + list(extra_callbacks or [])
     loggers = _instantiate_all(cfg.get("logger"))
+    ckpt_path = prepare_output(output_dir, cfg.get("ckpt_path"), bool(cfg.get("force", False)),
+                               *result_locations(output_dir, callbacks, loggers))
+    if loggers:
+        callbacks.append(HyperparametersWithMetric(hyperparameters(cfg), str(cfg.get("monitor") or "")))
+    else:  # nothing to log the learning rate to (Lightning refuses the monitor without a logger)
+        callbacks = [cb for cb in callbacks if not isinstance(cb, LearningRateMonitor)]
+    record = _record_start(output_dir, cfg, ckpt_path)
+    _write_text(output_dir / "config_resolved.yaml", OmegaConf.to_yaml(cfg, resolve=True))
+
+    pl.seed_everything(cfg.seed, workers=True)
+    datamodule, model = build(cfg)
     trainer: pl.Trainer = instantiate(cfg.trainer, callbacks=callbacks, logger=loggers or False,
                                       _convert_="all")
     # Same initial weights on every rank (seeded above); from here on each rank draws its own
@@ -112,8 +266,6 @@ def run(cfg: DictConfig, extra_callbacks: list[pl.Callback] | None = None) -> di
     torch.manual_seed(rank_seed)
     log.info("rank %d of %d: torch seed %d", trainer.global_rank, trainer.world_size, rank_seed)
 
-    ckpt_path = resolve_ckpt_path(cfg.get("ckpt_path"), output_dir)
-    _write_text(output_dir / "config_resolved.yaml", OmegaConf.to_yaml(cfg, resolve=True))
     if cfg.get("train", True):
         trainer.fit(model, datamodule=datamodule, ckpt_path=ckpt_path)
     metrics: dict[str, Any] = {"global_step": trainer.global_step, "epoch": trainer.current_epoch,
@@ -123,12 +275,41 @@ def run(cfg: DictConfig, extra_callbacks: list[pl.Callback] | None = None) -> di
         metrics["best_checkpoint"] = best
         metrics["best_score"] = _plain(_best_score(trainer))
     if cfg.get("test", True):
+        for cb in trainer.checkpoint_callbacks:  # a failure while testing must not save the tested weights
+            if isinstance(cb, ModelCheckpoint):  # as last.ckpt
+                cb.save_on_exception = False
         # the best checkpoint of this fit; with train=false, the checkpoint given as ckpt_path
         test_ckpt = best or (None if cfg.get("train", True) else ckpt_path)
         results = trainer.test(model, datamodule=datamodule, ckpt_path=test_ckpt)
         metrics["test"] = {k: _plain(v) for k, v in (results[0] if results else {}).items()}
+    metrics["stylemotion_version"] = record["stylemotion_version"]
+    metrics["git_commit"] = record["git_commit"]
     _write_metrics(output_dir / "metrics.json", metrics)
     return {"trainer": trainer, "model": model, "datamodule": datamodule, "metrics": metrics}
+
+
+def _record_start(output_dir: Path, cfg: DictConfig, ckpt_path: str | None) -> dict[str, Any]:
+    """Log what runs (version, commit, folder) and add this start to ``<output_dir>/run.json``
+    (``{"run_id", "output_dir", "starts": [provenance + time + resumed_from, …]}``; a fresh start
+    replaces the file). Returns this start's record."""
+    start = {**provenance(), "time": datetime.now().astimezone().isoformat(timespec="seconds"),
+             "resumed_from": ckpt_path}
+    log.info("stylemotion %s (commit %s): %s in %s", start["stylemotion_version"], start["git_commit"],
+             f"resuming from {ckpt_path}" if ckpt_path else "training", output_dir)
+    _write_run_record(output_dir / "run.json", start, str(cfg.get("run_id", "")), ckpt_path is not None)
+    return start
+
+
+@rank_zero_only
+def _write_run_record(path: Path, start: dict[str, Any], run_id: str, resumed: bool) -> None:
+    record = {"run_id": run_id, "output_dir": str(path.parent), "starts": []}
+    if resumed and path.is_file():
+        try:
+            record = json.loads(path.read_text())
+        except (OSError, ValueError):
+            log.warning("%s is unreadable: starting a new record", path)
+    record.setdefault("starts", []).append(start)
+    atomic_write_bytes(path, json.dumps(record, indent=2).encode())
 
 
 def _best_checkpoint(trainer: pl.Trainer) -> str | None:

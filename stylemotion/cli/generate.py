@@ -4,32 +4,35 @@
     stylemotion-generate run=runs/reproduce/bandai style=elderly seed=3
     stylemotion-generate style=active path.file=path.csv out=runs/generate/active_path
 
-The work and the folder's contents: :mod:`stylemotion.synthesis.generate`.
+The work and the folder's contents: :mod:`stylemotion.synthesis.generate`. The summary goes to the log
+(console and ``generate.log`` in the Hydra run folder); a bad ``threads``, path file or existing ``out``
+ends in one line naming it.
 """
 
 from __future__ import annotations
 
+import logging
 import sys
 
 import hydra
-import torch
 from omegaconf import DictConfig
 
-from stylemotion.config import CONFIG_PACKAGE
+from stylemotion.cli import reported
+from stylemotion.config import CONFIG_PACKAGE, ConfigError, set_torch_threads
 from stylemotion.io.outputs import OutputExistsError
 from stylemotion.synthesis.generate import generate, summary_lines
+from stylemotion.synthesis.path import PathError
+
+log = logging.getLogger(__name__)
 
 
 def _main(cfg: DictConfig) -> None:
-    if cfg.get("threads"):
-        torch.set_num_threads(int(cfg.threads))
-    try:
+    with reported("stylemotion-generate", ConfigError, OutputExistsError, PathError):
+        set_torch_threads(cfg.get("threads"))
         summary = generate(cfg, "stylemotion-generate " + " ".join(sys.argv[1:]))
-    except OutputExistsError as exc:
-        sys.exit(f"stylemotion-generate: {exc}")
     for line in summary_lines(summary):
-        print(line)
-    print(f"written to {cfg.out}")
+        log.info(line)
+    log.info("written to %s", cfg.out)
 
 
 def main() -> None:

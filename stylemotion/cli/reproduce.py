@@ -9,21 +9,18 @@ The work is :func:`stylemotion.reproduction.reproduce`; its module doc describes
 
 from __future__ import annotations
 
-import sys
-
 import hydra
 from omegaconf import DictConfig
 
-from stylemotion.config import CONFIG_PACKAGE
+from stylemotion.cli import reported
+from stylemotion.config import CONFIG_PACKAGE, ConfigError
 from stylemotion.io.outputs import OutputExistsError
 from stylemotion.reproduction import StageConflictError, reproduce
 
 
 def _main(cfg: DictConfig) -> None:
-    try:
+    with reported("stylemotion-reproduce", StageConflictError, OutputExistsError, ConfigError):
         reproduce(cfg)
-    except (StageConflictError, OutputExistsError) as exc:
-        sys.exit(f"stylemotion-reproduce: {exc}")
 
 
 def main() -> None:

@@ -15,6 +15,7 @@ from pathlib import Path
 import hydra
 from omegaconf import DictConfig
 
+from stylemotion.cli import reported
 from stylemotion.config import CONFIG_PACKAGE
 from stylemotion.io.outputs import OutputExistsError
 from stylemotion.segmentation_report import print_summary, write_report
@@ -22,10 +23,8 @@ from stylemotion.segmentation_report import print_summary, write_report
 
 def _main(cfg: DictConfig) -> None:
     command = "stylemotion-segment " + " ".join(sys.argv[1:])
-    try:
+    with reported("stylemotion-segment", OutputExistsError):
         report = write_report(cfg, Path(cfg.out), bool(cfg.force), command)
-    except OutputExistsError as exc:
-        sys.exit(f"stylemotion-segment: {exc}")
     print_summary(report, Path(cfg.out))
 
 

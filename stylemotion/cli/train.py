@@ -3,8 +3,11 @@
     stylemotion-train experiment=autoencoder data=bandai           # the thesis' motion autoencoder
     stylemotion-train experiment=smoke                              # seconds, on the synthetic data
     stylemotion-train experiment=smoke -m model.kernel_size=9,15,25 # a sweep (basic launcher)
+    stylemotion-train --help                                        # main keys and examples
 
-The work is :func:`stylemotion.training.run`; its module doc describes the run folder.
+The work is :func:`stylemotion.training.run`; its module doc describes the run folder, resuming
+(``ckpt_path=last|auto|<file>``) and ``force=true``. A bad value (``threads``, ``trainer.*``), a missing
+checkpoint or a folder holding another run's results ends in one line naming the key or folder.
 """
 
 from __future__ import annotations
@@ -12,12 +15,15 @@ from __future__ import annotations
 import hydra
 from omegaconf import DictConfig
 
-from stylemotion.config import CONFIG_PACKAGE
-from stylemotion.training import objective, run
+from stylemotion.cli import reported
+from stylemotion.config import CONFIG_PACKAGE, ConfigError
+from stylemotion.io.outputs import OutputExistsError
+from stylemotion.training import CheckpointNotFoundError, objective, run
 
 
 def _main(cfg: DictConfig) -> float | None:
-    result = run(cfg)
+    with reported("stylemotion-train", ConfigError, OutputExistsError, CheckpointNotFoundError):
+        result = run(cfg)
     return objective(result["metrics"], cfg)
 
 

@@ -8,13 +8,20 @@ A :class:`GroundPath` is a polyline; curves given by a few control points are sa
 a smoothing spline first (:meth:`GroundPath.from_points` with ``spline=True``). Paths come from a
 config list, a JSON file (``[[x, z], …]`` or ``{"points": [[x, z], …]}``) or a CSV file (two
 columns x, z; an optional header line), or from :func:`s_curve`.
+
+Path files are UTF-8 (a byte-order mark is allowed). Every coordinate must be a finite number within
+±:data:`MAX_COORDINATE_M` metres: empty CSV fields, booleans (``true``, JSON ``true``), strings,
+``nan``/``inf`` and values like ``1e300`` (whose squares overflow) are errors (:class:`PathError`) naming
+``file:line`` (CSV), the JSON index (``points[3][1]``) or the config key (``path.points[3][1]``).
 """
 
 from __future__ import annotations
 
 import csv
+import io
 import json
 import math
+import numbers
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -26,6 +33,10 @@ from stylemotion.geometry import direction_yaw, wrap_angle
 
 #: Spacing of the dense polyline a spline is sampled to, metres.
 SPLINE_SPACING_M = 0.02
+#: Largest absolute coordinate of a path point, metres (1000 km: arc lengths stay exact in float64).
+MAX_COORDINATE_M = 1e6
+#: CSV cells read as booleans (refused, not taken for a header).
+_BOOLEAN_WORDS = frozenset({"true", "false"})
 
 
 class PathError(ValueError):
@@ -51,8 +62,14 @@ class GroundPath:
         cubic spline in arc length (needs ≥ 3 points) sampled every :data:`SPLINE_SPACING_M`.
 
         Raises:
-            PathError: fewer than two distinct points, wrong shape or non-finite values (names ``source``).
+            PathError: fewer than two distinct points, wrong shape, a value that is not a number (a
+                boolean, a string), not finite or beyond ±:data:`MAX_COORDINATE_M` (names ``source``
+                and the point).
         """
+        if not isinstance(points, np.ndarray):
+            _check_values(points, source, finite=False)  # finite and in range: checked below, per point
+        elif points.dtype == np.bool_:
+            raise PathError(f"{source}: points are booleans, expected numbers in metres")
         try:
             p = np.asarray(points, dtype=np.float64)
         except (TypeError, ValueError) as exc:
@@ -62,6 +79,10 @@ class GroundPath:
         bad = np.flatnonzero(~np.isfinite(p).all(1))
         if bad.size:
             raise PathError(f"{source}: point {int(bad[0])} is not finite: {p[bad[0]].tolist()}")
+        far = np.flatnonzero((np.abs(p) > MAX_COORDINATE_M).any(1))
+        if far.size:
+            raise PathError(f"{source}: point {int(far[0])} is {p[far[0]].tolist()}: coordinates must be within "
+                            f"±{MAX_COORDINATE_M:g} m")
         keep = np.concatenate([[True], np.linalg.norm(np.diff(p, axis=0), axis=1) > 1e-9])
         p = p[keep]  # repeated points carry no direction
         if len(p) < 2:
@@ -73,18 +94,20 @@ class GroundPath:
 
     @classmethod
     def from_file(cls, path: str | Path, spline: bool = False) -> GroundPath:
-        """Load a path from ``.json`` or ``.csv`` (see the module doc); errors name the file and line."""
+        """Load a path from ``.json`` or ``.csv`` (see the module doc); errors name the file and the line
+        (CSV, JSON syntax) or the JSON index."""
         path = Path(path)
         if not path.is_file():
             raise PathError(f"path file {str(path)!r} does not exist")
         if path.suffix.lower() == ".json":
             try:
-                data = json.loads(path.read_text())
+                data = json.loads(_read_text(path))
             except json.JSONDecodeError as exc:
                 raise PathError(f"{path}:{exc.lineno}: not valid JSON ({exc.msg})") from None
             points = data.get("points") if isinstance(data, dict) else data
             if points is None:
                 raise PathError(f"{path}: expected a list of [x, z] pairs or an object with key 'points'")
+            _check_values(points, f"{path}: " + ("points" if isinstance(data, dict) else ""))
             return cls.from_points(points, spline=spline, source=str(path))
         if path.suffix.lower() == ".csv":
             return cls.from_points(_read_csv_points(path), spline=spline, source=str(path))
@@ -171,21 +194,87 @@ def _spline_points(points: np.ndarray) -> np.ndarray:
     return spline(np.linspace(0.0, chord[-1], count))
 
 
+def _check_values(points: object, where: str, finite: bool = True) -> None:
+    """Each item of ``points`` must be an ``[x, z]`` pair of real numbers (not booleans or strings)
+    and, with ``finite``, finite and within ±:data:`MAX_COORDINATE_M`; errors name ``<where>[i][j]``."""
+    if isinstance(points, (str, bytes)) or not isinstance(points, Sequence) and not _is_list(points):
+        raise PathError(f"{where}: points must be a list of [x, z] pairs in metres, got {points!r}")
+    for i, point in enumerate(points):
+        if isinstance(point, (str, bytes)) or not (isinstance(point, Sequence) or _is_list(point)):
+            raise PathError(f"{where}[{i}] is {point!r}: points must be (n, 2) [x, z] pairs in metres")
+        for j, value in enumerate(point):
+            _check_number(value, f"{where}[{i}][{j}]", finite)
+
+
+def _is_list(value: object) -> bool:
+    """A list-like config node (OmegaConf's ``ListConfig``) or array."""
+    return hasattr(value, "__len__") and hasattr(value, "__getitem__") and not isinstance(value, (str, bytes, dict))
+
+
+def _check_number(value: object, where: str, finite: bool = True) -> float:
+    """``value`` as a float: a real number (not a boolean) and, with ``finite``, finite and within
+    ±:data:`MAX_COORDINATE_M`."""
+    if isinstance(value, (bool, np.bool_)):
+        raise PathError(f"{where} is {value!r} (a boolean), expected a number in metres")
+    if not isinstance(value, numbers.Real):
+        raise PathError(f"{where} is {value!r}, expected a number in metres")
+    if not finite:
+        return float(value)
+    if not math.isfinite(value):
+        raise PathError(f"{where} is {value!r}: coordinates must be finite")
+    if abs(value) > MAX_COORDINATE_M:
+        raise PathError(f"{where} is {value!r}: coordinates must be within ±{MAX_COORDINATE_M:g} m")
+    return float(value)
+
+
+def _read_text(path: Path) -> str:
+    """The file as UTF-8 text (an initial byte-order mark dropped); a PathError naming file:line otherwise."""
+    data = path.read_bytes()
+    try:
+        return data.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        line = data[:exc.start].count(b"\n") + 1
+        raise PathError(f"{path}:{line}: not UTF-8 text (byte 0x{data[exc.start]:02x}); save the file as UTF-8") \
+            from None
+
+
 def _read_csv_points(path: Path) -> list[list[float]]:
-    """Rows ``x, z`` of a CSV file; blank and ``#`` lines are skipped, a first non-numeric row is a header."""
+    """Rows ``x, z`` of a CSV file; blank and ``#`` lines are skipped, and a first row with no number
+    and no boolean in it is a header. Errors name ``file:line``."""
     points: list[list[float]] = []
     header_allowed = True
-    with path.open(newline="") as handle:
-        for line, row in enumerate(csv.reader(handle), start=1):
-            cells = [c.strip() for c in row if c.strip()]
-            if not cells or cells[0].startswith("#"):
-                continue
-            if len(cells) != 2:
-                raise PathError(f"{path}:{line}: expected two columns x, z, got {len(cells)}: {row}")
-            try:
-                points.append([float(cells[0]), float(cells[1])])
-            except ValueError:
-                if not header_allowed:
-                    raise PathError(f"{path}:{line}: not a number: {row}") from None
+    reader = csv.reader(io.StringIO(_read_text(path), newline=""))
+    for row in reader:
+        line = reader.line_num
+        cells = [c.strip() for c in row]
+        if not any(cells) or cells[0].startswith("#"):
+            continue
+        if len(cells) != 2:
+            raise PathError(f"{path}:{line}: expected two columns x, z, got {len(cells)}: {row}")
+        if header_allowed and all(c and not _is_float(c) and c.lower() not in _BOOLEAN_WORDS for c in cells):
             header_allowed = False
+            continue
+        header_allowed = False
+        points.append([_csv_number(cell, f"{path}:{line}", column) for column, cell in zip(("x", "z"), cells)])
     return points
+
+
+def _is_float(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
+def _csv_number(cell: str, where: str, column: str) -> float:
+    """One CSV cell as a coordinate; errors name ``where`` (``file:line``) and the column."""
+    if not cell:
+        raise PathError(f"{where}: empty {column} field")
+    if cell.lower() in _BOOLEAN_WORDS:
+        raise PathError(f"{where}: {column} is {cell!r} (a boolean), expected a number in metres")
+    try:
+        value = float(cell)
+    except ValueError:
+        raise PathError(f"{where}: not a number: {column} = {cell!r}") from None
+    return _check_number(value, f"{where}: {column}")
