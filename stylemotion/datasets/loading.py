@@ -376,7 +376,10 @@ def _read_cache_or_discard(entry: Path, dataset: str) -> TakeSet | None:
     except Exception as exc:  # noqa: BLE001 - any damage to the entry means: rebuild it
         warnings.warn(f"{entry}: corrupt dataset cache entry ({type(exc).__name__}: {exc}); rebuilding it",
                       CacheWarning, stacklevel=3)
-        shutil.rmtree(entry, ignore_errors=True)
+        if entry.is_dir() and not entry.is_symlink():
+            shutil.rmtree(entry, ignore_errors=True)
+        else:
+            entry.unlink(missing_ok=True)
         return None
 
 

@@ -328,7 +328,7 @@ def _entry(cache: Path) -> Path:
 
 
 @pytest.mark.parametrize("damage", ["truncate_npy", "garbage_npy", "flip_npy_data", "garbage_index",
-                                    "missing_npy", "bad_span"])
+                                    "missing_npy", "bad_span", "file_not_folder"])
 def test_corrupt_cache_entry_is_rebuilt_with_a_warning(tmp_path, damage):
     root = _folder(tmp_path, {"a.bvh": canonical_bvh(), "b.bvh": canonical_bvh(frames=30)})
     first = _load(root, tmp_path)
@@ -346,6 +346,11 @@ def test_corrupt_cache_entry_is_rebuilt_with_a_warning(tmp_path, damage):
         index.write_text("{ half an ind")
     elif damage == "missing_npy":
         npy.unlink()
+    elif damage == "file_not_folder":
+        npy.unlink()
+        index.unlink()
+        entry.rmdir()
+        entry.write_text("a file where the entry's folder belongs")
     else:
         data = json.loads(index.read_text())
         data["takes"][0]["stop"] = 10_000
