@@ -13,7 +13,7 @@ from stylemotion.io.atomic import atomic_write_bytes
 
 
 def dataset_summary(takeset: TakeSet, split: dict[str, list[Take]] | None = None) -> dict[str, Any]:
-    """Counts of takes and frames per content × style, split sizes and skipped inputs."""
+    """Counts of takes and frames per content × style, split sizes, skipped inputs and warnings."""
     takes = Counter((t.content, t.style) for t in takeset.takes)
     frames: Counter[tuple[str, str]] = Counter()
     for t in takeset.takes:
@@ -29,6 +29,7 @@ def dataset_summary(takeset: TakeSet, split: dict[str, list[Take]] | None = None
             for c, s in sorted(takes)
         ],
         "skipped": [{"source": src, "reason": why} for src, why in takeset.skipped],
+        "warnings": list(takeset.warnings),
     }
     if split is not None:
         summary["split"] = {part: {"takes": len(ts), "frames": sum(t.num_frames for t in ts)}
@@ -48,6 +49,9 @@ def format_summary(summary: dict[str, Any]) -> str:
     if summary["skipped"]:
         lines.append(f"  skipped {len(summary['skipped'])} broken input(s):")
         lines.extend(f"    {s['reason']}" for s in summary["skipped"])
+    if summary.get("warnings"):
+        lines.append(f"  {len(summary['warnings'])} input(s) loaded but look wrong:")
+        lines.extend(f"    {w}" for w in summary["warnings"])
     return "\n".join(lines)
 
 
