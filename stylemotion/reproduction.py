@@ -414,26 +414,26 @@ def _submitit_results(jobs: Sequence[tuple[Stage, bool, dict[str, Any]]], node: 
 def choose_budget(cfg: DictConfig) -> str:
     """Fall back to ``default_budget`` when no ``budget`` was composed (no ``configs/budget/<data config
     name>.yaml``); returns a line saying which budget the training lengths come from."""
-    data_choice = _data_choice(cfg)
-    if cfg.get("budget") is None:
-        if cfg.get("default_budget") is None:
-            raise ValueError(f"no training budget: there is no configs/budget/{data_choice}.yaml and no default_budget")
-        with open_dict(cfg):
-            cfg.budget = cfg.default_budget
-        return (f"budget: budget/{cfg.budget.get('name', 'default')} (there is no budget/{data_choice}.yaml for this "
-                "data; scale the epochs with its number of clips, e.g. stages.vae=[...])")
-    return f"budget: budget/{cfg.budget.get('name', data_choice)}"
+    if cfg.get("budget") is not None:
+        return f"budget: budget/{cfg.budget.get('name', _data_choice() or '?')}"
+    if cfg.get("default_budget") is None:
+        raise ValueError("no training budget: no configs/budget/<data config name>.yaml and no default_budget")
+    with open_dict(cfg):
+        cfg.budget = cfg.default_budget
+    choice = _data_choice()
+    missing = f"budget/{choice}.yaml" if choice else "budget named after this data config"
+    return (f"budget: budget/{cfg.budget.get('name', 'default')} (there is no {missing}; scale the epochs with the "
+            "number of clips through stages.autoencoder/vae/cvae if training is too short or long)")
 
 
-def _data_choice(cfg: DictConfig) -> str:
-    """The name of the ``data`` config chosen (Hydra's choice when known, else ``data.name``)."""
+def _data_choice() -> str | None:
+    """The name of the ``data`` config Hydra composed, when Hydra's run config is known."""
     from hydra.core.hydra_config import HydraConfig
 
     if HydraConfig.initialized():
         choice = HydraConfig.get().runtime.choices.get("data")
-        if choice:
-            return str(choice)
-    return str(cfg.data.get("name", "?"))
+        return str(choice) if choice else None
+    return None
 
 
 def reproduce(cfg: DictConfig, say=print) -> dict[str, Any]:

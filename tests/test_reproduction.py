@@ -20,7 +20,7 @@ from stylemotion.evaluation.run import run_evaluation
 from stylemotion.evaluation.sources import MissingExampleError, MixedAutoencodersError
 from stylemotion.io.outputs import OutputExistsError
 from stylemotion.models.vae import PrimitiveVAE
-from stylemotion.reproduction import StageConflictError
+from stylemotion.reproduction import Reproduction, StageConflictError, choose_budget
 from stylemotion.reproduction import reproduce as run_reproduction
 
 torch.set_num_threads(1)
@@ -86,8 +86,27 @@ def test_reproduce_runs_every_stage_into_a_report(reproduced) -> None:
     assert report["table_5_1"]["walk_leftStance"]["models"] == ["neutral", "elderly", "youthful"]
     assert report["style_recognition"]["classifier_heldout_accuracy"] >= 0.8  # real clips, chance 1/3
     assert len(report["meta"]["checkpoints"]) == 3 and report["meta"]["samples"]["variance"] == 300
-    assert json.loads((out / "reproduce.json").read_text())["report"] == str(out / "report")
     assert (out / "cvae" / "walk_leftStance_elderly" / "samples").is_dir()  # the training stages' GIFs
+    assert lines[0] == "budget: budget/synthetic"
+
+
+def test_the_run_records_paths_relative_to_its_folder(reproduced) -> None:
+    """reproduce.json, done.json, evaluation.json and report.json name files inside the run relative to
+    it (so a moved run describes itself); the autoencoder the models embed is the stage's."""
+    out, _, _ = reproduced
+    summary = json.loads((out / "reproduce.json").read_text())
+    assert summary["report"] == "report"
+    vae = "vae/walk_leftStance/checkpoints/best.ckpt"
+    assert [s["folder"] for s in summary["stages"]][:2] == ["autoencoder", "vae/walk_leftStance"]
+    assert summary["stages"][1]["checkpoint"] == vae and (out / vae).is_file()
+    assert json.loads((out / "vae" / "walk_leftStance" / "done.json").read_text())["checkpoint"] == vae
+    assert json.loads((out / "evaluation.json").read_text())["report"] == "report"
+    meta = json.loads((out / "report" / "report.json").read_text())["meta"]
+    assert meta["paths_relative_to"] == ".." and meta["autoencoder"]["path"] == "autoencoder/checkpoints/best.ckpt"
+    assert meta["checkpoints"][0]["path"] == vae
+    raw = torch.load(out / vae, weights_only=True)
+    ae = torch.load(out / "autoencoder" / "checkpoints" / "best.ckpt", weights_only=True)["state_dict"]
+    assert all(torch.equal(raw["autoencoder"]["state_dict"][k], v) for k, v in ae.items())
 
 
 def test_parallel_stages_train_the_same_models_as_sequential_ones(reproduced, tmp_path: Path) -> None:
@@ -192,4 +211,118 @@ def test_budget_precision_follows_the_cpu(tmp_path) -> None:
 def test_bad_workers_value_is_refused_before_any_work(tmp_path: Path, workers) -> None:
     with pytest.raises(ValueError, match=r"'workers' must be an integer ≥ 1.*got"):
         reproduce(tiny_overrides(tmp_path / "run") + [f"workers={workers}"], [])
+    assert not (tmp_path / "run").exists()
+
+
+# -- style labels as folder names, a user's data, stages on submitit
+
+
+def test_style_labels_cannot_place_a_stage_outside_the_run(tmp_path: Path) -> None:
+    """CVAE folders come from style labels: sanitized, inside ``out``, and two labels never share one."""
+    with initialize_config_dir(config_dir=str(CONFIG_DIR), version_base="1.3"):
+        cfg = compose(config_name="reproduce", overrides=[f"out={tmp_path / 'run'}", "primitives=[walk_leftStance]"])
+    repro = Reproduction(cfg, say=lambda _: None)
+    repro.plan(["/../../../../escaped", "a b/c"])
+    cvae = [s.folder for s in repro.stages if s.kind == "cvae"]
+    assert [f.resolve().parent for f in cvae] == [(tmp_path / "run" / "cvae").resolve()] * 2, cvae
+    assert [f.name for f in cvae] == ["walk_leftStance_escaped", "walk_leftStance_a_b_c"]
+    assert [s.values["style"] for s in repro.stages if s.kind == "cvae"] == ["/../../../../escaped", "a b/c"]
+    with pytest.raises(ValueError, match=r"style label '\.\.' has no character usable in a file name"):
+        repro.plan([".."])
+    with pytest.raises(ValueError, match=r"style labels 'a/b' and 'a_b' would share the folder"):
+        repro.plan(["a/b", "a_b"])
+
+
+def write_user_configs(folder: Path) -> Path:
+    """A user's config folder holding ``data/mine.yaml``: a BVH folder with labels from file names, and
+    no ``budget/mine.yaml``."""
+    (folder / "data").mkdir(parents=True)
+    (folder / "data" / "mine.yaml").write_text(
+        "# my capture: <style>_<take>.bvh\ndefaults:\n  - bvh_folder\n  - _self_\n\nroot: ~/mocap\n"
+        "pattern: (?P<style>[a-z]+)_(?P<take>\\d+)\ndefault_labels: {content: walk}\n")
+    return folder
+
+
+def test_data_without_a_budget_of_its_own_uses_the_default_budget(tmp_path: Path) -> None:
+    configs = write_user_configs(tmp_path / "configs")
+    with initialize_config_dir(config_dir=str(CONFIG_DIR), version_base="1.3"):
+        cfg = compose(config_name="reproduce", overrides=[f"hydra.searchpath=[file://{configs}]", "data=mine"])
+        bandai = compose(config_name="reproduce", overrides=["data=bandai"])
+    assert cfg.get("budget") is None and cfg.data.pattern == "(?P<style>[a-z]+)_(?P<take>\\d+)"
+    assert choose_budget(cfg).startswith("budget: budget/default (there is no budget")
+    assert list(cfg.stages.vae) == ["experiment=primitive_vae", "trainer.max_epochs=100"]
+    assert list(cfg.stages.cvae)[1:] == list(bandai.stages.cvae)[1:] == ["trainer.max_epochs=60",
+                                                                         "model.style_weight=5.0"]
+    assert choose_budget(bandai) == "budget: budget/bandai"
+
+
+def write_user_mocap(folder: Path) -> None:
+    """The tiny synthetic takes as ``<style>_<take>.bvh`` files."""
+    from vae_fixtures import tiny_takeset
+
+    from stylemotion.export import write_motion_bvh
+
+    folder.mkdir(parents=True)
+    for take in tiny_takeset().takes:
+        write_motion_bvh(take.positions, folder / f"{take.labels['style']}_{take.labels['take']}.bvh", take.fps)
+
+
+def test_readme_regex_example_runs(tmp_path: Path) -> None:
+    """The README's bvh_folder line with a file-name regex, run as written (``~`` is the user's home)."""
+    readme = (Path(__file__).resolve().parents[1] / "README.md").read_text()
+    line = next(x for x in readme.splitlines() if "data.pattern=" in x and x.startswith("stylemotion-data"))
+    home = tmp_path / "home"
+    write_user_mocap(home / "mocap")
+    env = {**os.environ, "HOME": str(home), "OMP_NUM_THREADS": "1"}
+    proc = subprocess.run(["bash", "-c", line.split("#")[0]], capture_output=True, text=True, cwd=tmp_path, env=env,
+                          timeout=300)
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    summary = json.loads(next((tmp_path / "runs" / "prepare").rglob("summary.json")).read_text())
+    assert all(style in json.dumps(summary) for style in ("normal", "elderly", "youthful")), summary
+
+
+@pytest.mark.slow
+def test_a_users_bvh_folder_end_to_end_with_stages_as_submitit_jobs(tmp_path: Path, monkeypatch) -> None:
+    """``stylemotion-reproduce data=<their config>`` with ``~`` paths and executor=local (submitit's
+    LocalExecutor): a stage that fails does not lose the ones that finish, a rerun resumes and reuses."""
+    home = tmp_path / "home"
+    monkeypatch.setenv("HOME", str(home))
+    monkeypatch.setenv("OMP_NUM_THREADS", "1")
+    write_user_mocap(home / "mocap")
+    configs = write_user_configs(tmp_path / "configs")
+    user = [f"hydra.searchpath=[file://{configs}]", "data=mine", 'data.root="~/mocap"', "executor=local", "workers=2"]
+    overrides = [o for o in tiny_overrides(home / "x") if not o.startswith(("data.", "out="))] + user
+    out = home / "runs" / "mine"
+    blocker = out / "cvae" / "walk_leftStance_youthful" / "checkpoints"
+    blocker.parent.mkdir(parents=True)
+    blocker.write_text("a file where the youthful stage saves its checkpoints: that job fails")
+    lines: list[str] = []
+    with pytest.raises(RuntimeError, match=r"1 training stage\(s\) failed \(cvae walk_leftStance/youthful\)"):
+        reproduce(overrides + ['out="~/runs/mine"'], lines)
+    assert lines[0].startswith("budget: budget/default")
+    assert any("youthful FAILED" in line for line in lines), lines
+    summary = json.loads((out / "reproduce.json").read_text())
+    assert {s["name"]: s["status"] for s in summary["stages"]} == {
+        "autoencoder": "trained", "vae walk_leftStance": "trained", "cvae walk_leftStance/elderly": "trained",
+        "cvae walk_leftStance/youthful": "pending"}
+    for stage in ("vae/walk_leftStance", "cvae/walk_leftStance_elderly"):
+        assert (out / stage / "done.json").is_file() and any((out / stage / "submitit").iterdir()), stage
+    assert not (out / "cvae" / "walk_leftStance_youthful" / "done.json").exists()
+
+    blocker.unlink()
+    (out / "cvae" / "walk_leftStance_elderly" / "done.json").unlink()  # as if its job was killed at the end
+    lines = []
+    summary = reproduce(overrides + ['out="~/runs/mine"'], lines)
+    steps = [line for line in lines if line.startswith("[")]
+    assert sum(": reused " in line for line in steps) == 2, steps  # autoencoder, vae
+    assert any("resuming from" in line and "walk_leftStance_elderly" in line for line in lines), lines
+    assert [s["status"] for s in summary["stages"]] == ["reused", "reused", "resumed", "trained"]
+    assert summary["report"] == "report" and (out / "report" / "report.md").is_file()
+    report = json.loads((out / "report" / "report.json").read_text())
+    assert report["table_5_1"]["walk_leftStance"]["models"] == ["neutral", "elderly", "youthful"]
+
+
+def test_an_unknown_executor_is_refused_before_any_work(tmp_path: Path) -> None:
+    with pytest.raises(ValueError, match=r"'executor.engine' must be one of \['pool', 'local', 'slurm'\], got 'sge'"):
+        reproduce(tiny_overrides(tmp_path / "run") + ["executor.engine=sge"], [])
     assert not (tmp_path / "run").exists()
