@@ -369,9 +369,9 @@ def _pool_results(jobs: Sequence[tuple[Stage, bool, dict[str, Any]]], workers: i
             yield (*pending[future], future.result)
 
 
-def submitit_executor(node: Any, folder: Path, engine: str) -> Any:
-    """A submitit ``AutoExecutor`` for one stage (logs in ``folder``) with the ``executor`` node's
-    ``parameters`` (and ``partition`` as ``slurm_partition``).
+def submitit_executor(node: Any, folder: Path, engine: str, name: str = "stylemotion") -> Any:
+    """A submitit ``AutoExecutor`` for one stage (job ``name``, logs in ``folder``) with the
+    ``executor`` node's ``parameters`` (and ``partition`` as ``slurm_partition``).
 
     Raises:
         ImportError: submitit is not installed (the ``cluster`` extra).
@@ -383,6 +383,7 @@ def submitit_executor(node: Any, folder: Path, engine: str) -> Any:
                           "pip install 'stylemotion[cluster]' (or pip install submitit)") from exc
     params = OmegaConf.to_container(node.get("parameters") or {}, resolve=True) if isinstance(node, DictConfig) \
         else dict(node.get("parameters") or {})
+    params.setdefault("name", name)
     if node.get("partition"):
         params["slurm_partition"] = str(node.get("partition"))
     executor = submitit.AutoExecutor(folder=str(folder), cluster=engine)
@@ -399,7 +400,8 @@ def _submitit_results(jobs: Sequence[tuple[Stage, bool, dict[str, Any]]], node: 
     while waiting or running:
         while waiting and (limit is None or len(running) < limit):
             stage, resume, container = waiting.pop(0)
-            job = submitit_executor(node, stage.folder / "submitit", engine).submit(_train_in_worker, container)
+            name = f"stylemotion-{stage.kind}-{stage.folder.name}"
+            job = submitit_executor(node, stage.folder / "submitit", engine, name).submit(_train_in_worker, container)
             log.info("%s: submitit job %s (%s)", stage.name, job.job_id, engine)
             running.append((stage, resume, job))
         done = [item for item in running if item[2].done()]

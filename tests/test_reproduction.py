@@ -326,3 +326,26 @@ def test_an_unknown_executor_is_refused_before_any_work(tmp_path: Path) -> None:
     with pytest.raises(ValueError, match=r"'executor.engine' must be one of \['pool', 'local', 'slurm'\], got 'sge'"):
         reproduce(tiny_overrides(tmp_path / "run") + ["executor.engine=sge"], [])
     assert not (tmp_path / "run").exists()
+
+
+def test_slurm_executor_submits_the_configured_job(tmp_path: Path, monkeypatch) -> None:
+    """executor=slurm: the sbatch script submitit writes carries the config's partition and resources
+    (``sbatch``/``srun`` are stand-ins here: no cluster)."""
+    from stylemotion.reproduction import submitit_executor
+
+    bin_dir = tmp_path / "bin"
+    bin_dir.mkdir()
+    (bin_dir / "sbatch").write_text("#!/bin/sh\necho 'Submitted batch job 4242'\n")
+    (bin_dir / "srun").write_text("#!/bin/sh\nexit 0\n")
+    for tool in bin_dir.iterdir():
+        tool.chmod(0o755)
+    monkeypatch.setenv("PATH", f"{bin_dir}{os.pathsep}{os.environ['PATH']}")
+    with initialize_config_dir(config_dir=str(CONFIG_DIR), version_base="1.3"):
+        cfg = compose(config_name="reproduce", overrides=["executor=slurm", "executor.partition=cpu",
+                                                          "executor.parameters.mem_gb=16"])
+    executor = submitit_executor(cfg.executor, tmp_path / "jobs", "slurm", "stylemotion-vae-walk_leftStance")
+    assert executor.submit(print, "a stage").job_id == "4242"
+    script = (tmp_path / "jobs" / "4242_submission.sh").read_text()
+    for line in ("--partition=cpu", "--mem=16GB", "--cpus-per-task=8", "--time=240",
+                 "--job-name=stylemotion-vae-walk_leftStance"):
+        assert f"#SBATCH {line}" in script, script
