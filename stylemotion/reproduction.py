@@ -49,10 +49,10 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-import torch
 from hydra import compose
 from omegaconf import DictConfig, OmegaConf, open_dict
 
+from stylemotion.config import positive_int, set_torch_threads
 from stylemotion.datasets import build_dataset
 from stylemotion.evaluation.run import recorded_path, run_evaluation, summary_lines
 from stylemotion.io.atomic import atomic_write_bytes
@@ -285,8 +285,8 @@ class Reproduction:
             cfg.data = OmegaConf.create(self.data_cfg)
             cfg.output_dir = str(stage.folder.resolve())
             cfg.seed = int(self.cfg.seed)
-            if self.cfg.get("threads"):
-                cfg.threads = int(self.cfg.threads)
+            if self.cfg.get("threads") is not None:
+                cfg.threads = positive_int(self.cfg.threads, "threads")
             for key, value in stage.values.items():
                 OmegaConf.update(cfg, key, value, force_add=True)
             if stage.parent is not None:
@@ -444,12 +444,8 @@ def reproduce(cfg: DictConfig, say=print) -> dict[str, Any]:
     Must be called with Hydra's global config search initialized (inside ``stylemotion-reproduce``,
     or within ``hydra.initialize_config_dir``), since the training stages compose the ``train`` config.
     """
-    if cfg.get("threads"):
-        torch.set_num_threads(int(cfg.threads))  # the evaluation's too, so reruns compute alike
-    workers = cfg.get("workers", 1)
-    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
-        raise ValueError(f"reproduce config key 'workers' must be an integer ≥ 1 (training stages at once), "
-                         f"got {workers!r}")
+    set_torch_threads(cfg.get("threads"), "threads")  # the evaluation's too, so reruns compute alike
+    workers = positive_int(cfg.get("workers", 1), "workers")
     engine = executor_engine(cfg)
     say(choose_budget(cfg))
     repro = Reproduction(cfg, say)

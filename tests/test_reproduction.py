@@ -207,10 +207,12 @@ def test_budget_precision_follows_the_cpu(tmp_path) -> None:
     assert f"trainer.precision={cpu_precision()}" in list(cfg.stages.autoencoder)
 
 
-@pytest.mark.parametrize("workers", [0, -2, "two"])
-def test_bad_workers_value_is_refused_before_any_work(tmp_path: Path, workers) -> None:
-    with pytest.raises(ValueError, match=r"'workers' must be an integer ≥ 1.*got"):
-        reproduce(tiny_overrides(tmp_path / "run") + [f"workers={workers}"], [])
+@pytest.mark.parametrize("override", ["workers=0", "workers=-2", "workers=two", "workers=1.5", "threads=abc",
+                                      "threads=0"])
+def test_bad_workers_or_threads_value_is_refused_before_any_work(tmp_path: Path, override) -> None:
+    key, value = override.split("=")
+    with pytest.raises(ValueError, match=rf"{key} must be a whole number ≥ 1, got '?{value}'?"):
+        reproduce(tiny_overrides(tmp_path / "run") + [override], [])
     assert not (tmp_path / "run").exists()
 
 
