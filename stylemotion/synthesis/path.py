@@ -72,7 +72,7 @@ class GroundPath:
             raise PathError(f"{source}: points are booleans, expected numbers in metres")
         try:
             p = np.asarray(points, dtype=np.float64)
-        except (TypeError, ValueError) as exc:
+        except (TypeError, ValueError, OverflowError) as exc:
             raise PathError(f"{source}: points must be a list of [x, z] pairs ({exc})") from None
         if p.ndim != 2 or p.shape[1] != 2:
             raise PathError(f"{source}: points must be (n, 2) [x, z] pairs in metres, got shape {p.shape}")
@@ -218,12 +218,15 @@ def _check_number(value: object, where: str, finite: bool = True) -> float:
         raise PathError(f"{where} is {value!r} (a boolean), expected a number in metres")
     if not isinstance(value, numbers.Real):
         raise PathError(f"{where} is {value!r}, expected a number in metres")
+    text = repr(value) if len(repr(value)) <= 40 else repr(value)[:37] + "…"
+    if isinstance(value, numbers.Integral) and abs(value) > MAX_COORDINATE_M:  # before float(): 10**400 overflows
+        raise PathError(f"{where} is {text}: coordinates must be within ±{MAX_COORDINATE_M:g} m")
     if not finite:
         return float(value)
     if not math.isfinite(value):
-        raise PathError(f"{where} is {value!r}: coordinates must be finite")
+        raise PathError(f"{where} is {text}: coordinates must be finite")
     if abs(value) > MAX_COORDINATE_M:
-        raise PathError(f"{where} is {value!r}: coordinates must be within ±{MAX_COORDINATE_M:g} m")
+        raise PathError(f"{where} is {text}: coordinates must be within ±{MAX_COORDINATE_M:g} m")
     return float(value)
 
 

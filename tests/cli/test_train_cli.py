@@ -1,4 +1,5 @@
-"""``stylemotion-train``: run folders, sweeps (basic and joblib launchers), resume, DDP, bad config.
+"""``stylemotion-train``: run folders (unique ids, never overwritten), sweeps (basic and joblib
+launchers), resume, DDP, bad config and bad values (one line naming the key).
 
 The command-line tests run ``python -m stylemotion.cli.train`` (what the ``stylemotion-train``
 console script calls) in a subprocess on a tiny synthetic dataset with the ``smoke`` preset; the
@@ -9,6 +10,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -21,6 +23,7 @@ import yaml
 from hydra import compose, initialize_config_dir
 from hydra.errors import InstantiationException
 
+import stylemotion
 from stylemotion.config import config_dir
 from stylemotion.datamodules import EmptySplitError
 from stylemotion.training import resolve_ckpt_path, run
@@ -87,6 +90,37 @@ def test_single_run_folder_and_unknown_key(tmp_path):
     assert typo.returncode != 0
     assert "Could not override 'model.kernal_size'" in typo.stderr
     assert "Key 'kernal_size' is not in struct" in typo.stderr
+
+
+def test_run_folder_has_a_unique_id_records_itself_and_is_never_overwritten(tmp_path):
+    done = train_cli(*SMOKE, cwd=tmp_path)
+    assert done.returncode == 0, done.stderr[-4000:]
+    (run_dir,) = (tmp_path / "runs" / "train" / "smoke").iterdir()
+    resolved = check_run_dir(run_dir)
+    assert run_dir.name == resolved["run_id"]
+    assert re.fullmatch(r"\d{4}-\d\d-\d\d_\d\d-\d\d-\d\d_\d{6}_[0-9a-f]{4}", run_dir.name)
+    assert json.loads((run_dir / "run.json").read_text())["run_id"] == run_dir.name
+    assert f"stylemotion {stylemotion.__version__} (commit " in (run_dir / "train.log").read_text()
+    kept = {p: p.read_bytes() for p in [run_dir / "metrics.json", *(run_dir / "checkpoints").glob("*.ckpt")]}
+
+    again = train_cli(*SMOKE, f"hydra.run.dir={run_dir}", cwd=tmp_path)
+    assert again.returncode == 1 and "Traceback" not in again.stderr
+    (line,) = again.stderr.strip().splitlines()
+    assert line.startswith(f"stylemotion-train: {run_dir} already holds a run's results")
+    assert "ckpt_path=last" in line and "force=true" in line
+    assert {p: p.read_bytes() for p in kept} == kept
+
+
+@pytest.mark.parametrize("override, message", [
+    ("threads=abc", "threads must be a whole number ≥ 1, got 'abc'"),
+    ("trainer.max_steps=abc", "trainer.max_steps must be a whole number ≥ -1, got 'abc'"),
+    ("ckpt_path=last", "ckpt_path=last but there is no "),
+])
+def test_bad_values_end_in_one_line_naming_the_key(override, message, tmp_path):
+    done = train_cli(*SMOKE, override, f"hydra.run.dir={tmp_path / 'run'}", cwd=tmp_path)
+    assert done.returncode == 1 and "Traceback" not in done.stderr
+    (line,) = done.stderr.strip().splitlines()
+    assert line.startswith(f"stylemotion-train: {message}")
 
 
 def test_unknown_or_bad_model_option_is_a_clear_error(tmp_path):
