@@ -30,8 +30,8 @@ def stand_in(folder: Path):
     """An untrained PrimitiveVAE (and autoencoder checkpoint) with Bandai walk-stance sizes."""
     import lightning.pytorch as pl
 
-    from stylemotion.datamodules.features import autoencoder_info
     from stylemotion.models.autoencoder import MotionAutoencoder
+    from stylemotion.models.checkpoints import autoencoder_info
     from stylemotion.models.vae import PrimitiveVAE
 
     torch.manual_seed(0)
@@ -52,12 +52,9 @@ def stand_in(folder: Path):
 
 
 def load(path: Path):
-    from stylemotion.models.cvae import StyleCVAE
-    from stylemotion.models.vae import PrimitiveVAE
+    from stylemotion.models.checkpoints import load_generative
 
-    hparams = torch.load(path, map_location="cpu", weights_only=True)["hyper_parameters"]
-    cls = StyleCVAE if "style_weight" in hparams else PrimitiveVAE
-    return cls.load_from_checkpoint(path, map_location="cpu")
+    return load_generative(path)
 
 
 def main(argv: list[str] | None = None) -> dict:
