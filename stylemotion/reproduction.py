@@ -323,10 +323,10 @@ class Reproduction:
         return recorded_path(path, self.out.resolve())
 
     def located(self, path: str | None) -> str | None:
-        """A recorded path as a file path now: relative ones are relative to ``out``."""
+        """A recorded path as an absolute file path now: relative ones are relative to ``out``."""
         if not path:
             return None
-        return str(Path(path) if Path(path).is_absolute() else self.out / path)
+        return str(Path(path) if Path(path).is_absolute() else (self.out / path).resolve())
 
     def summary(self) -> dict[str, Any]:
         """What ``reproduce.json`` holds; paths inside ``out`` are relative to it."""
