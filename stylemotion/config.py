@@ -5,6 +5,13 @@ from a wheel or a non-editable install as well as from a clone. Values a user ty
 line are checked here before any work (:func:`positive_int`, :func:`set_torch_threads`,
 :func:`check_trainer_numbers`); a bad one is a :class:`ConfigError` naming the key and the value.
 Resolvers registered on import: ``${cpu_precision:}`` and ``${unique_id:}`` (run ids).
+
+Settings defaults live once, in the dataclasses that use them: on import the settings dataclasses
+are registered as Hydra structured configs (group ``schema``: ``segment`` =
+:class:`~stylemotion.primitives.SegmentSettings`, ``evaluation`` =
+:class:`~stylemotion.evaluation.settings.EvalSettings`, ``follow`` =
+:class:`~stylemotion.synthesis.controller.FollowSettings`), and the YAML files take them in their
+defaults lists instead of repeating their values; keys and types are checked by Hydra.
 """
 
 from __future__ import annotations
@@ -129,6 +136,54 @@ def cpu_precision(cpuinfo: str | Path = "/proc/cpuinfo") -> str:
     return "bf16-mixed" if {"avx512_bf16", "amx_bf16"} & set(flags) else "32-true"
 
 
+def structured_schema(cls: type) -> Any:
+    """``cls`` (a dataclass) as an OmegaConf structured config that overrides may change.
+
+    Frozen dataclasses give read-only nodes, which Hydra could not override; the flag is cleared on
+    every node (the dataclass itself stays frozen when built from the config).
+    """
+    from omegaconf import DictConfig, OmegaConf
+
+    def unlock(node: DictConfig) -> None:
+        node._set_flag("readonly", None)
+        for key in node.keys():
+            child = node._get_node(key)
+            if isinstance(child, DictConfig):
+                unlock(child)
+
+    node = OmegaConf.structured(cls)
+    unlock(node)
+    return node
+
+
+def build_settings(cls: type, values: Mapping[str, Any] | None, key: str) -> Any:
+    """An instance of the dataclass ``cls`` from (partial) config values, defaults from ``cls``.
+
+    Raises:
+        ConfigError: an unknown key or a value of the wrong type, named as ``<key>.<field>``.
+    """
+    from omegaconf import OmegaConf
+    from omegaconf.errors import OmegaConfBaseException
+
+    try:
+        return OmegaConf.to_object(OmegaConf.merge(structured_schema(cls), values or {}))
+    except OmegaConfBaseException as exc:
+        where = getattr(exc, "full_key", None)
+        raise ConfigError(f"{key}.{where}: {str(exc).splitlines()[0]}" if where else f"{key}: {exc}") from None
+
+
+def _register_schemas() -> None:
+    from hydra.core.config_store import ConfigStore
+
+    from stylemotion.evaluation.settings import EvalSettings
+    from stylemotion.primitives import SegmentSettings
+    from stylemotion.synthesis.controller import FollowSettings
+
+    store = ConfigStore.instance()
+    for name, cls in (("segment", SegmentSettings), ("evaluation", EvalSettings), ("follow", FollowSettings)):
+        store.store(group="schema", name=name, node=structured_schema(cls))
+
+
 def _register_resolvers() -> None:
     from omegaconf import OmegaConf
 
@@ -139,3 +194,4 @@ def _register_resolvers() -> None:
 
 
 _register_resolvers()
+_register_schemas()

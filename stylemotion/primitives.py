@@ -13,9 +13,10 @@ rejected, placement, timelines) is ``docs/primitives.md``.
 from __future__ import annotations
 
 from collections import Counter
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field, fields
 from functools import cached_property
+from typing import Any
 
 import numpy as np
 
@@ -85,17 +86,23 @@ class SegmentSettings:
     rest_speed: float = 0.12
     min_rest_s: float = 0.15
 
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "actions", tuple(self.actions))  # a config's list, hashable like the default
+
     @classmethod
-    def from_dict(cls, values: dict | None) -> SegmentSettings:
-        """Settings from plain values (e.g. a Hydra node); ``contacts`` may be a dict."""
+    def from_dict(cls, values: Mapping[str, Any] | SegmentSettings | None) -> SegmentSettings:
+        """Settings from plain values (e.g. a Hydra node); ``contacts`` may be a mapping."""
+        if isinstance(values, SegmentSettings):
+            return values
         values = dict(values or {})
-        for keys, where in ((set(values), cls), (set(values.get("contacts") or {}), ContactSettings)):
+        contacts = values.get("contacts")
+        for keys, where in ((set(values), cls), (set(contacts or {}), ContactSettings)):
             unknown = sorted(keys - {f.name for f in fields(where)})
             if unknown:
                 raise ValueError(f"unknown {where.__name__} option(s) {unknown}; valid: "
                                  f"{sorted(f.name for f in fields(where))}")
-        if isinstance(values.get("contacts"), dict):
-            values["contacts"] = ContactSettings(**values["contacts"])
+        if isinstance(contacts, Mapping):
+            values["contacts"] = ContactSettings(**contacts)
         if "actions" in values:
             values["actions"] = tuple(values["actions"])
         return cls(**values)

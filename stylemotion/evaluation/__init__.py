@@ -14,9 +14,10 @@
 
 from stylemotion.evaluation.classifier import StyleClassifier
 from stylemotion.evaluation.metrics import diversity, foot_skating, frechet_distance, nearest_distances
-from stylemotion.evaluation.pipeline import EvalSettings, evaluate_models
+from stylemotion.evaluation.pipeline import evaluate_models
 from stylemotion.evaluation.reference import PrimitiveData, primitive_data
 from stylemotion.evaluation.report import write_report
+from stylemotion.evaluation.settings import EvalSettings
 from stylemotion.evaluation.sources import (
     NEUTRAL,
     EvalModel,

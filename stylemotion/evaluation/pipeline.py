@@ -4,13 +4,13 @@
 checkpoints or any :class:`~stylemotion.evaluation.sources.SampleSource`), the dataset they were
 trained on and the autoencoder they share, and computes per primitive:
 
-* Table 5.1 (:mod:`.tables`) on ``table_samples`` samples per model;
-* Tables 5.2/5.3 on ``variance_samples`` samples per model, plus the training data and every real
+* Table 5.1 (:mod:`.tables`) on ``samples.table_5_1`` samples per model;
+* Tables 5.2/5.3 on ``samples.variance`` samples per model, plus the training data and every real
   style for reference;
 * the style classifier's held-out accuracy and confusion, and the share of each model's samples
   it assigns to the model's style (:mod:`.classifier`);
 * Fréchet distance, diversity, foot skating and nearest-training-clip distance on
-  ``metric_samples`` samples per model (:mod:`.metrics`), each against the model's ground truth
+  ``samples.metrics`` samples per model (:mod:`.metrics`), each against the model's ground truth
   (:meth:`.reference.PrimitiveData.ground_truth`);
 
 and, once, the autoencoder's reconstruction error on the data's test split. Every model is sampled
@@ -27,7 +27,7 @@ import logging
 import time
 from collections import defaultdict
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass
 from typing import Any
 
 import numpy as np
@@ -38,7 +38,6 @@ from stylemotion.datamodules.windows import MotionWindowDataModule
 from stylemotion.datasets import TakeSet
 from stylemotion.evaluation.classifier import StyleClassifier, predicted_shares
 from stylemotion.evaluation.metrics import (
-    SKATE_SPEED_MPS,
     FootSkating,
     diversity,
     foot_skating,
@@ -48,6 +47,7 @@ from stylemotion.evaluation.metrics import (
     pose_sequences,
 )
 from stylemotion.evaluation.reference import PrimitiveData, primitive_data, segment_action
+from stylemotion.evaluation.settings import EvalSettings
 from stylemotion.evaluation.sources import (
     NEUTRAL,
     EvalModel,
@@ -66,44 +66,6 @@ log = logging.getLogger(__name__)
 #: Largest relative Frobenius difference accepted between a style model's recorded example Gram and
 #: the Gram of its example clip recomputed from the evaluation data.
 GRAM_TOLERANCE = 1e-3
-
-
-@dataclass
-class EvalSettings:
-    """Sample counts and metric settings of an evaluation.
-
-    Attributes:
-        seed: sampling seed (every model is sampled with it) and classifier seed.
-        table_samples: N of Table 5.1 (1000 in the thesis).
-        variance_samples: samples per model for Tables 5.2/5.3 (10,000 in the thesis).
-        metric_samples: samples per model for classifier, Fréchet, diversity, skating, nearest clip.
-        neutral_style: the data's neutral style label.
-        classifier_components: PCA dimensions of the classifier's feature space.
-        classifier_c: inverse regularization strength of its logistic regression.
-        skate_speed: planted-point speed above which a contact foot skates, m/s.
-        diversity_items: rows used at most by the diversity.
-        chunk: motions encoded at once for Gram matrices.
-        ae_window_frames, ae_stride: test windows of the autoencoder's reconstruction error.
-        segment: segmentation overrides (as for training).
-    """
-
-    seed: int = 0
-    table_samples: int = 1000
-    variance_samples: int = 10000
-    metric_samples: int = 1000
-    neutral_style: str = "normal"
-    classifier_components: int = 32
-    classifier_c: float = 1.0
-    skate_speed: float = SKATE_SPEED_MPS
-    diversity_items: int = 2000
-    chunk: int = 256
-    ae_window_frames: int = 60
-    ae_stride: int = 30
-    segment: dict[str, Any] = field(default_factory=dict)
-
-    def __post_init__(self) -> None:
-        if min(self.table_samples, self.variance_samples, self.metric_samples) < 2:
-            raise ValueError("every sample count must be ≥ 2")
 
 
 def evaluate_models(models: Sequence[EvalModel], takeset: TakeSet, autoencoder, settings: EvalSettings | None = None,
@@ -158,7 +120,7 @@ def evaluate_models(models: Sequence[EvalModel], takeset: TakeSet, autoencoder, 
     for primitive in sorted(by_primitive):
         action = parse_primitive(primitive)[0]
         if action not in segmentations:
-            segmentations[action] = segment_action(takeset, action, settings.segment)
+            segmentations[action] = segment_action(takeset, action, _segment_values(settings))
         out = _evaluate_primitive(primitive, by_primitive[primitive], takeset, autoencoder, settings, split, say,
                                   segmentations[action])
         for key in results:
@@ -193,7 +155,8 @@ def autoencoder_test_error(autoencoder, takeset: TakeSet, split: Mapping[str, An
     ``test_mpjpe_m``: positions integrated from the origin for both (root drift counts);
     ``test_local_mpjpe_m``: root-local poses only (see :mod:`stylemotion.models.autoencoder`).
     """
-    dm = MotionWindowDataModule(takeset=takeset, window_frames=settings.ae_window_frames, stride=settings.ae_stride,
+    windows = settings.autoencoder_test
+    dm = MotionWindowDataModule(takeset=takeset, window_frames=windows.window_frames, stride=windows.stride,
                                 split=dict(split or {}), eval_batch_size=256)
     dm.setup("test")
     fps = float(takeset.fps)
@@ -205,7 +168,12 @@ def autoencoder_test_error(autoencoder, takeset: TakeSet, split: Mapping[str, An
         local += float(local_mpjpe(recon, batch)) * len(batch)
         count += len(batch)
     return {"test_mpjpe_m": total / count, "test_local_mpjpe_m": local / count, "test_windows": count,
-            "window_frames": settings.ae_window_frames, "data": takeset.name}
+            "window_frames": settings.autoencoder_test.window_frames, "data": takeset.name}
+
+
+def _segment_values(settings: EvalSettings) -> dict[str, Any]:
+    """The evaluation's segmentation settings as plain values (what the DataModules take)."""
+    return asdict(settings.segment)
 
 
 def _order(models: Sequence[EvalModel], styles: Sequence[str]) -> list[EvalModel]:
@@ -269,7 +237,8 @@ def _canonical_length(primitive: str, models: Sequence[EvalModel], takeset: Take
                          "trained on different data")
     if lengths:
         return lengths.pop()
-    probe = primitive_data(takeset, primitive, 2, settings.neutral_style, settings.segment, split, segmentation)
+    probe = primitive_data(takeset, primitive, 2, settings.neutral_style, _segment_values(settings), split,
+                           segmentation)
     return int(round(float(np.median([c.num_frames for c in probe.training_data()]))))
 
 
@@ -287,7 +256,8 @@ def real_side(primitive: str, models: Sequence[EvalModel], takeset: TakeSet, set
     """
     length = _canonical_length(primitive, models, takeset, settings, split, segmentation)
     say(f"{primitive}: real clips")
-    data = primitive_data(takeset, primitive, length, settings.neutral_style, settings.segment, split, segmentation)
+    data = primitive_data(takeset, primitive, length, settings.neutral_style, _segment_values(settings), split,
+                          segmentation)
     for m in models:
         if m.style not in data.styles:
             raise MissingExampleError(f"{m.checkpoint or m.label} models style {m.style!r}, which dataset "
@@ -316,7 +286,7 @@ def fit_style_classifier(data: PrimitiveData, settings: EvalSettings) -> tuple[S
     """The style classifier fitted on the train split of every style, and its held-out result."""
     train_clips, held = data.split("train"), data.heldout()
     train = motions_from_clips(train_clips, data.length)
-    classifier = StyleClassifier(settings.classifier_components, settings.classifier_c, settings.seed)
+    classifier = StyleClassifier(settings.classifier.components, settings.classifier.C, settings.seed)
     classifier.fit(train.normalized_frames.numpy(), train.duration_s.numpy(), [c.style for c in train_clips])
     held_m = motions_from_clips(held, data.length)
     rep = classifier.evaluate(held_m.normalized_frames.numpy(), held_m.duration_s.numpy(), [c.style for c in held])
@@ -402,13 +372,13 @@ class Skating:
 
 
 def skating(real: RealSide, model: EvalModel, samples: MotionSamples, settings: EvalSettings) -> Skating:
-    """Share of contact foot-frames whose planted point moves faster than ``settings.skate_speed``."""
+    """Share of contact foot-frames whose planted point moves faster than ``settings.skate_speed_mps``."""
     data, truth = real.data, real.truth[model.name]
     return Skating(
         foot_skating(samples.positions.numpy(), samples.num_frames.numpy(), samples.fps, data.rest_heights,
-                     data.stance_foot, settings.skate_speed),
+                     data.stance_foot, settings.skate_speed_mps),
         foot_skating(truth.positions.numpy(), truth.num_frames.numpy(), truth.fps, data.rest_heights,
-                     data.stance_foot, settings.skate_speed))
+                     data.stance_foot, settings.skate_speed_mps))
 
 
 @dataclass
@@ -427,12 +397,12 @@ class StyleTable:
 
 
 def style_table(real: RealSide, autoencoder, model_frames: Sequence[np.ndarray], settings: EvalSettings) -> StyleTable:
-    """Table 5.1 from each model's first ``table_samples`` normalized sample frames (in ``real.models`` order)."""
+    """Table 5.1 from each model's first ``samples.table_5_1`` normalized sample frames (in ``real.models`` order)."""
     grams = torch.stack([_example_gram(autoencoder, real.data, m, real.examples[m.name]) for m in real.models])
-    table = distance_table(autoencoder, model_frames, grams, settings.chunk)
+    table = distance_table(autoencoder, model_frames, grams, settings.gram_chunk)
     clips = {m.name: ("mean motion of the neutral training clips" if m.name == NEUTRAL
                       else [c.describe() for c in real.examples[m.name]]) for m in real.models}
-    return StyleTable([m.name for m in real.models], table, settings.table_samples, clips)
+    return StyleTable([m.name for m in real.models], table, settings.samples.table_5_1, clips)
 
 
 def _example_gram(autoencoder, data: PrimitiveData, model: EvalModel, clips: list) -> torch.Tensor:
@@ -468,14 +438,14 @@ def _evaluate_primitive(primitive: str, models: list[EvalModel], takeset: TakeSe
                            "classifier": real.classifier_result}
     table_frames = []
     neutral_features = None
-    n_draw = max(settings.table_samples, settings.variance_samples, settings.metric_samples)
+    n_draw = max(settings.samples.table_5_1, settings.samples.variance, settings.samples.metrics)
     for m in real.models:
         t0 = time.perf_counter()
         say(f"{primitive}: {m.name}: {n_draw} samples")
         samples = m.source.sample(n_draw, seed=settings.seed)  # one draw serves every family
-        table_frames.append(samples.normalized_frames[:settings.table_samples].numpy())
-        variance.rows[m.name] = _variance(samples.subset(slice(0, settings.variance_samples)))
-        s = samples.subset(slice(0, settings.metric_samples))
+        table_frames.append(samples.normalized_frames[:settings.samples.table_5_1].numpy())
+        variance.rows[m.name] = _variance(samples.subset(slice(0, settings.samples.variance)))
+        s = samples.subset(slice(0, settings.samples.metrics))
         del samples
         f_s, f_t = real.features(s), real.features(real.truth[m.name])
         if m.name == NEUTRAL:
@@ -491,7 +461,8 @@ def _evaluate_primitive(primitive: str, models: list[EvalModel], takeset: TakeSe
         out["nearest_training"][m.name] = _nearest(train_poses, real.examples[m.name], s, real.truth[m.name],
                                                    real.heldout_neutral, real.length)
         log.debug("%s/%s evaluated in %.1f s", primitive, m.name, time.perf_counter() - t0)
-    say(f"{primitive}: Table 5.1 ({len(real.models)} × {len(real.models)}, {settings.table_samples} samples per model)")
+    n_models, n_table = len(real.models), settings.samples.table_5_1
+    say(f"{primitive}: Table 5.1 ({n_models} × {n_models}, {n_table} samples per model)")
     out["table_5_1"] = style_table(real, autoencoder, table_frames, settings).as_dict()
     out["variance"] = variance.rows
     out["variance_real"] = variance.real

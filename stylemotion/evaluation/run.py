@@ -17,16 +17,20 @@ import logging
 import os
 import time
 from collections.abc import Callable, Mapping, Sequence
+from dataclasses import asdict
 from pathlib import Path
 from typing import Any
 
 from omegaconf import DictConfig, OmegaConf
 
+from stylemotion.config import build_settings
 from stylemotion.datasets import build_dataset
-from stylemotion.evaluation.pipeline import EvalSettings, evaluate_models
+from stylemotion.evaluation.pipeline import evaluate_models
 from stylemotion.evaluation.report import write_report
-from stylemotion.evaluation.sources import check_one_autoencoder, load_model
+from stylemotion.evaluation.settings import EvalSettings
+from stylemotion.evaluation.sources import EvalModel, check_one_autoencoder, load_model
 from stylemotion.io.outputs import check_new_output
+from stylemotion.models.autoencoder import IncompatibleModelError, MotionAutoencoder
 from stylemotion.models.checkpoints import autoencoder_info, find_checkpoints, load_autoencoder
 from stylemotion.provenance import provenance
 
@@ -34,23 +38,15 @@ log = logging.getLogger(__name__)
 
 
 def settings_from_config(node: Mapping[str, Any], seed: int) -> EvalSettings:
-    """:class:`EvalSettings` from an ``evaluation`` config node (``configs/evaluation/default.yaml``)."""
-    node = OmegaConf.to_container(node, resolve=True) if isinstance(node, DictConfig) else dict(node)
-    known = {"samples", "neutral_style", "classifier", "skate_speed_mps", "diversity_items", "gram_chunk",
-             "autoencoder_test", "segment"}
-    unknown = sorted(set(node) - known)
-    if unknown:
-        raise ValueError(f"unknown evaluation option(s) {unknown}; valid: {sorted(known)}")
-    samples, clf, ae = node.get("samples", {}), node.get("classifier", {}), node.get("autoencoder_test", {})
-    return EvalSettings(seed=int(seed), table_samples=int(samples.get("table_5_1", 1000)),
-                        variance_samples=int(samples.get("variance", 10000)),
-                        metric_samples=int(samples.get("metrics", 1000)),
-                        neutral_style=str(node.get("neutral_style", "normal")),
-                        classifier_components=int(clf.get("components", 32)), classifier_c=float(clf.get("C", 1.0)),
-                        skate_speed=float(node.get("skate_speed_mps", 0.2)),
-                        diversity_items=int(node.get("diversity_items", 2000)), chunk=int(node.get("gram_chunk", 256)),
-                        ae_window_frames=int(ae.get("window_frames", 60)), ae_stride=int(ae.get("stride", 30)),
-                        segment=dict(node.get("segment") or {}))
+    """:class:`EvalSettings` from an ``evaluation`` config node (any subset of its keys; the rest
+    are the dataclass' defaults), sampled with ``seed``.
+
+    Raises:
+        ConfigError: an unknown key or a value of the wrong type, named as ``evaluation.<key>``.
+    """
+    values = OmegaConf.to_container(node, resolve=True) if isinstance(node, DictConfig) else dict(node or {})
+    values["seed"] = int(seed)
+    return build_settings(EvalSettings, values, "evaluation")
 
 
 def recorded_path(path: str | os.PathLike | None, root: Path) -> str | None:
@@ -63,6 +59,20 @@ def recorded_path(path: str | os.PathLike | None, root: Path) -> str | None:
         return path.relative_to(root).as_posix()
     except ValueError:
         return str(path)
+
+
+def models_autoencoder(model: EvalModel) -> tuple[MotionAutoencoder, str | None]:
+    """The autoencoder a model was trained with and the file to name in the report: the recorded
+    autoencoder checkpoint while it is still there (same weights), else the model's checkpoint,
+    which embeds it (see :func:`stylemotion.models.checkpoints.resolve_autoencoder`)."""
+    recorded = (model.autoencoder or {}).get("path")
+    if recorded and Path(recorded).is_file():
+        try:
+            return load_autoencoder(recorded, expected=model.autoencoder), recorded
+        except IncompatibleModelError:
+            pass  # replaced since: the embedded one is the model's own
+    autoencoder = model.source.autoencoder
+    return autoencoder, model.source.autoencoder_path
 
 
 def run_evaluation(data_cfg: Mapping[str, Any], checkpoints: Sequence[str], evaluation: Mapping[str, Any],
@@ -97,8 +107,8 @@ def run_evaluation(data_cfg: Mapping[str, Any], checkpoints: Sequence[str], eval
         check_one_autoencoder(models, info["fingerprint"])
     else:
         check_one_autoencoder(models)
-        autoencoder = models[0].source.autoencoder  # embedded in its checkpoint (or found on disk)
-        info = autoencoder_info(autoencoder, models[0].source.autoencoder_path or models[0].autoencoder.get("path"))
+        autoencoder, path = models_autoencoder(models[0])
+        info = autoencoder_info(autoencoder, path)
     for m in models:
         m.source.attach_autoencoder(autoencoder)
     info = {**info, "path": recorded_path(info["path"], base)}
@@ -109,13 +119,12 @@ def run_evaluation(data_cfg: Mapping[str, Any], checkpoints: Sequence[str], eval
         entry["checkpoint"] = recorded_path(entry.get("checkpoint"), base)
     results["meta"] = {
         "data": data_cfg, "data_name": takeset.name, "seed": int(seed),
-        "samples": {"table_5_1": settings.table_samples, "variance": settings.variance_samples,
-                    "metrics": settings.metric_samples},
+        "samples": asdict(settings.samples),
         "checkpoints": [{"path": recorded_path(m.checkpoint, base), "primitive": m.primitive, "name": m.name,
                          "style": m.style} for m in models],
         "autoencoder": {"path": info["path"], "fingerprint": info["fingerprint"]},
         "paths_relative_to": Path(os.path.relpath(base, out.resolve())).as_posix(),
-        "settings": {k: v for k, v in vars(settings).items()}, **provenance(command or None),
+        "settings": asdict(settings), **provenance(command or None),
         "seconds": time.perf_counter() - started,
     }
     write_report(results, out, force)

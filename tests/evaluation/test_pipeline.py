@@ -13,9 +13,10 @@ import torch
 from vae_fixtures import TINY_DATA, tiny_autoencoder_ckpt, tiny_takeset
 
 from stylemotion.datamodules.features import describe_clip
-from stylemotion.evaluation.pipeline import EvalSettings, evaluate_models
+from stylemotion.evaluation.pipeline import evaluate_models
 from stylemotion.evaluation.reference import primitive_data
 from stylemotion.evaluation.report import write_report
+from stylemotion.evaluation.settings import ClassifierSettings, EvalSettings, SampleCounts
 from stylemotion.evaluation.sources import (
     NEUTRAL,
     EvalModel,
@@ -28,7 +29,8 @@ from stylemotion.io.outputs import OutputExistsError
 from stylemotion.models.checkpoints import autoencoder_info, load_autoencoder
 
 torch.set_num_threads(1)
-SETTINGS = EvalSettings(table_samples=120, variance_samples=200, metric_samples=120, classifier_components=8)
+SETTINGS = EvalSettings(samples=SampleCounts(table_5_1=120, variance=200, metrics=120),
+                        classifier=ClassifierSettings(components=8))
 PRIMITIVES = ("walk_leftStance", "walk_rightStance")
 
 

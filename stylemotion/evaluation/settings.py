@@ -1,0 +1,88 @@
+"""Settings of an evaluation, one dataclass per config node: the defaults live here only.
+
+The ``evaluation`` config node (``configs/evaluation/default.yaml``) is built from
+:class:`EvalSettings` (registered as a Hydra structured config by :mod:`stylemotion.config`), so its
+keys are these field names, typed and checked; the YAML file holds only what differs.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from stylemotion.evaluation.metrics import SKATE_SPEED_MPS
+from stylemotion.primitives import SegmentSettings
+
+
+@dataclass
+class SampleCounts:
+    """Samples drawn per model.
+
+    Attributes:
+        table_5_1: N of Table 5.1 (eq. 5.12; 1000 in the thesis).
+        variance: samples for pose_SD, V_SD, step_SD (eq. 5.13–5.15; 10,000 in the thesis).
+        metrics: samples for the classifier share, Fréchet distance, diversity, foot skating and
+            nearest training clip.
+    """
+
+    table_5_1: int = 1000
+    variance: int = 10000
+    metrics: int = 1000
+
+
+@dataclass
+class ClassifierSettings:
+    """The style classifier (PCA + logistic regression) whose space hosts Fréchet and diversity.
+
+    Attributes:
+        components: PCA dimensions of its feature space.
+        C: inverse L2 strength of the logistic regression.
+    """
+
+    components: int = 32
+    C: float = 1.0
+
+
+@dataclass
+class WindowSettings:
+    """Test windows of the autoencoder's reconstruction error.
+
+    Attributes:
+        window_frames: frames per window.
+        stride: frames between window starts.
+    """
+
+    window_frames: int = 60
+    stride: int = 30
+
+
+@dataclass
+class EvalSettings:
+    """Sample counts and metric settings of an evaluation.
+
+    Attributes:
+        samples: samples per model for each table (:class:`SampleCounts`).
+        neutral_style: the data's neutral style label (the neutral VAE's content).
+        classifier: the style classifier (:class:`ClassifierSettings`).
+        skate_speed_mps: planted-point speed above which a contact foot skates, m/s.
+        diversity_items: motions used at most by the diversity (pairs grow as n²).
+        gram_chunk: motions encoded at once for the Gram matrices of Table 5.1.
+        autoencoder_test: windows of the autoencoder's test error (:class:`WindowSettings`).
+        segment: segmentation settings, as for training.
+        seed: sampling seed (every model is sampled with it) and classifier seed; set from the
+            command's top-level ``seed``.
+    """
+
+    samples: SampleCounts = field(default_factory=SampleCounts)
+    neutral_style: str = "normal"
+    classifier: ClassifierSettings = field(default_factory=ClassifierSettings)
+    skate_speed_mps: float = SKATE_SPEED_MPS
+    diversity_items: int = 2000
+    gram_chunk: int = 256
+    autoencoder_test: WindowSettings = field(default_factory=WindowSettings)
+    segment: SegmentSettings = field(default_factory=SegmentSettings)
+    seed: int = 0
+
+    def __post_init__(self) -> None:
+        counts = self.samples
+        if min(counts.table_5_1, counts.variance, counts.metrics) < 2:
+            raise ValueError(f"every evaluation.samples count must be ≥ 2, got {counts}")
