@@ -315,13 +315,16 @@ def _json_default(value: Any) -> Any:
     raise TypeError(f"not JSON serializable: {type(value).__name__}")
 
 
-def print_summary(report: dict[str, Any], out: Path) -> None:
+def summary_lines(report: dict[str, Any], out: Path) -> list[str]:
+    """A few lines for the terminal and the command's log: coverage per action, where the report is."""
+    lines = []
     if not report["coverage_by_action"]:
         d = report["dataset"]
-        print(f"no take of {d['name']} was segmented: {d['ignored_takes']} takes of contents "
-              f"{d['ignored_contents']} are none of the actions {list(report['settings']['actions'])}")
+        lines.append(f"no take of {d['name']} was segmented: {d['ignored_takes']} takes of contents "
+                     f"{d['ignored_contents']} are none of the actions {list(report['settings']['actions'])}")
     for row in report["coverage_by_action"]:
         cov = "–" if row["coverage"] is None else f"{row['coverage']:.1%}"
-        print(f"{row['action']}: {row['clips']} clips of {row['complete_steps']} complete steps ({cov}); "
-              f"{row['border_steps']} border steps, {row['rejected_takes']} rejected takes")
-    print(f"report written to {out}")
+        lines.append(f"{row['action']}: {row['clips']} clips of {row['complete_steps']} complete steps ({cov}); "
+                     f"{row['border_steps']} border steps, {row['rejected_takes']} rejected takes")
+    lines.append(f"report written to {out}")
+    return lines

@@ -9,6 +9,7 @@ The work and the folder's contents: :mod:`stylemotion.segmentation_report`.
 
 from __future__ import annotations
 
+import logging
 import sys
 from pathlib import Path
 
@@ -18,14 +19,17 @@ from omegaconf import DictConfig
 from stylemotion.cli import reported
 from stylemotion.config import CONFIG_PACKAGE
 from stylemotion.io.outputs import OutputExistsError
-from stylemotion.segmentation_report import print_summary, write_report
+from stylemotion.segmentation_report import summary_lines, write_report
+
+log = logging.getLogger(__name__)
 
 
 def _main(cfg: DictConfig) -> None:
     command = "stylemotion-segment " + " ".join(sys.argv[1:])
     with reported("stylemotion-segment", OutputExistsError):
         report = write_report(cfg, Path(cfg.out), bool(cfg.force), command)
-    print_summary(report, Path(cfg.out))
+    for line in summary_lines(report, Path(cfg.out)):
+        log.info(line)
 
 
 def main() -> None:

@@ -85,5 +85,6 @@ def test_command_line(tmp_path: Path) -> None:
     first = subprocess.run(args, capture_output=True, text=True, cwd=tmp_path, env=env, timeout=120)
     assert first.returncode == 0, first.stderr
     assert "walk:" in first.stdout and "report written to" in first.stdout
+    assert "report written to" in (tmp_path / "run" / "segment.log").read_text()  # the run folder keeps it too
     again = subprocess.run(args, capture_output=True, text=True, cwd=tmp_path, env=env, timeout=120)
     assert again.returncode != 0 and "exists" in again.stderr and "force=true" in again.stderr
