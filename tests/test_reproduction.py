@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import os
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -138,6 +139,18 @@ def test_rerun_reuses_finished_stages_and_resumes_an_interrupted_one(reproduced)
     assert f"resuming from {interrupted / 'checkpoints' / 'last.ckpt'}" in proc.stdout
     assert (interrupted / "done.json").is_file()
     assert (out / "report" / "report.json").read_text() == before
+
+
+def test_a_moved_run_reuses_its_own_stages(reproduced, tmp_path: Path) -> None:
+    """A run folder copied elsewhere resumes there: every stage and the report are reused from the copy."""
+    out, _, _ = reproduced
+    moved = tmp_path / "moved"
+    shutil.copytree(out, moved)
+    lines: list[str] = []
+    summary = reproduce(tiny_overrides(moved), lines)
+    reused = [line for line in lines if line.startswith("[") and ": reused " in line]
+    assert len(reused) == 5 and all(str(moved) in line for line in reused), lines
+    assert {s["status"] for s in summary["stages"]} == {"reused"}
 
 
 def test_changed_settings_are_refused_not_overwritten(reproduced) -> None:

@@ -40,19 +40,27 @@ EVAL = {"samples": {"table_5_1": 40, "variance": 60, "metrics": 40}, "classifier
 SAMPLE_FIELDS = ("positions", "frames", "num_frames", "duration_s", "latent", "features")
 
 
-@pytest.fixture(scope="module")
-def run(tmp_path_factory) -> Path:
-    """A run folder laid out like a reproduction's: ``autoencoder/checkpoints/best.ckpt`` and tiny
-    neutral VAEs of both walk stances in ``vae/<primitive>/checkpoints/best.ckpt``."""
-    root = tmp_path_factory.mktemp("checkpoints") / "run"
+def train_run(root: Path, autoencoder: Path) -> Path:
+    """A run folder laid out like a reproduction's: ``autoencoder/checkpoints/best.ckpt`` (a copy of
+    ``autoencoder``) and tiny neutral VAEs of both walk stances in ``vae/<primitive>/checkpoints/best.ckpt``."""
     ae = root / "autoencoder" / "checkpoints" / "best.ckpt"
     ae.parent.mkdir(parents=True)
-    shutil.copy(tiny_autoencoder_ckpt(tmp_path_factory.mktemp("checkpoints_ae")), ae)
+    shutil.copy(autoencoder, ae)
     for primitive in PRIMITIVES:
         torch.manual_seed(0)
         model = PrimitiveVAE(latent_dim=4, hidden=[32], samples_per_item=2)
         fit(model, feature_module(ae, primitive=primitive), steps=16, folder=root / "vae" / primitive / "checkpoints")
     return root
+
+
+@pytest.fixture(scope="module")
+def tiny_ae(tmp_path_factory) -> Path:
+    return tiny_autoencoder_ckpt(tmp_path_factory.mktemp("checkpoints_ae"))
+
+
+@pytest.fixture(scope="module")
+def run(tmp_path_factory, tiny_ae) -> Path:
+    return train_run(tmp_path_factory.mktemp("checkpoints") / "run", tiny_ae)
 
 
 def vae_ckpt(root: Path, primitive: str = "walk_leftStance") -> Path:
@@ -185,13 +193,12 @@ def test_an_embedded_autoencoder_with_other_weights_is_refused(run, tmp_path) ->
 # -- a run folder that moved
 
 
-def test_a_moved_run_samples_evaluates_and_synthesizes(run, tmp_path) -> None:
-    first = tmp_path / "first" / "run"
-    shutil.copytree(run, first)
+def test_a_moved_run_samples_evaluates_and_synthesizes(tiny_ae, tmp_path) -> None:
+    first = train_run(tmp_path / "first" / "run", tiny_ae)
     before = run_evaluation(TINY_DATA, [str(first / "vae")], EVAL, first / "report", root=first)
     meta = before["meta"]
     assert meta["paths_relative_to"] == ".."  # from the report folder to the run folder
-    assert meta["autoencoder"]["path"] == "vae/walk_leftStance/checkpoints/best.ckpt"  # embedded there
+    assert meta["autoencoder"]["path"] == "autoencoder/checkpoints/best.ckpt"
     assert [c["path"] for c in meta["checkpoints"]] == [f"vae/{p}/checkpoints/best.ckpt" for p in PRIMITIVES]
     samples = load_generative(vae_ckpt(first)).sample(5, seed=1)
 
@@ -202,7 +209,7 @@ def test_a_moved_run_samples_evaluates_and_synthesizes(run, tmp_path) -> None:
     assert_same_samples(PrimitiveVAE.load_from_checkpoint(vae_ckpt(moved)).sample(5, seed=1), samples)
 
     again = run_evaluation(TINY_DATA, [str(moved / "vae")], EVAL, tmp_path / "eval")  # stylemotion-eval
-    assert again["meta"]["autoencoder"]["path"] == str(vae_ckpt(moved))  # embedded there
+    assert again["meta"]["autoencoder"]["path"] == str(vae_ckpt(moved))  # the recorded one is gone: embedded there
     assert [c["path"] for c in again["meta"]["checkpoints"]] == [str(vae_ckpt(moved, p)) for p in PRIMITIVES]
     assert [m["checkpoint"] for m in before["models"]] == [c["path"] for c in meta["checkpoints"]]
     assert json.dumps(numbers(again), sort_keys=True) == json.dumps(numbers(before), sort_keys=True)
