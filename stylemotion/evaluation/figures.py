@@ -13,6 +13,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from stylemotion.evaluation.tables import VARIANCE_KEYS
+from stylemotion.io.outputs import inside
 
 
 def _footer(results: dict[str, Any], samples: Any, primitive: str | None = None) -> str:
@@ -81,13 +82,13 @@ def write_figures(results: dict[str, Any], folder: Path) -> list[str]:
         name = f"table_5_1_{p}.png"
         _heatmap(np.asarray(t["distance"]), t["models"], t["examples"],
                  f"Table 5.1, {p}: D(model, example)\nbold = row minimum, red box = diagonal",
-                 _footer(results, t["samples"], p), folder / name, xlabel="style example", ylabel="model")
+                 _footer(results, t["samples"], p), inside(folder, name), xlabel="style example", ylabel="model")
         written.append(name)
     for p, c in results.get("style_recognition", {}).get("per_primitive", {}).items():
         name = f"classifier_confusion_{p}.png"
         _heatmap(np.asarray(c["confusion"], dtype=float), c["styles"], c["styles"],
                  f"style classifier, real held-out {p} clips\naccuracy {c['heldout_accuracy']:.1%}",
-                 _footer(results, f"{c['heldout_clips']} real clips", p), folder / name, integer=True,
+                 _footer(results, f"{c['heldout_clips']} real clips", p), inside(folder, name), integer=True,
                  xlabel="predicted", ylabel="true style")
         written.append(name)
     if results.get("variance_ratio"):

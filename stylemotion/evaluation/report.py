@@ -23,7 +23,7 @@ from stylemotion.evaluation.figures import write_figures
 from stylemotion.evaluation.markdown import DEFINITIONS, format_markdown
 from stylemotion.evaluation.tables import VARIANCE_KEYS
 from stylemotion.io.atomic import atomic_folder
-from stylemotion.io.outputs import check_new_output
+from stylemotion.io.outputs import check_new_output, inside
 
 
 def write_report(results: dict[str, Any], out: str | os.PathLike, force: bool = False) -> Path:
@@ -70,7 +70,7 @@ def write_csvs(results: dict[str, Any], folder: Path) -> list[str]:
     written = []
 
     def put(name: str, header: list[str], rows: list[list[Any]]) -> None:
-        (folder / name).write_text(_csv_text(header, rows))
+        inside(folder, name).write_text(_csv_text(header, rows))  # names hold primitive names from checkpoints
         written.append(name)
 
     for p, t in results.get("table_5_1", {}).items():
