@@ -267,7 +267,8 @@ def run(cfg: DictConfig, extra_callbacks: list[pl.Callback] | None = None) -> di
     log.info("rank %d of %d: torch seed %d", trainer.global_rank, trainer.world_size, rank_seed)
 
     if cfg.get("train", True):
-        trainer.fit(model, datamodule=datamodule, ckpt_path=ckpt_path)
+        # checkpoints hold tensors and plain values only, so they load without unpickling code
+        trainer.fit(model, datamodule=datamodule, ckpt_path=ckpt_path, weights_only=True)
     metrics: dict[str, Any] = {"global_step": trainer.global_step, "epoch": trainer.current_epoch,
                                "data": getattr(datamodule, "summary", None)}
     best = _best_checkpoint(trainer)
@@ -280,7 +281,7 @@ def run(cfg: DictConfig, extra_callbacks: list[pl.Callback] | None = None) -> di
                 cb.save_on_exception = False
         # the best checkpoint of this fit; with train=false, the checkpoint given as ckpt_path
         test_ckpt = best or (None if cfg.get("train", True) else ckpt_path)
-        results = trainer.test(model, datamodule=datamodule, ckpt_path=test_ckpt)
+        results = trainer.test(model, datamodule=datamodule, ckpt_path=test_ckpt, weights_only=True)
         metrics["test"] = {k: _plain(v) for k, v in (results[0] if results else {}).items()}
     metrics["stylemotion_version"] = record["stylemotion_version"]
     metrics["git_commit"] = record["git_commit"]
