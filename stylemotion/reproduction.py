@@ -52,7 +52,7 @@ from typing import Any
 from hydra import compose
 from omegaconf import DictConfig, OmegaConf, open_dict
 
-from stylemotion.config import positive_int, set_torch_threads
+from stylemotion.config import positive_int, set_torch_threads  # also registers the configs' resolvers
 from stylemotion.datasets import build_dataset
 from stylemotion.evaluation.run import recorded_path, run_evaluation, summary_lines
 from stylemotion.io.atomic import atomic_write_bytes
@@ -291,7 +291,7 @@ class Reproduction:
                 OmegaConf.update(cfg, key, value, force_add=True)
             if stage.parent is not None:
                 cfg.autoencoder_ckpt = stage.parent.checkpoint
-            cfg.ckpt_path = "last" if resume else None
+            cfg.ckpt_path = "auto"  # resumes from last.ckpt exactly when there is one (``resume``)
         return cfg
 
     def evaluation_stage(self) -> dict[str, Any]:

@@ -137,6 +137,8 @@ def test_rerun_reuses_finished_stages_and_resumes_an_interrupted_one(reproduced)
     steps = [line for line in proc.stdout.splitlines() if line.startswith("[")]
     assert sum(": reused " in line for line in steps) == 4, proc.stdout  # autoencoder, vae, elderly cvae, report
     assert f"resuming from {interrupted / 'checkpoints' / 'last.ckpt'}" in proc.stdout
+    log_text = max((out / "hydra").glob("*/reproduce.log"), key=lambda f: f.stat().st_mtime).read_text()
+    assert "resuming from" in log_text and "report:" in log_text  # the run folder keeps what the console showed
     assert (interrupted / "done.json").is_file()
     assert (out / "report" / "report.json").read_text() == before
 

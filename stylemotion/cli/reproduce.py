@@ -9,6 +9,8 @@ The work is :func:`stylemotion.reproduction.reproduce`; its module doc describes
 
 from __future__ import annotations
 
+import logging
+
 import hydra
 from omegaconf import DictConfig
 
@@ -17,10 +19,12 @@ from stylemotion.config import CONFIG_PACKAGE, ConfigError
 from stylemotion.io.outputs import OutputExistsError
 from stylemotion.reproduction import StageConflictError, reproduce
 
+log = logging.getLogger(__name__)
+
 
 def _main(cfg: DictConfig) -> None:
     with reported("stylemotion-reproduce", StageConflictError, OutputExistsError, ConfigError):
-        reproduce(cfg)
+        reproduce(cfg, say=log.info)  # the console and <out>/hydra/<time>/reproduce.log
 
 
 def main() -> None:
