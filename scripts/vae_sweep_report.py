@@ -32,6 +32,7 @@ import yaml
 
 from stylemotion.datamodules.features import FeatureDataModule
 from stylemotion.datasets import build_dataset
+from stylemotion.models.checkpoints import load_generative
 from stylemotion.models.cvae import StyleCVAE
 from stylemotion.models.style import feature_style_distance, gram
 from stylemotion.models.vae import PrimitiveVAE
@@ -127,14 +128,14 @@ def main() -> None:
     takesets: dict = {}
     cvaes: dict[str, list[StyleCVAE]] = {}
     for run in runs_of(args.cvae_sweep):
-        model = StyleCVAE.load_from_checkpoint(run / "checkpoints" / "best.ckpt", map_location="cpu").eval()
+        model = load_generative(run / "checkpoints" / "best.ckpt")
         cvaes.setdefault(model.primitive, []).append(model)
         print(json.dumps({"kind": "style_run", "run": str(run), "primitive": model.primitive, "style": model.style,
                           "run_seconds": train_seconds(run),
                           "epochs": json.loads((run / "metrics.json").read_text()).get("epoch"),
                           "test": json.loads((run / "metrics.json").read_text()).get("test")}), flush=True)
     for run in runs_of(args.vae_sweep):
-        model = PrimitiveVAE.load_from_checkpoint(run / "checkpoints" / "best.ckpt", map_location="cpu").eval()
+        model = load_generative(run / "checkpoints" / "best.ckpt")
         dm = datamodule(run, takesets)
         print(json.dumps(reconstruction(model, dm, run, args.n, args.seed)), flush=True)
         if cvaes.get(model.primitive):

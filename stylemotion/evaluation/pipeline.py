@@ -315,10 +315,11 @@ class Variance:
 
 
 def real_variance(real: RealSide) -> Variance:
-    """The reference rows of Tables 5.2/5.3: the training data, and the real clips of every style."""
-    return Variance({"training_data": _variance(real.training)},
-                    {style: _variance(motions_from_clips(real.data.style_clips(style), real.length))
-                     for style in real.data.styles})
+    """The reference rows of Tables 5.2/5.3: the training data, and the real clips of every style that has
+    clips of this primitive."""
+    clips = {style: real.data.style_clips(style) for style in real.data.styles}
+    return Variance({"training_data": _variance(real.training)},  # a style without clips of the primitive has no row
+                    {style: _variance(motions_from_clips(c, real.length)) for style, c in clips.items() if c})
 
 
 @dataclass

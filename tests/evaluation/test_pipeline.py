@@ -168,3 +168,19 @@ def test_bad_input_gets_clear_errors(autoencoder) -> None:
         run([models[1], models[1]])
     with pytest.raises(ValueError, match="no model"):
         run([])
+
+
+def test_real_variance_leaves_out_a_style_without_clips_of_the_primitive():
+    from types import SimpleNamespace
+
+    from stylemotion.evaluation.pipeline import real_variance
+    from stylemotion.evaluation.sources import motions_from_clips
+
+    data = primitive_data(tiny_takeset(), "walk_leftStance", 17)
+    clips = {s: data.style_clips(s) for s in data.styles}
+    clips["standing_only"] = []
+    real = SimpleNamespace(training=motions_from_clips(data.training_data(), 17), length=17,
+                           data=SimpleNamespace(styles=[*data.styles, "standing_only"], style_clips=clips.__getitem__))
+    variance = real_variance(real)
+    assert set(variance.real) == set(data.styles)
+    assert variance.ratio["training_data"] == {"pose_sd": 1.0, "v_sd": 1.0, "step_sd": 1.0}
