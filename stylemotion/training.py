@@ -8,33 +8,11 @@
     stylemotion-train ... hydra.run.dir=<run folder> ckpt_path=last # resume that run
     stylemotion-train ... hydra.run.dir=<run folder> ckpt_path=auto # resume if it has last.ckpt, else start
 
-The entry point only composes and instantiates: ``cfg.datamodule`` receives the data config
-(``cfg.data``) as ``data=``; ``cfg.model`` is any LightningModule; ``cfg.trainer``, ``cfg.logger``
-and ``cfg.callbacks`` are Lightning objects. Each run writes into one folder (``output_dir``): the
-config as composed (``.hydra/``) and resolved (``config_resolved.yaml``), ``run.json`` (package
-version, git commit, command and time of every start), ``tensorboard/`` (metrics, learning rate, and
-the hyperparameters with the best monitored value in the HPARAMS tab), ``checkpoints/{best,last}.ckpt``
-and ``metrics.json`` (test metrics of the best checkpoint, version and commit).
-
-A run never writes over another run's results. Before any work, :func:`prepare_output` looks for
-results in the folder (checkpoints, ``metrics.json``, logger files; Hydra's own ``.hydra/`` and
-``<job>.log`` do not count) and refuses with :class:`~stylemotion.io.outputs.OutputExistsError`
-unless the run resumes (``ckpt_path=last|auto|<file>``) or ``force=true``, which **deletes** the
-old checkpoints, ``metrics.json`` and logger files (event files, ``hparams.yaml``, ``metrics.csv``)
-and starts afresh. ``ckpt_path``:
-
-* ``null``: start (refused where results exist, see above);
-* ``last``: resume from ``<output_dir>/checkpoints/last.ckpt``, which must exist;
-* ``auto``: resume from it if it exists, else start (for requeued cluster jobs); logger files of an
-  attempt that saved no checkpoint are deleted, other results are refused;
-* a path: resume from that checkpoint.
-
-``last.ckpt`` is written by Lightning's public checkpointing API: the ``checkpoint_last`` callback (a
-``ModelCheckpoint`` named ``last`` without a monitor, ``save_on_exception=True``) after every epoch
-(or every N steps) and on Ctrl+C or an exception, and :class:`CheckpointAtTrainEnd` when fitting ends
-(``trainer.save_checkpoint``). Neither ``save_last`` (which copies only when its callback saves: in
-Lightning 2.6 only when the best score improves) nor ``OnExceptionCheckpoint`` (which deletes its
-file when a fit ends normally) can keep ``last.ckpt`` alone.
+Each run writes into one folder: the resolved config, ``run.json`` (version, commit, command of
+every start), TensorBoard logs, ``checkpoints/{best,last}.ckpt`` and ``metrics.json``. A folder that
+holds a run's results is refused unless the run resumes (``ckpt_path=last|auto|<file>``) or
+``force=true`` (which deletes the old results). The full specification (what counts as a result,
+``ckpt_path`` modes, how ``last.ckpt`` is kept with Lightning's public API) is ``docs/training.md``.
 """
 
 from __future__ import annotations
