@@ -58,6 +58,7 @@ from stylemotion.evaluation.run import recorded_path, run_evaluation, summary_li
 from stylemotion.io.atomic import atomic_write_bytes
 from stylemotion.io.outputs import inside, safe_name
 from stylemotion.primitives import SegmentSettings, action_of, parse_primitive, segment_takes
+from stylemotion.provenance import provenance
 
 log = logging.getLogger(__name__)
 
@@ -122,6 +123,7 @@ class Reproduction:
         self.primitives = [str(p) for p in cfg.primitives]
         for p in self.primitives:
             parse_primitive(p)
+        self.provenance = provenance()  # version, commit and command of this run (in reproduce.json)
         self.started = time.perf_counter()
         self.stages: list[Stage] = []
         self.data_summary: dict[str, Any] = {}
@@ -330,7 +332,8 @@ class Reproduction:
 
     def summary(self) -> dict[str, Any]:
         """What ``reproduce.json`` holds; paths inside ``out`` are relative to it."""
-        return {"out": str(self.out), "data": self.data_summary, "seconds": time.perf_counter() - self.started,
+        return {"out": str(self.out), "provenance": self.provenance, "data": self.data_summary,
+                "seconds": time.perf_counter() - self.started,
                 "stages": [{"name": s.name, "kind": s.kind, "status": s.status,
                             "checkpoint": self.recorded(s.checkpoint), "seconds": s.seconds, "metrics": s.metrics,
                             "folder": self.recorded(s.folder)} for s in self.stages]}

@@ -42,6 +42,7 @@ from stylemotion.primitives import (
     segment_takes,
     stance_speeds,
 )
+from stylemotion.provenance import provenance
 
 log = logging.getLogger(__name__)
 
@@ -302,6 +303,7 @@ def write_report(cfg: DictConfig | dict, out: Path, force: bool = False, command
                 sheets.append(sheet)
         report["figures"] = {"takes": plots, "sheets": sheets}
         report["command"] = command
+        report["provenance"] = provenance(command or None)
         (tmp / "report.json").write_text(json.dumps(report, indent=1, default=_json_default))
         (tmp / "report.md").write_text(format_report(report, command, plots, sheets))
     return report

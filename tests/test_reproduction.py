@@ -16,6 +16,7 @@ import torch
 from hydra import compose, initialize_config_dir
 from vae_fixtures import feature_module, fit, tiny_autoencoder_ckpt
 
+import stylemotion
 from stylemotion.config import CONFIG_DIR
 from stylemotion.evaluation.run import run_evaluation
 from stylemotion.evaluation.sources import MissingExampleError, MixedAutoencodersError
@@ -97,6 +98,8 @@ def test_the_run_records_paths_relative_to_its_folder(reproduced) -> None:
     out, _, _ = reproduced
     summary = json.loads((out / "reproduce.json").read_text())
     assert summary["report"] == "report"
+    recorded = summary["provenance"]
+    assert recorded["stylemotion_version"] == stylemotion.__version__ and recorded["git_commit"]
     vae = "vae/walk_leftStance/checkpoints/best.ckpt"
     assert [s["folder"] for s in summary["stages"]][:2] == ["autoencoder", "vae/walk_leftStance"]
     assert summary["stages"][1]["checkpoint"] == vae and (out / vae).is_file()

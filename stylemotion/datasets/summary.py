@@ -59,9 +59,11 @@ def write_dataset_summary(data_cfg: Mapping[str, Any], out_dir: str | Path) -> d
     """Build the dataset of ``data_cfg``, split it as ``data_cfg.split`` says and write
     ``summary.json`` into ``out_dir``; returns the summary."""
     from stylemotion.datasets import build_dataset
+    from stylemotion.provenance import provenance
 
     takeset = build_dataset(data_cfg)
     split = takeset.split(**(data_cfg.get("split") or {}))
     summary = dataset_summary(takeset, split)
+    summary["provenance"] = provenance()
     atomic_write_bytes(Path(out_dir) / "summary.json", json.dumps(summary, indent=2).encode())
     return summary

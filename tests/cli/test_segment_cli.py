@@ -35,6 +35,7 @@ def test_report_folder_contents(tmp_path: Path) -> None:
     assert len(list((out / "takes").glob("*.png"))) == 4  # one take per action × style
     saved = json.loads((out / "report.json").read_text())
     assert saved["coverage_total"][0]["coverage"] == 1.0
+    assert saved["provenance"]["command"] == "test" and saved["provenance"]["stylemotion_version"]
     counts = {(r["action"], r["primitive"], r["style"]): r["clips"] for r in saved["counts"]}
     assert len(counts) == 2 * 6 * 2 and counts[("walk", "beginLeftStance", "normal")] == 0
     assert counts[("walk", "leftStance", "elderly")] > 0

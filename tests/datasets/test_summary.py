@@ -33,5 +33,6 @@ def test_write_dataset_summary_of_the_synthetic_data(tmp_path, monkeypatch):
     summary = write_dataset_summary({"name": "synthetic", "split": {"seed": 0}}, tmp_path / "out")
     written = json.loads((tmp_path / "out" / "summary.json").read_text())
     assert written == summary
+    assert written["provenance"]["stylemotion_version"] and written["provenance"]["git_commit"]
     assert written["dataset"] == "synthetic" and written["takes"] > 0
     assert sum(part["takes"] for part in written["split"].values()) == written["takes"]
