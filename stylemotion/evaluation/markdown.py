@@ -49,6 +49,13 @@ DEFINITIONS = {
             "mean yaw rate (rad/s, signed) (eq. 5.14).",
     "step_sd": "standard deviation over motions of the step length, the ground distance of the summed relative "
                "root translation from first to last frame (eq. 5.15); cm.",
+    "pose_across_sd": "sqrt(1/T Σ_t Σ_c Var_i(x_itc)) in cm: the spread across motions at aligned frames t of the "
+                      "canonical timeline, x_itc coordinate c of the 21 root-local joints of motion i (beyond the "
+                      "thesis: copies of one motion score 0, while pose_SD stays high from the motion within a step).",
+    "variation_vs_style": "a model's pose_across_SD, V_SD and step_SD divided by those of all real clips of its own "
+                          "style, and its diversity divided by that of its ground truth clips (beyond the thesis, "
+                          "whose ratios divide by the neutral training data): near 100 % keeps the style's "
+                          "variation, near 0 copies one motion.",
     "classifier": "z-scored descriptor (the clip's 66-dim frames on the canonical timeline + log duration) → PCA → "
                   "multinomial logistic regression, fitted on real train-split clips of every style; held-out "
                   "accuracy on real val+test clips; a model's share = fraction of its samples assigned its style.",
@@ -110,6 +117,7 @@ def format_markdown(results: dict[str, Any], figures: list[str], tables: list[st
     out += _thesis_section(results)
     out += _table_5_1_section(results)
     out += _variance_section(results)
+    out += _variation_section(results)
     out += _recognition_section(results)
     out += _metric_sections(results)
     out += ["## Files", "", "Tables as CSV: " + ", ".join(f"`{t}`" for t in tables) + ".", ""]
@@ -186,6 +194,24 @@ def _variance_section(results: dict[str, Any]) -> list[str]:
                                for st, s in real.items()]), ""]
     if results.get("variance_ratio"):
         out += ["![variance](variance.png)", ""]
+    return out
+
+
+def _variation_section(results: dict[str, Any]) -> list[str]:
+    if not results.get("variation_vs_style"):
+        return []
+    out = ["## Variation across samples, against the real clips of each model's style", "",
+           "pose_across_SD in cm (spread across motions at aligned canonical frames); % = the model's value / its "
+           "style's real clips (diversity: / its ground truth). A model that copies one motion scores near 0 here "
+           "whatever its pose_SD.", ""]
+    for p, ratios in results["variation_vs_style"].items():
+        rows, real = results["variance"][p], results.get("variance_real", {}).get(p, {})
+        body = [[m, r["style"], fmt(rows[m].get("pose_across_sd")), fmt(real.get(r["style"], {}).get("pose_across_sd")),
+                 pct(r["pose_across_sd"]), pct(r["v_sd"]), pct(r["step_sd"]), pct(r["diversity"])]
+                for m, r in ratios.items()]
+        header = ["model", "style", "pose_across_SD", "its style's real clips", "pose_across %", "V_SD %", "step_SD %",
+                  "diversity %"]
+        out += [f"### {p}", "", _md_table(header, body), ""]
     return out
 
 

@@ -105,8 +105,8 @@ def evaluate_models(models: Sequence[EvalModel], takeset: TakeSet, autoencoder, 
             raise ValueError(f"{m.checkpoint or m.label} was trained on dataset {m.dataset!r}, not {takeset.name!r}")
         by_primitive[m.primitive].append(m)
     results: dict[str, Any] = {key: {} for key in (
-        "table_5_1", "variance", "variance_ratio", "variance_real", "frechet", "frechet_reference", "diversity",
-        "foot_skating_detail", "nearest_training")}
+        "table_5_1", "variance", "variance_ratio", "variance_real", "variation_vs_style", "frechet",
+        "frechet_reference", "diversity", "foot_skating_detail", "nearest_training")}
     recognition: dict[str, Any] = {"per_primitive": {}, "per_model_detail": {}}
     skating: dict[str, list] = defaultdict(list)
     skating_real: dict[str, list] = defaultdict(list)
@@ -296,7 +296,32 @@ def fit_style_classifier(data: PrimitiveData, settings: EvalSettings) -> tuple[S
 
 
 def _variance(motions: MotionSamples) -> dict[str, float]:
-    return variance_stats(motions.frames.numpy(), motions.positions.numpy(), motions.num_frames.numpy())
+    return variance_stats(motions.frames.numpy(), motions.positions.numpy(), motions.num_frames.numpy(),
+                          motions.normalized_frames.numpy())
+
+
+#: What :func:`variation_vs_style` compares with the real clips of a model's own style.
+VARIATION_KEYS = ("pose_across_sd", "v_sd", "step_sd", "diversity")
+
+
+def variation_vs_style(variance: Variance, diversity_rows: Mapping[str, Mapping[str, float]],
+                       models: Sequence[EvalModel]) -> dict[str, dict[str, float]]:
+    """Each model's variation as a share of the real clips of its own style (``style``): pose_across_SD,
+    V_SD and step_SD over the style's clips (:func:`real_variance`), diversity over its ground truth.
+
+    Beyond the thesis, which divides by the neutral training data: a style model that copies its one
+    example keeps its style's pose_SD but scores near 0 here.
+    """
+    out = {}
+    for m in models:
+        real = variance.real.get(m.style)
+        if real is None:
+            continue
+        row, div = variance.rows[m.name], diversity_rows[m.name]
+        ratios = {k: row[k] / real[k] if real[k] else float("nan") for k in VARIATION_KEYS[:-1]}
+        ratios["diversity"] = div["samples"] / div["real"] if div["real"] else float("nan")
+        out[m.name] = {"style": m.style, **ratios}
+    return out
 
 
 @dataclass
@@ -468,6 +493,7 @@ def _evaluate_primitive(primitive: str, models: list[EvalModel], takeset: TakeSe
     out["variance"] = variance.rows
     out["variance_real"] = variance.real
     out["variance_ratio"] = variance.ratio
+    out["variation_vs_style"] = variation_vs_style(variance, out["diversity"], real.models)
     return out
 
 

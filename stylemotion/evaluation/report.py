@@ -21,6 +21,7 @@ import numpy as np
 
 from stylemotion.evaluation.figures import write_figures
 from stylemotion.evaluation.markdown import DEFINITIONS, format_markdown
+from stylemotion.evaluation.pipeline import VARIATION_KEYS
 from stylemotion.evaluation.tables import VARIANCE_KEYS
 from stylemotion.io.atomic import atomic_folder
 from stylemotion.io.outputs import check_new_output, inside
@@ -85,6 +86,10 @@ def write_csvs(results: dict[str, Any], folder: Path) -> list[str]:
                  for st, s in results.get("variance_real", {}).get(p, {}).items()]
         put(f"variance_{p}.csv", ["kind", "row", "pose_sd_cm", "v_sd", "step_sd_cm", "pose_sd_ratio", "v_sd_ratio",
                                   "step_sd_ratio", "speed_mean_mps", "step_mean_cm", "motions"], body)
+    body = [[p, m] + [r[k] for k in VARIATION_KEYS] for p, models in results.get("variation_vs_style", {}).items()
+            for m, r in models.items()]
+    if body:
+        put("variation_vs_style.csv", ["primitive", "model"] + [f"{k}_ratio" for k in VARIATION_KEYS], body)
     rec = results.get("style_recognition", {})
     for p, c in rec.get("per_primitive", {}).items():
         put(f"classifier_confusion_{p}.csv", ["true \\ predicted"] + c["styles"],

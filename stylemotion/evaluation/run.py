@@ -142,6 +142,13 @@ def summary_lines(results: dict[str, Any]) -> list[str]:
     lines.append(f"style classifier on real held-out clips: {rec['classifier_heldout_accuracy']:.1%} (chance "
                  f"{rec['chance']:.1%}); samples assigned their style: "
                  + ", ".join(f"{m} {s:.0%}" for m, s in rec["per_model"].items()))
+    for p, rows in results.get("variation_vs_style", {}).items():
+        styled = {m: r for m, r in rows.items() if m != "neutral"}
+        if styled:
+            across = [r["pose_across_sd"] for r in styled.values()]
+            div = [r["diversity"] for r in styled.values()]
+            lines.append(f"{p} style models / real clips of their style: pose_across_SD {min(across):.0%}–"
+                         f"{max(across):.0%}, diversity {min(div):.0%}–{max(div):.0%}")
     for p, ratio in results["variance_ratio"].items():
         if "neutral" in ratio:
             r = ratio["neutral"]

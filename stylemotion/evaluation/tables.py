@@ -26,6 +26,12 @@ Tables 5.2/5.3, over a set of motions (samples of a model, or real clips):
   does, in m/s and rad/s.
 * ``step_SD`` (eq. 5.15) = the standard deviation over **motions** of the step length ``l_i``, the
   length of the summed relative root translation on the ground (first to last frame), centimetres.
+
+Beyond the thesis, because pose_SD is dominated by the motion within a step and stays high when a
+model draws the same motion every time: ``pose_across_SD`` = ``sqrt(1/T Σ_t Σ_c Var_i(x_{i,t,c}))``,
+the spread **across motions** at aligned frames of the canonical timeline (``x_{i,t,c}`` coordinate
+``c`` of the 21 root-local joint positions of motion ``i`` at canonical frame ``t``; population
+variance over motions), centimetres. Copies of one motion score 0 whatever their own movement.
 """
 
 from __future__ import annotations
@@ -119,17 +125,32 @@ def diagonal_minima(table: np.ndarray, names: Sequence[str]) -> dict[str, object
             "all_columns": len(cols) == len(names), "row_argmin": {names[i]: names[int(t[i].argmin())] for i in idx}}
 
 
-def variance_stats(frames: np.ndarray, positions: np.ndarray, num_frames: np.ndarray) -> dict[str, float]:
+def across_sample_sd(normalized_frames: np.ndarray) -> float:
+    """pose_across_SD (cm): spread across motions at aligned canonical frames (see the module doc).
+
+    Args:
+        normalized_frames: ``(n, T, 66)`` frames of n ≥ 2 motions on one canonical timeline.
+    """
+    x = np.asarray(normalized_frames, dtype=np.float64)
+    if x.ndim != 3 or len(x) < 2 or x.shape[-1] != FRAME_DIM:
+        raise ValueError(f"need (n ≥ 2, T, {FRAME_DIM}) normalized frames, got {x.shape}")
+    return float(np.sqrt(x[..., JOINT_DIMS].var(axis=0).sum(-1).mean()) * 100.0)
+
+
+def variance_stats(frames: np.ndarray, positions: np.ndarray, num_frames: np.ndarray,
+                   normalized_frames: np.ndarray | None = None) -> dict[str, float]:
     """pose_SD (cm), V_SD (m/s ⊕ rad/s) and step_SD (cm) of a set of motions (see the module doc).
 
     Args:
         frames: ``(n, frames, 66)`` padded frames at the data's fps (velocities per second).
         positions: ``(n, frames, 21, 3)`` padded positions, metres.
         num_frames: ``(n,)`` valid frames of each motion (≥ 2).
+        normalized_frames: ``(n, T, 66)`` the same motions on the canonical timeline; given, the
+            result adds ``pose_across_sd`` (cm, :func:`across_sample_sd`).
 
     Returns:
         ``pose_sd``, ``v_sd``, ``step_sd``, and for context ``speed_mean_mps``, ``yaw_rate_sd``
-        (rad/s), ``step_mean_cm``, ``motions``, ``poses``.
+        (rad/s), ``step_mean_cm``, ``motions``, ``poses`` (and ``pose_across_sd``).
     """
     f = np.asarray(frames, dtype=np.float64)
     p = np.asarray(positions, dtype=np.float64)
@@ -150,6 +171,9 @@ def variance_stats(frames: np.ndarray, positions: np.ndarray, num_frames: np.nda
     root = p[:, :, ROOT_JOINT, :][..., [0, 2]]
     last = root[np.arange(n), n_valid - 1]
     step = np.linalg.norm(last - root[:, 0], axis=-1)
-    return {"pose_sd": float(pose_sd * 100.0), "v_sd": float(v_sd), "step_sd": float(step.std(ddof=1) * 100.0),
-            "speed_mean_mps": float(v.mean()), "yaw_rate_sd": float(w.std(ddof=1)),
-            "step_mean_cm": float(step.mean() * 100.0), "motions": int(n), "poses": int(len(poses))}
+    stats = {"pose_sd": float(pose_sd * 100.0), "v_sd": float(v_sd), "step_sd": float(step.std(ddof=1) * 100.0),
+             "speed_mean_mps": float(v.mean()), "yaw_rate_sd": float(w.std(ddof=1)),
+             "step_mean_cm": float(step.mean() * 100.0), "motions": int(n), "poses": int(len(poses))}
+    if normalized_frames is not None:
+        stats["pose_across_sd"] = across_sample_sd(normalized_frames)
+    return stats

@@ -16,7 +16,13 @@ from stylemotion.evaluation.metrics import (
     pose_sequences,
 )
 from stylemotion.evaluation.sources import motions_from_clips
-from stylemotion.evaluation.tables import diagonal_minima, distance_table, mean_motion, variance_stats
+from stylemotion.evaluation.tables import (
+    across_sample_sd,
+    diagonal_minima,
+    distance_table,
+    mean_motion,
+    variance_stats,
+)
 from stylemotion.models.style import gram
 from stylemotion.primitives import segment_takes
 from stylemotion.representation import frames_to_positions
@@ -101,6 +107,23 @@ def test_variance_stats_of_constructed_motions() -> None:
     w = np.array([0.0, 0.0, 0.5, -0.5])
     assert variance_stats(frames, positions, frames_n)["v_sd"] == pytest.approx(
         np.sqrt((((speeds - speeds.mean()) ** 2).sum() + ((w - w.mean()) ** 2).sum()) / 3))
+
+
+def test_across_sample_sd_sees_copies_that_pose_sd_misses() -> None:
+    """Copies of one moving motion: pose_SD is high (the motion within the step), pose_across_SD is 0;
+    two motions 2 cm apart on every coordinate: sqrt(63 · (0.01 m)²) = 7.94 cm."""
+    t = np.linspace(0, 2 * np.pi, 17)
+    one = np.zeros((17, 66))
+    one[:, :63] = 0.1 * np.sin(t)[:, None] * np.linspace(0.5, 1.5, 63)[None, :]  # every joint moves
+    copies = np.repeat(one[None], 50, axis=0)
+    positions = frames_to_positions(copies, 30.0)
+    stats = variance_stats(copies, positions, np.full(50, 17), copies)
+    assert stats["pose_sd"] > 5.0 and stats["pose_across_sd"] == pytest.approx(0.0, abs=1e-9)
+    shifted = np.stack([one, one])
+    shifted[1, :, :63] += 0.02
+    assert across_sample_sd(shifted) == pytest.approx(100 * np.sqrt(63 * 0.01 ** 2))
+    with pytest.raises(ValueError, match="normalized frames"):
+        across_sample_sd(one[None])
 
 
 @pytest.fixture(scope="module")

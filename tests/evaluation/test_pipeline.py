@@ -25,6 +25,7 @@ from stylemotion.evaluation.sources import (
     RealClipSource,
     SampleSource,
 )
+from stylemotion.evaluation.tables import variance_stats
 from stylemotion.io.outputs import OutputExistsError
 from stylemotion.models.checkpoints import autoencoder_info, load_autoencoder
 
@@ -106,11 +107,14 @@ def test_report_folder_is_complete_and_never_overwritten_silently(results, tmp_p
     for p in PRIMITIVES:
         assert {f"table_5_1_{p}.csv", f"table_5_1_{p}.png", f"variance_{p}.csv",
                 f"classifier_confusion_{p}.png"} <= names
-    assert {"report.md", "report.json", "variance.png", "style_recognition.csv", "foot_skating.csv"} <= names
+    assert {"report.md", "report.json", "variance.png", "style_recognition.csv", "foot_skating.csv",
+            "variation_vs_style.csv"} <= names
     saved = json.loads((out / "report.json").read_text())
     t = saved["table_5_1"]["walk_leftStance"]
     assert len(t["distance"]) == len(t["models"]) == len(t["examples"]) == 3
-    assert set(saved["variance"]["walk_rightStance"]["elderly"]) >= {"pose_sd", "v_sd", "step_sd"}
+    assert set(saved["variance"]["walk_rightStance"]["elderly"]) >= {"pose_sd", "v_sd", "step_sd", "pose_across_sd"}
+    assert set(saved["variation_vs_style"]["walk_rightStance"]["elderly"]) == {"style", "pose_across_sd", "v_sd",
+                                                                               "step_sd", "diversity"}
     assert {"classifier_heldout_accuracy", "per_model"} <= set(saved["style_recognition"])
     assert isinstance(saved["frechet"]["walk_leftStance"]["youthful"], float)
     assert isinstance(saved["foot_skating"]["neutral"], float)
@@ -118,7 +122,8 @@ def test_report_folder_is_complete_and_never_overwritten_silently(results, tmp_p
     assert {"data_name", "seed", "samples", "checkpoints", "git_commit", "seconds"} <= set(saved["meta"])
     md = (out / "report.md").read_text()
     for heading in ("## Against the thesis", "## Table 5.1", "## Tables 5.2/5.3", "## Style recognition",
-                    "## Foot skating", "## Nearest training clip", "## Definitions", "pose_SD in cm"):
+                    "## Foot skating", "## Nearest training clip", "## Definitions", "pose_SD in cm",
+                    "## Variation across samples", "**pose_across_sd**"):
         assert heading in md
     (out / "notes.txt").write_text("keep me")
     with pytest.raises(OutputExistsError, match="already exists"):
@@ -184,3 +189,20 @@ def test_real_variance_leaves_out_a_style_without_clips_of_the_primitive():
     variance = real_variance(real)
     assert set(variance.real) == set(data.styles)
     assert variance.ratio["training_data"] == {"pose_sd": 1.0, "v_sd": 1.0, "step_sd": 1.0}
+
+
+def test_variation_against_the_style_is_near_one_for_real_clips_and_zero_for_a_copy(results) -> None:
+    """The oracle models draw real clips of their style: their across-sample variation and diversity are
+    about their style's own; a source that repeats one clip has none (while its pose_SD stays high)."""
+    for primitive in PRIMITIVES:
+        rows = results["variation_vs_style"][primitive]
+        assert set(rows) == {"neutral", "elderly", "youthful"}
+        for name, r in rows.items():
+            assert r["style"] == ("normal" if name == "neutral" else name)
+            assert 0.75 < r["pose_across_sd"] < 1.25 and 0.75 < r["diversity"] < 1.25, (primitive, name, r)
+    data = primitive_data(tiny_takeset(), "walk_leftStance", 16, split=TINY_DATA["split"])
+    copy = RealClipSource(data.style_clips("elderly")[:1], 16).sample(200, seed=0)
+    stats = variance_stats(copy.frames.numpy(), copy.positions.numpy(), copy.num_frames.numpy(),
+                           copy.normalized_frames.numpy())
+    real = results["variance_real"]["walk_leftStance"]["elderly"]
+    assert stats["pose_across_sd"] == pytest.approx(0.0, abs=1e-9) and stats["pose_sd"] > 0.5 * real["pose_sd"]
