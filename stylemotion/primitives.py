@@ -283,6 +283,12 @@ def rest_runs(positions: np.ndarray, contacts: np.ndarray, fps: float, settings:
     return [(a, b) for a, b in _runs(still) if b - a >= min_len]
 
 
+def segment_action(takes: Iterable[Take], action: str, settings: SegmentSettings | None = None) -> Segmentation:
+    """The takes whose content is of ``action`` (:func:`action_of`), segmented (:func:`segment_takes`)."""
+    settings = settings or SegmentSettings()
+    return segment_takes([t for t in takes if action_of(t.content, settings.actions) == action], settings)
+
+
 def segment_take(take: Take, settings: SegmentSettings | None = None) -> TakeSegmentation:
     """Cut one walk or run take into primitive clips (see the module docstring).
 

@@ -1,6 +1,6 @@
-"""Lightning DataModules over datasets, and normalization."""
+"""Lightning DataModules over datasets, and the normalization statistics of their frames."""
 
-from stylemotion.datamodules.normalization import Normalizer, channel_stats
+from stylemotion.datamodules.normalization import channel_stats
 from stylemotion.datamodules.windows import (
     REPRESENTATION,
     EmptySplitError,
@@ -9,5 +9,5 @@ from stylemotion.datamodules.windows import (
     window_starts,
 )
 
-__all__ = ["REPRESENTATION", "EmptySplitError", "MotionWindowDataModule", "Normalizer", "WindowDataset",
+__all__ = ["REPRESENTATION", "EmptySplitError", "MotionWindowDataModule", "WindowDataset",
            "channel_stats", "window_starts"]

@@ -46,9 +46,8 @@ from stylemotion.primitives import (
     Clip,
     Segmentation,
     SegmentSettings,
-    action_of,
     check_primitive,
-    segment_takes,
+    segment_action,
     time_normalize,
 )
 from stylemotion.representation import FRAME_DIM
@@ -191,8 +190,7 @@ class ClipDataModule(SplitDataModule):
         if self._given_segmentation is not None:
             self.segmentation = self._given_segmentation
         else:
-            takes = [t for t in takeset.takes if action_of(t.content, self.segment_settings.actions) == self.action]
-            self.segmentation = segment_takes(takes, self.segment_settings)
+            self.segmentation = segment_action(takeset.takes, self.action, self.segment_settings)
         for part, members in takeset.split(**self.split_cfg).items():
             for take in members:
                 self.split_of[take.name] = part

@@ -1,5 +1,5 @@
-"""Per-channel z-score statistics of 66-dim frames; the module that applies them (and carries them in
-checkpoints as buffers), :class:`~stylemotion.models.normalization.Normalizer`, is re-exported here.
+"""Per-channel z-score statistics of 66-dim frames (the module that applies them and carries them in
+checkpoints as buffers is :class:`stylemotion.models.normalization.Normalizer`).
 
 Statistics come from the training split only (:func:`channel_stats`); a channel whose standard
 deviation is below ``std_floor`` (e.g. the Hips' x and z, which are 0 by construction in the
@@ -12,9 +12,7 @@ from collections.abc import Iterable
 
 import numpy as np
 
-from stylemotion.models.normalization import Normalizer
-
-__all__ = ["DEFAULT_STD_FLOOR", "Normalizer", "channel_stats"]
+__all__ = ["DEFAULT_STD_FLOOR", "channel_stats"]
 
 #: Smallest standard deviation used for a channel (in the channel's own unit: m, m/s or rad/s).
 DEFAULT_STD_FLOOR = 1e-3

@@ -46,7 +46,7 @@ from stylemotion.evaluation.metrics import (
     pooled_skating,
     pose_sequences,
 )
-from stylemotion.evaluation.reference import PrimitiveData, primitive_data, segment_action
+from stylemotion.evaluation.reference import PrimitiveData, primitive_data
 from stylemotion.evaluation.settings import EvalSettings
 from stylemotion.evaluation.sources import (
     NEUTRAL,
@@ -58,7 +58,7 @@ from stylemotion.evaluation.sources import (
 from stylemotion.evaluation.tables import diagonal_minima, distance_table, example_gram, mean_motion, variance_stats
 from stylemotion.models.autoencoder import local_mpjpe, mpjpe
 from stylemotion.models.style import mean_gram
-from stylemotion.primitives import Segmentation, parse_primitive
+from stylemotion.primitives import Segmentation, parse_primitive, segment_action
 from stylemotion.sampling import MotionSamples
 
 log = logging.getLogger(__name__)
@@ -120,7 +120,7 @@ def evaluate_models(models: Sequence[EvalModel], takeset: TakeSet, autoencoder, 
     for primitive in sorted(by_primitive):
         action = parse_primitive(primitive)[0]
         if action not in segmentations:
-            segmentations[action] = segment_action(takeset, action, _segment_values(settings))
+            segmentations[action] = segment_action(takeset.takes, action, settings.segment)
         out = _evaluate_primitive(primitive, by_primitive[primitive], takeset, autoencoder, settings, split, say,
                                   segmentations[action])
         for key in results:
@@ -248,7 +248,7 @@ def real_side(primitive: str, models: Sequence[EvalModel], takeset: TakeSet, set
     """Split the (segmented) data for ``primitive``, fit the style classifier, gather the ground truths.
 
     ``segmentation``: the primitive's action already segmented with ``settings.segment``
-    (:func:`~.reference.segment_action`), shared by the primitives of one evaluation; None segments here.
+    (:func:`stylemotion.primitives.segment_action`), shared by the primitives of one evaluation; None segments here.
 
     Raises:
         MissingExampleError: a model's style is not in the data, or its example clip is missing.
@@ -424,19 +424,20 @@ class StyleTable:
 
 def style_table(real: RealSide, autoencoder, model_frames: Sequence[np.ndarray], settings: EvalSettings) -> StyleTable:
     """Table 5.1 from each model's first ``samples.table_5_1`` normalized sample frames (in ``real.models`` order)."""
-    grams = torch.stack([_example_gram(autoencoder, real.data, m, real.examples[m.name]) for m in real.models])
+    grams = torch.stack([_example_gram(autoencoder, real, m) for m in real.models])
     table = distance_table(autoencoder, model_frames, grams, settings.gram_chunk)
     clips = {m.name: ("mean motion of the neutral training clips" if m.name == NEUTRAL
                       else [c.describe() for c in real.examples[m.name]]) for m in real.models}
     return StyleTable([m.name for m in real.models], table, settings.samples.table_5_1, clips)
 
 
-def _example_gram(autoencoder, data: PrimitiveData, model: EvalModel, clips: list) -> torch.Tensor:
+def _example_gram(autoencoder, real: RealSide, model: EvalModel) -> torch.Tensor:
+    """Gram of the model's column: its example clip(s), or the mean neutral training motion."""
     if model.name == NEUTRAL:
-        return example_gram(autoencoder, [mean_motion(motions_from_clips(data.training_data(),
-                                                                         data.length).normalized_frames.numpy())])
+        return example_gram(autoencoder, [mean_motion(real.training.normalized_frames.numpy())])
+    clips = real.examples[model.name]
     # encoded exactly as for training: resampled to the canonical length unless recorded "natural"
-    length = None if model.example_length == "natural" else int(model.examples[0].get("encoded_frames") or data.length)
+    length = None if model.example_length == "natural" else int(model.examples[0].get("encoded_frames") or real.length)
     g = mean_gram(encode_examples(autoencoder, clips, length)).float()
     if model.target_gram is not None:
         target = model.target_gram.float()

@@ -29,10 +29,8 @@ from stylemotion.primitives import (
     STANCE_FOOT,
     Clip,
     Segmentation,
-    SegmentSettings,
     action_of,
     parse_primitive,
-    segment_takes,
 )
 
 
@@ -118,8 +116,8 @@ def primitive_data(takeset: TakeSet, primitive: str, length: int, neutral_style:
         neutral_style: the neutral style label; must be a style of the data.
         segment: segmentation overrides (as for training).
         split: split settings (as for training; the data config's ``split``).
-        segmentation: the action's takes already segmented with ``segment`` (see
-            :func:`segment_action`); None segments them here.
+        segmentation: the action's takes already segmented with ``segment``
+            (:func:`stylemotion.primitives.segment_action`); None segments them here.
     """
     action, name = parse_primitive(primitive)
     module = ClipDataModule(takeset=takeset, action=action, primitives=[name], styles=None, timeline=int(length),
@@ -135,9 +133,3 @@ def primitive_data(takeset: TakeSet, primitive: str, length: int, neutral_style:
         raise ValueError(f"dataset {takeset.name!r} has no {action} take in the train split")
     rest = np.median(np.stack([foot_signals(t.positions, takeset.fps).rest_heights for t in takes]), axis=0)
     return PrimitiveData(primitive, int(length), float(takeset.fps), neutral_style, module, rest)
-
-
-def segment_action(takeset: TakeSet, action: str, segment: Mapping[str, Any] | None = None) -> Segmentation:
-    """The takes of ``action`` segmented once (to share between the primitives of one evaluation)."""
-    settings = SegmentSettings.from_dict(dict(segment or {}))
-    return segment_takes([t for t in takeset.takes if action_of(t.content, settings.actions) == action], settings)
