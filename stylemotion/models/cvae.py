@@ -38,6 +38,8 @@ from stylemotion.models.vae import PrimitiveVAE
 
 #: Which latent codes the style term decodes (see :class:`StyleCVAE`).
 STYLE_LATENTS = ("posterior", "prior", "both")
+#: How the style distance enters the loss (see :class:`StyleCVAE`).
+STYLE_TERMS = ("distance", "margin")
 
 
 class StyleCVAE(PrimitiveVAE):
@@ -50,19 +52,27 @@ class StyleCVAE(PrimitiveVAE):
         **kwargs: :class:`PrimitiveVAE` arguments.
     """
 
-    def __init__(self, style_weight: float = 5.0, style_latents: str = "both", **kwargs: Any):
+    def __init__(self, style_weight: float = 5.0, style_latents: str = "both", style_term: str = "distance",
+                 style_margin: float = 1.0, **kwargs: Any):
         super().__init__(**kwargs)
         if not style_weight >= 0:
             raise ValueError(f"style_weight must be ≥ 0, got {style_weight}")
         if style_latents not in STYLE_LATENTS:
             raise ValueError(f"style_latents must be one of {STYLE_LATENTS}, got {style_latents!r}")
+        if style_term not in STYLE_TERMS:
+            raise ValueError(f"style_term must be one of {STYLE_TERMS}, got {style_term!r}")
+        if not style_margin > 0:
+            raise ValueError(f"style_margin must be > 0, got {style_margin}")
         self.save_hyperparameters({**dict(self.hparams), "style_weight": float(style_weight),
-                                   "style_latents": str(style_latents)})
+                                   "style_latents": str(style_latents), "style_term": str(style_term),
+                                   "style_margin": float(style_margin)})
 
     def _build(self, spec: dict[str, Any]) -> None:
         super()._build(spec)
         channels = int(spec["feature_channels"])
         self.register_buffer("style_gram", torch.zeros(channels, channels))
+        #: median Gram distance of the content (neutral) training clips to their mean Gram
+        self.register_buffer("content_spread", torch.tensor(float("nan")))
 
     def _adapt_spec(self, spec: dict[str, Any]) -> dict[str, Any]:
         if not spec.get("style"):
@@ -81,6 +91,18 @@ class StyleCVAE(PrimitiveVAE):
         if not datamodule.style_features:
             raise ValueError(f"the datamodule has no style example for style {datamodule.style!r}")
         self.style_gram.copy_(mean_gram(datamodule.style_features))
+        self.content_spread.fill_(content_spread(datamodule.datasets["train"].features))
+
+    def on_load_checkpoint(self, checkpoint: dict[str, Any]) -> None:
+        super().on_load_checkpoint(checkpoint)
+        # checkpoints from before the margin term have no content_spread (their loss never used it)
+        checkpoint.get("state_dict", {}).setdefault("content_spread", torch.tensor(float("nan")))
+
+    @property
+    def style_radius(self) -> float:
+        """τ = ``style_margin`` × :attr:`content_spread`: the distance to the example under which the
+        margin term is zero (Gram units)."""
+        return float(self.hparams.style_margin * self.content_spread)
 
     @property
     def style(self) -> str:
@@ -109,4 +131,22 @@ class StyleCVAE(PrimitiveVAE):
             z = torch.randn(count, self.hparams.latent_dim, generator=generator, device=recon.device, dtype=recon.dtype)
             outputs.append(self.net.decode(z))
         features, _ = self.denormalize(torch.cat(outputs), clamp=False)
-        return {"style": (self.style_distance(features).mean(), self.hparams.style_weight)}
+        distance = self.style_distance(features)
+        terms = {"style": (distance.mean(), self.hparams.style_weight)}
+        if self.hparams.style_term == "margin":
+            terms["style"] = (distance.mean(), 0.0)  # logged, not optimized
+            terms["style_excess"] = (margin_excess(distance, self.style_radius), self.hparams.style_weight)
+        return terms
+
+
+def content_spread(features: torch.Tensor) -> float:
+    """Median Gram distance of feature sequences ``(n, C, T')`` to their mean Gram: how far the clips of
+    one style (the content data) typically sit from its centre, in Gram units."""
+    centre = mean_gram(list(features))
+    return float(feature_style_distance(features, centre).median())
+
+
+def margin_excess(distance: torch.Tensor, radius: float) -> torch.Tensor:
+    """``mean (max(0, d − τ) / τ)²``: the squared relative excess of style distances ``(n,)`` over the
+    radius τ — zero inside the ball, dimensionless (the same for any Gram scale)."""
+    return ((distance - radius).clamp_min(0) / radius).square().mean()
