@@ -53,7 +53,7 @@ from hydra import compose
 from omegaconf import DictConfig, OmegaConf, open_dict
 
 from stylemotion.config import positive_int, set_torch_threads  # also registers the configs' resolvers
-from stylemotion.datasets import build_dataset
+from stylemotion.datasets import build_dataset, data_config_key
 from stylemotion.evaluation.run import recorded_path, run_evaluation, summary_lines
 from stylemotion.io.atomic import atomic_write_bytes
 from stylemotion.io.outputs import inside, safe_name
@@ -190,7 +190,8 @@ class Reproduction:
         Returns None when the stage was reused, else whether it resumes from ``last.ckpt``.
         """
         parent_hash = stage.parent.settings_hash if stage.parent else None
-        stage.settings_hash = _hash({"overrides": stage.overrides, "values": stage.values, "data": self.data_cfg,
+        stage.settings_hash = _hash({"overrides": stage.overrides, "values": stage.values,
+                                     "data": data_config_key(self.data_cfg),
                                      "seed": int(self.cfg.seed), "parent": parent_hash})
         done, started = stage.folder / "done.json", stage.folder / "stage.json"
         last = stage.folder / "checkpoints" / "last.ckpt"

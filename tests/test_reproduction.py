@@ -253,6 +253,25 @@ def test_style_labels_cannot_place_a_stage_outside_the_run(tmp_path: Path) -> No
         repro.plan(["a/b", "a_b"])
 
 
+
+def test_a_null_retarget_keeps_the_stage_hashes_of_earlier_runs(tmp_path: Path) -> None:
+    """``data.retarget: null`` (the default) hashes like a data config written before the key existed, so
+    the finished stages of earlier runs stay valid; a style name is other data."""
+    with initialize_config_dir(config_dir=str(CONFIG_DIR), version_base="1.3"):
+        cfg = compose(config_name="reproduce", overrides=[f"out={tmp_path / 'run'}", "primitives=[walk_leftStance]"])
+    repro = Reproduction(cfg, say=lambda _: None)
+    repro.plan([])
+    stage = repro.stages[0]
+    hashes = {}
+    for retarget in ("absent", None, "normal"):
+        repro.data_cfg.pop("retarget", None)
+        if retarget != "absent":
+            repro.data_cfg["retarget"] = retarget
+        repro.prepare_stage(1, stage)
+        hashes[retarget] = stage.settings_hash
+    assert hashes[None] == hashes["absent"] != hashes["normal"]
+    assert cfg.data.retarget is None
+
 def write_user_configs(folder: Path) -> Path:
     """A user's config folder holding ``data/mine.yaml``: a BVH folder with labels from file names, and
     no ``budget/mine.yaml``."""

@@ -2,7 +2,7 @@
 
 from stylemotion.datasets.base import Take, TakeSet
 from stylemotion.datasets.loading import ConversionSettings, DatasetBuildError
-from stylemotion.datasets.registry import DATASETS, build_dataset, load_dataset, register_dataset
+from stylemotion.datasets.registry import DATASETS, build_dataset, data_config_key, load_dataset, register_dataset
 
 __all__ = ["DATASETS", "ConversionSettings", "DatasetBuildError", "Take", "TakeSet", "build_dataset",
-           "load_dataset", "register_dataset"]
+           "data_config_key", "load_dataset", "register_dataset"]

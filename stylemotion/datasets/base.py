@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from functools import cached_property
+from typing import Any
 
 import numpy as np
 
@@ -62,6 +63,8 @@ class TakeSet:
         fps: the common frame rate of all takes.
         skipped: ``[(source, reason)]`` for inputs that were skipped (only with skip_broken).
         warnings: messages about inputs that loaded but look wrong (each names its file).
+        retarget: None when every take keeps its own bones; else the skeleton all takes were put
+            on (``style``, ``takes``, ``bone_lengths_m``; see :mod:`stylemotion.datasets.retarget`).
     """
 
     name: str
@@ -69,6 +72,7 @@ class TakeSet:
     fps: float
     skipped: list[tuple[str, str]] = field(default_factory=list)
     warnings: list[str] = field(default_factory=list)
+    retarget: dict[str, Any] | None = None
 
     def __len__(self) -> int:
         return len(self.takes)

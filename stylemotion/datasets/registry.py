@@ -10,6 +10,7 @@ from stylemotion.datasets.bandai import load_bandai
 from stylemotion.datasets.base import Take, TakeSet
 from stylemotion.datasets.bvh_folder import load_bvh_folder
 from stylemotion.datasets.loading import ConversionSettings
+from stylemotion.datasets.retarget import check_retarget, retarget_takeset
 
 DatasetLoader = Callable[..., TakeSet]
 DATASETS: dict[str, DatasetLoader] = {}
@@ -18,6 +19,11 @@ DATASETS: dict[str, DatasetLoader] = {}
 _CONVERSION_KEYS = ("fps", "joint_map", "unit_scale", "up_axis", "max_file_mb", "max_frames", "max_joint_frames")
 #: Keys of a data config used by the data modules, not by the loaders.
 _MODULE_KEYS = ("name", "split")
+#: Keys of a data config applied here to every dataset kind, after its loader.
+_TAKESET_KEYS = ("retarget",)
+#: Keys added after run records began hashing data configs, whose null is the behaviour from
+#: before they existed: a null one is left out of :func:`data_config_key`.
+_NULL_IS_ABSENT = ("retarget",)
 
 
 def register_dataset(name: str) -> Callable[[DatasetLoader], DatasetLoader]:
@@ -55,20 +61,24 @@ def load_dataset(name: str, **options: Any) -> TakeSet:
     Conversion keys (``fps``, ``joint_map``, ``unit_scale``, ``up_axis`` and the limits
     ``max_file_mb``, ``max_frames``, ``max_joint_frames``) are gathered into a
     :class:`ConversionSettings` for the loaders that convert files; a bad value is a ValueError
-    naming its ``data.`` key.
+    naming its ``data.`` key. ``retarget`` (a style name or None) is applied here, to every
+    dataset kind, after the loader (:func:`stylemotion.datasets.retarget.retarget_takeset`), so
+    the converted takes and their cache do not depend on it.
     """
     if name not in DATASETS:
         raise KeyError(f"unknown dataset {name!r}; registered: {sorted(DATASETS)}")
     loader = DATASETS[name]
     params = inspect.signature(loader).parameters
+    retarget = check_retarget(options.pop("retarget", None))
     if "settings" in params:
         conv = {k: options.pop(k) for k in _CONVERSION_KEYS if k in options}
         options["settings"] = ConversionSettings(**conv)
     unknown = sorted(set(options) - set(params))
     if unknown:
-        valid = sorted(set(params) - {"settings"} | (set(_CONVERSION_KEYS) if "settings" in params else set()))
+        valid = sorted(set(params) - {"settings"} | set(_TAKESET_KEYS)
+                       | (set(_CONVERSION_KEYS) if "settings" in params else set()))
         raise KeyError(f"dataset {name!r} has no option(s) {unknown}; valid options: {valid}")
-    return loader(**options)
+    return retarget_takeset(loader(**options), retarget)
 
 
 def build_dataset(cfg: Mapping[str, Any]) -> TakeSet:
@@ -77,6 +87,12 @@ def build_dataset(cfg: Mapping[str, Any]) -> TakeSet:
     if "name" not in cfg:
         raise KeyError(f"data config needs a 'name' (one of {sorted(DATASETS)})")
     return load_dataset(str(cfg["name"]), **options)
+
+
+def data_config_key(cfg: Mapping[str, Any]) -> dict[str, Any]:
+    """``cfg`` (a ``data`` config node) as run records hash it: null keys of :data:`_NULL_IS_ABSENT`
+    left out, so a config that names them as null hashes like one written before they existed."""
+    return {k: _plain(v) for k, v in dict(cfg).items() if not (k in _NULL_IS_ABSENT and v is None)}
 
 
 def _plain(value: Any) -> Any:

@@ -13,7 +13,8 @@ from stylemotion.io.atomic import atomic_write_bytes
 
 
 def dataset_summary(takeset: TakeSet, split: dict[str, list[Take]] | None = None) -> dict[str, Any]:
-    """Counts of takes and frames per content × style, split sizes, skipped inputs and warnings."""
+    """Counts of takes and frames per content × style, split sizes, skipped inputs, warnings and the
+    skeleton the takes were retargeted to (``retarget``: None when each keeps its own bones)."""
     takes = Counter((t.content, t.style) for t in takeset.takes)
     frames: Counter[tuple[str, str]] = Counter()
     for t in takeset.takes:
@@ -30,6 +31,7 @@ def dataset_summary(takeset: TakeSet, split: dict[str, list[Take]] | None = None
         ],
         "skipped": [{"source": src, "reason": why} for src, why in takeset.skipped],
         "warnings": list(takeset.warnings),
+        "retarget": takeset.retarget,
     }
     if split is not None:
         summary["split"] = {part: {"takes": len(ts), "frames": sum(t.num_frames for t in ts)}
@@ -44,6 +46,11 @@ def format_summary(summary: dict[str, Any]) -> str:
     lines.append(f"  {'content':<20} {'style':<12} {'takes':>6} {'frames':>8}")
     for row in summary["per_content_style"]:
         lines.append(f"  {row['content']:<20} {row['style']:<12} {row['takes']:>6} {row['frames']:>8}")
+    target = summary.get("retarget")
+    if target:
+        bones = target["bone_lengths_m"]
+        lines.append(f"  retargeted: every take on the median bones of the {target['takes']} {target['style']!r} "
+                     f"takes (left thigh {bones['LowerLeg_L']:.3f} m, shin {bones['Foot_L']:.3f} m)")
     for part, info in summary.get("split", {}).items():
         lines.append(f"  split {part:<5}: {info['takes']} takes, {info['frames']} frames")
     if summary["skipped"]:

@@ -6,7 +6,9 @@ import json
 
 import numpy as np
 
+from stylemotion.datasets import load_dataset
 from stylemotion.datasets.base import Take, TakeSet
+from stylemotion.datasets.retarget import retarget_takeset
 from stylemotion.datasets.summary import dataset_summary, format_summary, write_dataset_summary
 
 
@@ -26,6 +28,18 @@ def test_summary_counts_and_lists_skipped_and_warnings():
     text = format_summary(summary)
     assert "skipped 1 broken input(s)" in text and "bad.bvh:3: no HIERARCHY" in text
     assert "1 input(s) loaded but look wrong" in text and "odd.bvh" in text
+    assert summary["retarget"] is None and "retargeted" not in text
+
+
+def test_summary_records_the_skeleton_the_takes_were_retargeted_to():
+    retargeted = retarget_takeset(load_dataset("synthetic", takes_per_pair=1, duration_s=1.0, contents=["walk"]),
+                                  "elderly")
+    summary = dataset_summary(retargeted)
+    assert summary["retarget"] == retargeted.retarget and summary["retarget"]["style"] == "elderly"
+    assert summary["retarget"]["takes"] == 1 and len(summary["retarget"]["bone_lengths_m"]) == 20
+    thigh = summary["retarget"]["bone_lengths_m"]["LowerLeg_L"]
+    assert f"retargeted: every take on the median bones of the 1 'elderly' takes (left thigh {thigh:.3f} m" \
+        in format_summary(summary)
 
 
 def test_write_dataset_summary_of_the_synthetic_data(tmp_path, monkeypatch):

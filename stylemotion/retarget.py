@@ -1,0 +1,167 @@
+"""Put a motion on other bone lengths: every bone keeps its direction, takes the target length.
+
+Thesis §5.2 retargets all data to one skeleton, so that neither a model nor a classifier can tell
+recordings apart by body proportions. This module is that transform on canonical positions:
+
+* ``positions``: ``(frames, 21, 3)`` global canonical joint positions, metres, Y up
+  (:data:`stylemotion.skeleton.CANONICAL_JOINTS` order);
+* bone lengths: ``(20,)`` metres, one per non-root joint (the bone from its parent to it), in
+  :data:`BONE_NAMES` order (the canonical order without Hips).
+
+The tree walk is the one FK (:func:`stylemotion.skeleton.forward_kinematics`) with identity
+rotations and each bone's new global vector as its translation. The root (Hips) trajectory is
+scaled by the ratio of target to source leg length (:func:`leg_length`), so stride relative to leg
+length, and with it the feet planted on the ground, stays plausible; the ground (the lowest height
+of any foot point over the take) stays at its level.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+
+import numpy as np
+
+from stylemotion.contacts import FOOT_POINTS
+from stylemotion.ik import MIN_BONE_LENGTH
+from stylemotion.skeleton import CANONICAL_JOINTS, CANONICAL_PARENTS, JOINT_INDEX, bone_lengths, forward_kinematics
+
+#: Canonical index of the child joint of each bone, i.e. every joint but the root (20).
+BONE_JOINTS: tuple[int, ...] = tuple(j for j, p in enumerate(CANONICAL_PARENTS) if p >= 0)
+#: Each bone named by its child joint (``"LowerLeg_L"`` is the thigh, from the hip joint ``UpperLeg_L``).
+BONE_NAMES: tuple[str, ...] = tuple(CANONICAL_JOINTS[j] for j in BONE_JOINTS)
+#: Number of bones of the canonical skeleton (20).
+NUM_BONES = len(BONE_JOINTS)
+#: Bone indices (into :data:`BONE_NAMES`) of the thigh and the shin of each leg: the hip-to-ankle
+#: chain of :func:`stylemotion.contacts.leg_length`.
+_LEG_BONES = {side: (BONE_NAMES.index(f"LowerLeg_{side}"), BONE_NAMES.index(f"Foot_{side}")) for side in "LR"}
+_ROOT = JOINT_INDEX["Hips"]
+
+
+def median_bone_lengths(positions: np.ndarray) -> np.ndarray:
+    """Each bone's median length over frames.
+
+    Args:
+        positions: ``(..., frames, 21, 3)`` canonical positions, metres.
+
+    Returns:
+        ``(..., 20)`` float64 bone lengths in :data:`BONE_NAMES` order, metres.
+    """
+    positions = np.asarray(positions, dtype=np.float64)
+    return np.median(bone_lengths(positions)[..., list(BONE_JOINTS)], axis=-2)
+
+
+def target_bone_lengths(takes: Iterable[np.ndarray]) -> np.ndarray:
+    """One skeleton for several takes: per bone, the median over takes of each take's median length.
+
+    Args:
+        takes: each ``(frames, 21, 3)`` canonical positions, metres.
+
+    Returns:
+        ``(20,)`` float64 bone lengths, metres.
+
+    Raises:
+        ValueError: no takes.
+    """
+    per_take = [median_bone_lengths(p) for p in takes]
+    if not per_take:
+        raise ValueError("target_bone_lengths needs at least one take")
+    return np.median(np.stack(per_take), axis=0)
+
+
+def leg_length(lengths: np.ndarray) -> np.ndarray:
+    """Hip-to-ankle length (thigh + shin, mean of both legs) of a skeleton given by its bones.
+
+    The same chain as :func:`stylemotion.contacts.leg_length`, from bone lengths instead of positions.
+
+    Args:
+        lengths: ``(..., 20)`` bone lengths, metres.
+
+    Returns:
+        ``(...)`` leg length, metres.
+    """
+    lengths = np.asarray(lengths, dtype=np.float64)
+    return sum(lengths[..., thigh] + lengths[..., shin] for thigh, shin in _LEG_BONES.values()) / 2.0
+
+
+def retarget_positions(positions: np.ndarray, target_lengths: np.ndarray) -> np.ndarray:
+    """``positions`` on a skeleton with bone lengths ``target_lengths``.
+
+    Every bone keeps its direction in every frame and gets its target length; the joints are
+    placed from the root outwards. The root's horizontal path (relative to its first frame) and its
+    height are scaled by ``leg_length(target) / leg_length(source)`` (source: the take's median
+    bone lengths); then the whole take is shifted vertically so that its ground, the lowest height
+    of any foot point (``Foot_*``, ``Toes_*``) over all frames, is where it was.
+
+    Args:
+        positions: ``(frames, 21, 3)`` canonical positions, metres, Y up.
+        target_lengths: ``(20,)`` bone lengths in :data:`BONE_NAMES` order, metres.
+
+    Returns:
+        ``(frames, 21, 3)`` positions, metres, in the dtype of ``positions`` (float64 for integers).
+
+    Raises:
+        ValueError: bad shapes or values (naming the argument), a source bone of zero length
+            (< :data:`stylemotion.ik.MIN_BONE_LENGTH`) whose target is not zero (naming the bone and
+            frame), or a zero leg length.
+    """
+    source = _check_positions(positions)
+    target = _check_lengths(target_lengths)
+    children, parents = list(BONE_JOINTS), [CANONICAL_PARENTS[j] for j in BONE_JOINTS]
+    vectors = source[:, children] - source[:, parents]  # (frames, 20, 3)
+    lengths = bone_lengths(source)[:, children]  # (frames, 20)
+    short = lengths < MIN_BONE_LENGTH
+    lost = short & (target >= MIN_BONE_LENGTH)
+    if lost.any():
+        frame, bone = (int(i) for i in np.argwhere(lost)[0])
+        raise ValueError(f"positions: bone {BONE_NAMES[bone]!r} has zero length (< {MIN_BONE_LENGTH} m) in "
+                         f"{int(lost[:, bone].sum())} frame(s), first at frame {frame}, so it has no direction "
+                         f"to give the target length {target[bone]:.4g} m")
+    directions = np.where(short[..., None], 0.0, vectors / np.where(short, 1.0, lengths)[..., None])
+
+    source_leg = float(leg_length(np.median(lengths, axis=0)))
+    if source_leg < MIN_BONE_LENGTH:
+        raise ValueError(f"positions: the leg (thigh + shin) has zero length ({source_leg:.3g} m); cannot scale "
+                         "the root's path")
+    ratio = float(leg_length(target)) / source_leg
+    root = source[:, _ROOT]
+    start = root[0] * np.array([1.0, 0.0, 1.0])  # the first frame's ground point stays put
+    translations = np.zeros_like(source)
+    translations[:, _ROOT] = start + ratio * (root - start)
+    translations[:, children] = directions * target[:, None]
+    result = forward_kinematics(np.broadcast_to(np.eye(3), (len(CANONICAL_JOINTS), 3, 3)), translations,
+                                CANONICAL_PARENTS)
+    feet = list(FOOT_POINTS.ravel())
+    result[..., 1] += source[:, feet, 1].min() - result[:, feet, 1].min()
+    dtype = np.asarray(positions).dtype
+    return result.astype(dtype if np.issubdtype(dtype, np.floating) else np.float64)
+
+
+def _check_positions(positions: np.ndarray) -> np.ndarray:
+    """``positions`` as float64 ``(frames, 21, 3)``; ValueError naming what is wrong."""
+    array = np.asarray(positions)
+    if array.ndim != 3 or array.shape[1:] != (len(CANONICAL_JOINTS), 3) or array.shape[0] < 1:
+        raise ValueError(f"positions must have shape (frames, {len(CANONICAL_JOINTS)}, 3) with at least one "
+                         f"frame, got {array.shape}")
+    if not np.issubdtype(array.dtype, np.number):
+        raise ValueError(f"positions must be numbers, got dtype {array.dtype}")
+    array = array.astype(np.float64)
+    if not np.all(np.isfinite(array)):
+        frame, joint, _ = (int(i) for i in np.argwhere(~np.isfinite(array))[0])
+        raise ValueError(f"positions hold NaN or infinite values, first at frame {frame}, joint "
+                         f"{CANONICAL_JOINTS[joint]!r}")
+    return array
+
+
+def _check_lengths(target_lengths: np.ndarray) -> np.ndarray:
+    """``target_lengths`` as float64 ``(20,)``, finite and ≥ 0; ValueError naming what is wrong."""
+    lengths = np.asarray(target_lengths)
+    if lengths.shape != (NUM_BONES,) or not np.issubdtype(lengths.dtype, np.number):
+        raise ValueError(f"target_lengths must be {NUM_BONES} numbers (metres, bones {list(BONE_NAMES)}), got "
+                         f"shape {lengths.shape} dtype {lengths.dtype}")
+    lengths = lengths.astype(np.float64)
+    bad = ~np.isfinite(lengths) | (lengths < 0)
+    if bad.any():
+        bone = int(np.argmax(bad))
+        raise ValueError(f"target_lengths must be finite and ≥ 0 metres; bone {BONE_NAMES[bone]!r} has "
+                         f"{float(lengths[bone])!r}")
+    return lengths
