@@ -26,7 +26,8 @@ even if another one fails. A stage that finished writes
 the stage it builds on); a rerun **reuses** it, and a stage interrupted mid-training **resumes**
 from its ``checkpoints/last.ckpt``. A stage whose recorded settings differ from the current ones
 stops the run with an error (choose another ``out`` or delete that stage's folder) — results are
-never overwritten silently. ``reproduce.json`` under ``out`` summarizes the stages.
+never overwritten silently. ``reproduce.json`` under ``out`` summarizes the stages (each with the Hydra
+overrides and values it was composed from, which ``stylemotion-style`` trains a new style with).
 
 Training lengths come from ``configs/budget/<data config name>.yaml``, or from
 ``budget/default.yaml`` (Bandai's) for data without a budget of its own; the first line says which.
@@ -283,19 +284,8 @@ class Reproduction:
 
     def train_config(self, stage: Stage, resume: bool) -> DictConfig:
         """The ``train`` config of ``stage``: its overrides, this run's data, seed, threads and folder."""
-        cfg = compose(config_name="train", overrides=list(stage.overrides))
-        with open_dict(cfg):
-            cfg.data = OmegaConf.create(self.data_cfg)
-            cfg.output_dir = str(stage.folder.resolve())
-            cfg.seed = int(self.cfg.seed)
-            if self.cfg.get("threads") is not None:
-                cfg.threads = positive_int(self.cfg.threads, "threads")
-            for key, value in stage.values.items():
-                OmegaConf.update(cfg, key, value, force_add=True)
-            if stage.parent is not None:
-                cfg.autoencoder_ckpt = stage.parent.checkpoint
-            cfg.ckpt_path = "auto"  # resumes from last.ckpt exactly when there is one (``resume``)
-        return cfg
+        return stage_train_config(stage.overrides, stage.values, self.data_cfg, stage.folder, int(self.cfg.seed),
+                                  self.cfg.get("threads"), stage.parent.checkpoint if stage.parent else None)
 
     def evaluation_stage(self) -> dict[str, Any]:
         """Evaluate every trained model into ``<out>/report`` (or reuse the report of the same stages)."""
@@ -332,12 +322,36 @@ class Reproduction:
         return str(Path(path) if Path(path).is_absolute() else (self.out / path).resolve())
 
     def summary(self) -> dict[str, Any]:
-        """What ``reproduce.json`` holds; paths inside ``out`` are relative to it."""
+        """What ``reproduce.json`` holds; paths inside ``out`` are relative to it. Each stage records the
+        Hydra overrides and values it was trained with (``stylemotion-style`` trains new styles with them)."""
         return {"out": str(self.out), "provenance": self.provenance, "data": self.data_summary,
                 "seconds": time.perf_counter() - self.started,
                 "stages": [{"name": s.name, "kind": s.kind, "status": s.status,
                             "checkpoint": self.recorded(s.checkpoint), "seconds": s.seconds, "metrics": s.metrics,
-                            "folder": self.recorded(s.folder)} for s in self.stages]}
+                            "folder": self.recorded(s.folder), "overrides": list(s.overrides),
+                            "values": dict(s.values)} for s in self.stages]}
+
+
+def stage_train_config(overrides: Sequence[str], values: dict[str, Any], data_cfg: dict[str, Any], folder: Path,
+                       seed: int, threads: Any = None, autoencoder_ckpt: str | None = None) -> DictConfig:
+    """The ``train`` config of a training stage: its Hydra ``overrides`` (as ``reproduce.json`` records
+    them), then the run's ``data`` node, ``seed``, ``threads``, the output ``folder``, the stage's
+    ``values`` (primitive, style) and the autoencoder it builds on; ``ckpt_path=auto`` (resumes from
+    ``last.ckpt`` exactly when there is one). Needs Hydra's config search initialized (see :func:`reproduce`).
+    """
+    cfg = compose(config_name="train", overrides=list(overrides))
+    with open_dict(cfg):
+        cfg.data = OmegaConf.create(data_cfg)
+        cfg.output_dir = str(Path(folder).resolve())
+        cfg.seed = int(seed)
+        if threads is not None:
+            cfg.threads = positive_int(threads, "threads")
+        for key, value in values.items():
+            OmegaConf.update(cfg, key, value, force_add=True)
+        if autoencoder_ckpt is not None:
+            cfg.autoencoder_ckpt = autoencoder_ckpt
+        cfg.ckpt_path = "auto"
+    return cfg
 
 
 def _train_in_worker(container: dict[str, Any]) -> tuple[dict[str, Any], float]:

@@ -20,7 +20,7 @@ from __future__ import annotations
 import json
 import logging
 import math
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from datetime import datetime
 from pathlib import Path
 from typing import Any
@@ -170,13 +170,20 @@ def _instantiate_all(node: DictConfig | None) -> list[Any]:
     return [instantiate(v, _convert_="all") for v in node.values() if v is not None and "_target_" in v]
 
 
-def build(cfg: DictConfig) -> tuple[pl.LightningDataModule, pl.LightningModule]:
+def build(cfg: DictConfig, datamodule_args: Mapping[str, Any] | None = None
+          ) -> tuple[pl.LightningDataModule, pl.LightningModule]:
     """The DataModule (``cfg.datamodule`` given ``data=cfg.data``) and the LightningModule ``cfg.model``.
 
-    Both receive plain Python values only, so their hyperparameters are checkpoint-safe.
+    Both receive plain Python values from the config, so their hyperparameters are checkpoint-safe.
+    ``datamodule_args``: further DataModule arguments that are Python objects rather than config values
+    (e.g. the user's example clips of ``stylemotion-style``); passed as they are, never through OmegaConf.
     """
     data_cfg = OmegaConf.to_container(cfg.data, resolve=True)
-    datamodule = instantiate(cfg.datamodule, data=data_cfg, _convert_="all")
+    if datamodule_args:
+        factory = instantiate(cfg.datamodule, data=data_cfg, _convert_="all", _partial_=True)
+        datamodule = factory(**datamodule_args)
+    else:
+        datamodule = instantiate(cfg.datamodule, data=data_cfg, _convert_="all")
     model = instantiate(cfg.model, _convert_="all")
     return datamodule, model
 
@@ -214,9 +221,11 @@ class HyperparametersWithMetric(pl.Callback):
                 logger.log_hyperparams(self.params, metrics={f"hp/{self.monitor}": float(_plain(value))})
 
 
-def run(cfg: DictConfig, extra_callbacks: list[pl.Callback] | None = None) -> dict[str, Any]:
+def run(cfg: DictConfig, extra_callbacks: list[pl.Callback] | None = None,
+        datamodule_args: Mapping[str, Any] | None = None) -> dict[str, Any]:
     """Train (and test) as ``cfg`` says; returns ``{"trainer", "model", "datamodule", "metrics"}``.
 
+    ``datamodule_args``: Python objects for the DataModule besides its config (see :func:`build`).
     Bad values (``threads``, the trainer's numbers, ``force`` with ``ckpt_path``) and a folder that
     holds another run's results are refused before any work (see the module doc).
     """
@@ -235,7 +244,7 @@ def run(cfg: DictConfig, extra_callbacks: list[pl.Callback] | None = None) -> di
     _write_text(output_dir / "config_resolved.yaml", OmegaConf.to_yaml(cfg, resolve=True))
 
     pl.seed_everything(cfg.seed, workers=True)
-    datamodule, model = build(cfg)
+    datamodule, model = build(cfg, datamodule_args)
     trainer: pl.Trainer = instantiate(cfg.trainer, callbacks=callbacks, logger=loggers or False,
                                       _convert_="all")
     # Same initial weights on every rank (seeded above); from here on each rank draws its own

@@ -3,10 +3,11 @@
     stylemotion-generate                                          # neutral, 10 m S-curve, synthetic run
     stylemotion-generate run=runs/reproduce/bandai style=elderly seed=3
     stylemotion-generate style=active path.file=path.csv out=runs/generate/active_path
+    stylemotion-generate run=runs/style/mine style=mine           # a style made by stylemotion-style
 
 The work and the folder's contents: :mod:`stylemotion.synthesis.generate`. The summary goes to the log
-(console and ``generate.log`` in the Hydra run folder); a bad ``threads``, path file or existing ``out``
-ends in one line naming it.
+(console and ``generate.log`` in the Hydra run folder); a bad ``threads``, path file, unknown style or existing
+``out`` ends in one line naming it.
 """
 
 from __future__ import annotations
@@ -21,13 +22,14 @@ from stylemotion.cli import reported
 from stylemotion.config import CONFIG_PACKAGE, ConfigError, set_torch_threads
 from stylemotion.io.outputs import OutputExistsError
 from stylemotion.synthesis.generate import generate, summary_lines
+from stylemotion.synthesis.graph import UnknownStyleError
 from stylemotion.synthesis.path import PathError
 
 log = logging.getLogger(__name__)
 
 
 def _main(cfg: DictConfig) -> None:
-    with reported("stylemotion-generate", ConfigError, OutputExistsError, PathError):
+    with reported("stylemotion-generate", ConfigError, OutputExistsError, PathError, UnknownStyleError):
         set_torch_threads(cfg.get("threads"))
         summary = generate(cfg, "stylemotion-generate " + " ".join(sys.argv[1:]))
     for line in summary_lines(summary):

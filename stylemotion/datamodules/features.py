@@ -32,6 +32,12 @@ straight walking/running) is encoded either resampled to the canonical length (`
 canonical``, like the content clips) or as recorded (``natural``, e.g. for examples of several
 steps). The frames an example is encoded at must be at least as many as the autoencoder's
 receptive field (:func:`receptive_field`).
+
+Examples from outside the dataset (``stylemotion-style``: a user's own BVH file): ``example_clips``
+gives the clips themselves (cut with :func:`stylemotion.primitives.segment_action` like the
+dataset's, at the data's fps) instead of ``examples`` specs; the style then need not be a style of
+the dataset. ``example_records`` adds plain values to each clip's record in the model's
+``spec.style_examples`` (e.g. the file, its sha256 and the clip's frames in it).
 """
 
 from __future__ import annotations
@@ -153,6 +159,21 @@ class FeatureDataset(Dataset):
                 "positions": self.positions[index], "num_frames": self.num_frames[index]}
 
 
+def _check_example_clips(clips: Sequence[Clip], records: Sequence[Mapping[str, Any]] | None, style: str | None,
+                         examples: Sequence[Mapping[str, Any]] | None) -> None:
+    """ValueError unless external example clips come with a style, without specs, one record per clip."""
+    if not style:
+        raise ValueError("example_clips are a style's examples: set style=<its name> as well")
+    if examples:
+        raise ValueError("give either examples (specs of the dataset's clips) or example_clips (clips from "
+                         "elsewhere), not both")
+    if not clips:
+        raise ValueError(f"example_clips of style {style!r} is empty: give at least one clip")
+    if records is not None and len(records) != len(clips):
+        raise ValueError(f"example_records has {len(records)} entries for {len(clips)} example clips; give one "
+                         "per clip")
+
+
 def _clip_module(**kwargs: Any) -> ClipDataModule:
     """A ClipDataModule built outside any ``__init__`` (Lightning's ``save_hyperparameters`` would
     otherwise also record the calling constructor's arguments, the autoencoder among them)."""
@@ -171,6 +192,9 @@ class FeatureDataModule(SplitDataModule):
         content_styles: styles of the content (training) clips: the neutral database, ``[normal]``.
         style: the style whose example(s) condition a :class:`StyleCVAE`; None for a plain VAE.
         examples: example specs (see the module doc); None = one default example.
+        example_clips: the style's example clips themselves, from outside the dataset (Python use; see
+            the module doc); instead of ``examples``.
+        example_records: one mapping of plain values per clip of ``example_clips``, recorded with it.
         example_length: ``canonical`` or ``natural`` (see the module doc).
         timeline: canonical length, ``median`` or frames (see :class:`ClipDataModule`).
         segment: segmentation overrides (see :class:`ClipDataModule`).
@@ -193,6 +217,8 @@ class FeatureDataModule(SplitDataModule):
         content_styles: Sequence[str] = ("normal",),
         style: str | None = None,
         examples: Sequence[Mapping[str, Any]] | None = None,
+        example_clips: Sequence[Clip] | None = None,
+        example_records: Sequence[Mapping[str, Any]] | None = None,
         example_length: str = "canonical",
         timeline: str | int = "median",
         segment: Mapping[str, Any] | None = None,
@@ -215,13 +241,17 @@ class FeatureDataModule(SplitDataModule):
             raise ValueError(f"feature_scale must be one of {FEATURE_SCALES}, got {feature_scale!r}")
         if min_train_clips < 1 or batch_size < 1:
             raise ValueError(f"need min_train_clips ≥ 1 and batch_size ≥ 1, got {min_train_clips}, {batch_size}")
-        self.save_hyperparameters(ignore=["takeset", "autoencoder"])
+        if example_clips is not None:
+            _check_example_clips(example_clips, example_records, style, examples)
+        self.save_hyperparameters(ignore=["takeset", "autoencoder", "example_clips"])
         self.primitive = primitive
         self.autoencoder_ckpt = autoencoder_ckpt
         self._autoencoder = autoencoder
         self.content_styles = [content_styles] if isinstance(content_styles, str) else list(content_styles)
         self.style = style
         self.example_specs = [dict(e) for e in examples] if examples else [{}]
+        self.example_clips = None if example_clips is None else list(example_clips)
+        self.example_records = [dict(r) for r in example_records or [{}] * len(self.example_clips or [])]
         self.example_length = example_length
         self.min_train_clips = min_train_clips
         self.feature_scale = feature_scale
@@ -229,7 +259,8 @@ class FeatureDataModule(SplitDataModule):
         self.clip_data = _clip_module(
             data=data, takeset=takeset, action=self.action, primitives=[self.primitive_name],
             styles=self.content_styles, timeline=timeline, example=self.example_specs[0],
-            example_styles=[style] if style else [], segment=segment, split=split, batch_size=batch_size)
+            example_styles=[style] if style and self.example_clips is None else [], segment=segment, split=split,
+            batch_size=batch_size)
         self.datasets: dict[str, FeatureDataset] = {}
         self.feature_mean: torch.Tensor | None = None
         self.feature_std: torch.Tensor | None = None
@@ -312,6 +343,9 @@ class FeatureDataModule(SplitDataModule):
         log.info("%s features %s×%s of %s clips: %s", self.primitive, channels, steps, self.content_styles, counts)
 
     def _encode_style_examples(self) -> None:
+        if self.example_clips is not None:
+            self._encode_clips(self.example_clips, self.example_records)
+            return
         clips = []
         for i, spec in enumerate(self.example_specs):
             source = self.clip_data if i == 0 else _clip_module(
@@ -323,9 +357,18 @@ class FeatureDataModule(SplitDataModule):
             except NoClipsError as err:
                 raise NoClipsError(f"style model {self.primitive}/{self.style} needs an example clip (spec "
                                    f"{spec or 'default'}): {err}") from err
+        self._encode_clips(clips, [{}] * len(clips))
+
+    def _encode_clips(self, clips: Sequence[Clip], records: Sequence[Mapping[str, Any]]) -> None:
+        """Encode the example ``clips`` and record each (with its extra ``records`` values)."""
+        for clip in clips:
+            if abs(clip.fps - self.fps) > 1e-6 * self.fps:
+                raise ValueError(f"style example {clip.describe()} is at {clip.fps:g} fps, the data at {self.fps:g} "
+                                 "fps: convert it to the data's frame rate first")
         length = self.timeline_frames if self.example_length == "canonical" else None
         self.style_features = encode_examples(self.autoencoder, clips, length)
-        self.style_examples = [{**describe_clip(c), "encoded_frames": int(length or c.num_frames)} for c in clips]
+        self.style_examples = [{**describe_clip(c), "encoded_frames": int(length or c.num_frames), **dict(r)}
+                               for c, r in zip(clips, records)]
 
     def model_spec(self) -> dict[str, Any]:
         """Plain values a model records about its data (after :meth:`setup`)."""

@@ -36,6 +36,7 @@ from stylemotion.io.bvh import DEFAULT_MAX_JOINT_FRAMES, parse_bvh
 from stylemotion.io.errors import MotionDataError, MotionDataWarning
 from stylemotion.io.outputs import safe_name
 from stylemotion.io.sources import FileSource
+from stylemotion.motion import Motion
 
 log = logging.getLogger(__name__)
 
@@ -121,6 +122,16 @@ def load_canonical_positions(source: FileSource, settings: ConversionSettings) -
         MotionDataError: naming the file (LimitError for a file over the settings' limits).
     """
     motion = parse_bvh(source.read_bytes(settings.max_file_mb), source.name, settings.max_joint_frames)
+    return convert_motion(motion, settings)
+
+
+def convert_motion(motion: Motion, settings: ConversionSettings) -> np.ndarray:
+    """``(frames, 21, 3)`` float32 canonical positions of a parsed motion, converted as every dataset
+    converts its files (joint map, units, up axis, resampling to ``settings.fps``, limits).
+
+    Raises:
+        MotionDataError: naming the motion's source.
+    """
     return to_canonical_positions(
         motion, joint_map=settings.joint_map, fps=settings.fps, unit_scale=settings.unit_scale,
         up_axis=settings.up_axis, max_frames=settings.max_frames, max_joint_frames=settings.max_joint_frames,

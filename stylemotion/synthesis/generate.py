@@ -3,8 +3,11 @@
     stylemotion-generate                                          # neutral, 10 m S-curve, synthetic run
     stylemotion-generate run=runs/reproduce/bandai style=elderly seed=3
     stylemotion-generate style=active path.file=path.csv out=runs/generate/active_path
+    stylemotion-generate run=runs/style/mine style=mine           # a style made by stylemotion-style
 
-The models come from a ``stylemotion-reproduce`` folder (``run``) or an explicit ``models`` mapping;
+The models come from a ``stylemotion-reproduce`` folder (``run``), a ``stylemotion-style`` folder (``run``:
+its new style, and through the reproduce run it extends ``neutral`` and the run's styles) or an
+explicit ``models`` mapping;
 the path from ``path.file`` (.json/.csv), ``path.points`` or the default S-curve
 (:mod:`stylemotion.synthesis.path`). The walk is synthesized by
 :func:`stylemotion.synthesis.controller.follow_path` and written to the folder ``out`` (refused if
@@ -46,7 +49,7 @@ from stylemotion.provenance import provenance
 from stylemotion.skeleton import CANONICAL_JOINTS
 from stylemotion.synthesis.cleanup import clean_foot_skating
 from stylemotion.synthesis.controller import FollowSettings, SynthesizedMotion, follow_path
-from stylemotion.synthesis.graph import load_graph
+from stylemotion.synthesis.graph import extended_run, load_graph, style_folder_meta
 from stylemotion.synthesis.path import GroundPath, s_curve
 from stylemotion.synthesis.quality import skating, walk_figures
 from stylemotion.viz.walk import save_walk_animation
@@ -74,7 +77,14 @@ def bvh_round_trip_error(bvh: Path, positions: np.ndarray, fps: float) -> float:
 
 
 def real_foot_skating(run: str | Path | None, style: str) -> float | None:
-    """The foot-skating ratio of real clips of ``style`` in a reproduce run's report, if recorded."""
+    """The foot-skating ratio of real clips of ``style`` in a reproduce run's report, if recorded; for the
+    new style of a ``stylemotion-style`` folder, that of its example's clips (the run's styles: the run's)."""
+    meta = style_folder_meta(run) if run else None
+    if meta is not None:
+        if style != meta.get("name"):
+            return real_foot_skating(extended_run(run, meta), style)
+        value = json.loads((Path(run).expanduser() / "report.json").read_text()).get("foot_skating_pooled", {})
+        return None if value.get("example") is None else float(value["example"])
     report = Path(run) / "report" / "report.json" if run else None
     if report is None or not report.is_file():
         return None

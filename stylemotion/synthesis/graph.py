@@ -13,8 +13,10 @@ follow the foot that carries the body. A clip that ends at the transfer onto the
 chosen style, all decoding through one autoencoder.
 
 Models come from a ``stylemotion-reproduce`` run folder (its ``report/report.json`` lists every
-evaluated checkpoint with its primitive and style) or from an explicit ``{primitive: checkpoint}``
-mapping.
+evaluated checkpoint with its primitive and style), from a ``stylemotion-style`` folder (its
+``report.json`` lists the new style's checkpoints and names the reproduce run it extends, whose
+models — neutral and the run's styles — it offers as well), or from an explicit
+``{primitive: checkpoint}`` mapping.
 """
 
 from __future__ import annotations
@@ -44,6 +46,8 @@ TRANSITIONS: dict[str, tuple[str, ...]] = {
 }
 #: Prior samples drawn per primitive to measure its typical step (length, turn).
 PROFILE_SAMPLES = 512
+#: ``meta.kind`` in the ``report.json`` of a ``stylemotion-style`` folder.
+STYLE_FOLDER_KIND = "style"
 
 
 class UnknownStyleError(KeyError):
@@ -141,8 +145,39 @@ class MotionGraph:
         return self.profiles
 
 
+def style_folder_meta(run: str | Path) -> dict | None:
+    """``meta`` of a ``stylemotion-style`` folder's ``report.json`` (``kind: style``), or None when ``run``
+    is no such folder."""
+    report = Path(run).expanduser() / "report.json"
+    if not report.is_file():
+        return None
+    meta = json.loads(report.read_text()).get("meta", {})
+    return meta if meta.get("kind") == STYLE_FOLDER_KIND else None
+
+
+def extended_run(folder: str | Path, meta: dict) -> Path:
+    """The ``stylemotion-reproduce`` run a style folder extends: where it was (``meta.run``), else where it
+    lies relative to the style folder (``meta.run_relative``: both moved together).
+
+    Raises:
+        FileNotFoundError: neither holds a finished run (``report/report.json``).
+    """
+    candidates = [Path(str(meta[key])) if key == "run" else Path(folder).expanduser() / str(meta[key])
+                  for key in ("run", "run_relative") if meta.get(key)]
+    for candidate in candidates:
+        if (candidate / "report" / "report.json").is_file():
+            return candidate
+    raise FileNotFoundError(f"{folder} is a style that extends the stylemotion-reproduce run {meta.get('run')}, "
+                            f"which is gone (looked at {[str(c) for c in candidates]}): put the run back, or give "
+                            "models={primitive: checkpoint}")
+
+
 def report_meta(run: str | Path) -> dict:
-    """``meta`` of a ``stylemotion-reproduce`` run's ``report/report.json`` (checkpoints, autoencoder)."""
+    """``meta`` of a ``stylemotion-reproduce`` run's ``report/report.json`` (checkpoints, autoencoder), or of
+    a ``stylemotion-style`` folder's ``report.json`` (:func:`style_folder_meta`)."""
+    style = style_folder_meta(run)
+    if style is not None:
+        return style
     report = Path(run) / "report" / "report.json"
     if not report.is_file():
         raise FileNotFoundError(f"{report} does not exist: point run= at a finished stylemotion-reproduce folder "
@@ -152,8 +187,13 @@ def report_meta(run: str | Path) -> dict:
 
 def available_models(run: str | Path, meta: dict | None = None) -> list[dict[str, str]]:
     """Checkpoints of a ``stylemotion-reproduce`` run: ``[{primitive, name, style, path}]`` from its
-    report's ``meta`` (read from ``run`` unless given; ``name`` is ``neutral`` or the style)."""
+    report's ``meta`` (read from ``run`` unless given; ``name`` is ``neutral`` or the style). For a
+    ``stylemotion-style`` folder: its own style's checkpoints, then those of the run it extends."""
     meta = report_meta(run) if meta is None else meta
+    if meta.get("kind") == STYLE_FOLDER_KIND:
+        own = [{**{k: str(e[k]) for k in ("primitive", "name", "style")},
+                "path": os.path.normpath(Path(run).expanduser() / e["path"])} for e in meta.get("checkpoints", [])]
+        return own + available_models(extended_run(run, meta))
     entries = meta.get("checkpoints")
     if not entries:
         raise ValueError(f"{Path(run) / 'report' / 'report.json'}: meta.checkpoints is empty; no model to "
@@ -190,6 +230,8 @@ def run_autoencoder(run: str | Path, meta: dict | None = None):
     the checkpoints), checked against its recorded fingerprint; None if the report names none or the
     file is gone (the models then use the autoencoder embedded in their checkpoints)."""
     meta = report_meta(run) if meta is None else meta
+    if meta.get("kind") == STYLE_FOLDER_KIND:  # the new style's models were trained on the run's autoencoder
+        return run_autoencoder(extended_run(run, meta))
     info = meta.get("autoencoder") or {}
     if not info.get("path"):
         return None
@@ -206,7 +248,8 @@ def load_graph(style: str, run: str | Path | None = None, models: Mapping[str, s
     Args:
         style: which models: ``neutral`` (or ``neutral_style``) picks the neutral VAEs, anything else
             the StyleCVAEs trained for that style.
-        run: a ``stylemotion-reproduce`` folder to take checkpoints from (see :func:`available_models`).
+        run: a ``stylemotion-reproduce`` or ``stylemotion-style`` folder to take checkpoints from (see
+            :func:`available_models`).
         models: explicit ``{primitive: checkpoint}`` (``walk_leftStance`` or ``leftStance``); overrides ``run``.
         action: the action whose primitives to use.
         neutral_style: the data's name of the neutral style (Bandai: ``normal``).

@@ -25,6 +25,7 @@ COMMANDS = {  # module → (console script, a phrase of its description, a key o
     "segment": ("stylemotion-segment", "segment walks and runs into motion primitives", "timeline="),
     "prepare": ("stylemotion-data", "build a dataset", "data.skip_broken=true"),
     "reproduce": ("stylemotion-reproduce", "resumable command", "workers=N"),
+    "style": ("stylemotion-style", "add a new style to a finished stylemotion-reproduce run", "example=<BVH>"),
 }
 
 

@@ -1,0 +1,17 @@
+"""A new style from the user's own example clip (``stylemotion-style``; issue 12).
+
+:func:`add_style` converts the user's BVH file like the datasets convert theirs, cuts it into the
+primitives of a finished ``stylemotion-reproduce`` run with the run's segmentation, trains the run's
+primitive models for the new style (a StyleCVAE each, exactly as the run's CVAE stage, with the user's
+clips as the style example) and evaluates them against the run's Table 5.1 columns. The folder it
+writes extends the run for ``stylemotion-generate run=<folder> style=<name>``. Modules:
+:mod:`.example` (the example), :mod:`.base_run` (the run), :mod:`.evaluate` (the report's numbers),
+:mod:`.command` (the whole command and its methods). Specification: ``docs/style.md``.
+"""
+
+from stylemotion.style_example.base_run import NameTakenError, SourceRun, load_run
+from stylemotion.style_example.command import METHODS, add_style, add_style_from_config
+from stylemotion.style_example.example import ExampleSpec, StyleExampleError, convert_example, parse_example
+
+__all__ = ["METHODS", "ExampleSpec", "NameTakenError", "SourceRun", "StyleExampleError", "add_style",
+           "add_style_from_config", "convert_example", "load_run", "parse_example"]

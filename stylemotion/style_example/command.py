@@ -1,0 +1,309 @@
+"""A new style from the user's own example (what ``stylemotion-style`` runs).
+
+    stylemotion-style example=my_walk.bvh run=runs/reproduce/synthetic name=mine
+    stylemotion-style example=walk_120fps.bvh:240-960 run=runs/reproduce/bandai name=limp out=runs/style/limp
+    stylemotion-generate run=runs/style/mine style=mine      # a walk in the new style (neutral and the run's too)
+
+Stages (one progress line each, ``[k/N]``, as ``stylemotion-reproduce`` prints them):
+
+1. check the run (a finished reproduce run, :mod:`.base_run`), the name and the example, and convert
+   the example (:func:`.example.convert_example`);
+2. cut it into the run's primitives with the run's segmentation (:func:`.example.cut_example`);
+3. one model per primitive of the example's action, by ``method`` (:func:`train_models`; ``cvae``:
+   the run's StyleCVAE training, :func:`train_cvae`);
+4. evaluate them against the run (:mod:`.evaluate`) and write ``report.md`` and ``report.json``.
+
+Everything is built in a temporary folder beside ``out`` and renamed into it at the end
+(:func:`stylemotion.io.atomic.atomic_folder`): a failure leaves nothing, an existing ``out`` is refused
+before any work. The folder holds ``cvae/<primitive>_<name>/`` (each model's training folder, as the
+run's stages have them: checkpoints, ``config_resolved.yaml``, ``run.json``, ``metrics.json``; their
+records name the temporary folder they were trained in), ``example/example.npz`` (the converted
+example: ``positions`` (frames, 21, 3) metres, ``fps``, ``joint_names``), ``report.md`` and
+``report.json`` (layout in ``docs/style.md``). Paths in ``report.json`` inside ``out`` are relative to it.
+"""
+
+from __future__ import annotations
+
+import io
+import json
+import os
+import time
+from collections.abc import Callable, Iterator, Mapping
+from contextlib import contextmanager
+from dataclasses import asdict
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from omegaconf import DictConfig, OmegaConf
+
+from stylemotion.config import ConfigError, config_dir, positive_int
+from stylemotion.datasets import TakeSet, build_dataset
+from stylemotion.datasets.loading import ConversionSettings
+from stylemotion.evaluation.report import _plain
+from stylemotion.evaluation.sources import load_model
+from stylemotion.io.atomic import atomic_folder
+from stylemotion.io.outputs import check_new_output, inside
+from stylemotion.models.checkpoints import autoencoder_info, load_autoencoder
+from stylemotion.primitives import parse_primitive, segment_action
+from stylemotion.provenance import provenance
+from stylemotion.skeleton import CANONICAL_JOINTS
+from stylemotion.style_example.base_run import STYLE_KIND, SourceRun, check_name, load_run, run_action, train_config
+from stylemotion.style_example.evaluate import evaluate_primitive, markdown, pooled_foot_skating
+from stylemotion.style_example.example import (
+    ConvertedExample,
+    CutExample,
+    convert_example,
+    cut_example,
+    on_run_skeleton,
+    parse_example,
+)
+
+#: Conversion keys of the command (``stylemotion.datasets.loading.ConversionSettings`` fields).
+CONVERSION_KEYS = ("joint_map", "unit_scale", "up_axis")
+
+Say = Callable[[str], None]
+
+
+class Progress:
+    """``[k/N] text  (at x min)`` lines, as ``stylemotion-reproduce`` prints its stages."""
+
+    def __init__(self, total: int, say: Say):
+        self.total, self.say, self.step, self.started = total, say, 0, time.perf_counter()
+
+    def __call__(self, text: str) -> None:
+        self.step += 1
+        self.say(f"[{self.step}/{self.total}] {text}  (at {(time.perf_counter() - self.started) / 60:.1f} min)")
+
+
+@contextmanager
+def hydra_configs() -> Iterator[None]:
+    """Hydra's config search over the packaged configs, unless a command already set it up (the run's
+    training stages are composed from the ``train`` config)."""
+    from hydra import initialize_config_dir
+    from hydra.core.global_hydra import GlobalHydra
+
+    if GlobalHydra.instance().is_initialized():
+        yield
+        return
+    with initialize_config_dir(config_dir=config_dir(), version_base="1.3"):
+        yield
+
+
+# -- methods: how a style's primitive models come about
+
+
+def train_cvae(run: SourceRun, name: str, example: ConvertedExample, cut: CutExample, folder: Path,
+               progress: Progress, say: Say, threads: Any = None) -> dict[str, Path]:
+    """A :class:`~stylemotion.models.cvae.StyleCVAE` per primitive, trained as the run's CVAE stage of that
+    primitive (:func:`.base_run.train_config`) on the example's clips; returns primitive → checkpoint."""
+    from stylemotion.training import run as train_run
+
+    checkpoints = {}
+    for primitive, clips in cut.used.items():
+        model_folder = inside(folder, "cvae", f"{primitive}_{name}")
+        cfg = train_config(run, primitive, name, model_folder, threads)
+        progress(f"cvae {primitive}/{name}: training ({cfg.trainer.max_epochs} epochs, style_weight "
+                 f"{cfg.model.style_weight}) on {len(clips)} example clip(s)")
+        t0 = time.perf_counter()
+        result = train_run(cfg, datamodule_args={"example_clips": clips,
+                                                 "example_records": [example.record(c) for c in clips]})
+        metrics = result["metrics"]
+        last = model_folder / "checkpoints" / "last.ckpt"
+        checkpoints[primitive] = Path(metrics.get("best_checkpoint") or last)
+        test = ", ".join(f"{k} {v:.4g}" for k, v in metrics.get("test", {}).items() if isinstance(v, float))
+        say(f"    cvae {primitive}/{name} done in {(time.perf_counter() - t0) / 60:.1f} min" + (f": {test}" if test
+                                                                                                else ""))
+    return checkpoints
+
+
+#: ``method`` → the function that makes the style's models (one place to add another method).
+METHODS: dict[str, Callable[..., dict[str, Path]]] = {"cvae": train_cvae}
+
+
+def check_method(method: Any) -> str:
+    """``method`` if it names one of :data:`METHODS`; :class:`ConfigError` naming the key otherwise."""
+    if method not in METHODS:
+        raise ConfigError(f"method must be one of {sorted(METHODS)}, got {method!r}")
+    return str(method)
+
+
+def train_models(method: str, *args: Any, **kwargs: Any) -> dict[str, Path]:
+    """The style's primitive models by ``method`` (arguments as :func:`train_cvae`'s)."""
+    return METHODS[check_method(method)](*args, **kwargs)
+
+
+# -- the command
+
+
+def add_style(example: str, run: str | os.PathLike, name: str, out: str | os.PathLike, method: str = "cvae",
+              action: str | None = None, samples: int = 1000, seed: int | None = None, threads: Any = 1,
+              conversion: Mapping[str, Any] | None = None, say: Say = print, command: str = "") -> dict[str, Any]:
+    """Train the models of a new style ``name`` from ``example`` and evaluate them (see the module doc).
+
+    Args:
+        example: ``<BVH>[:start-end]`` (frames of the file's own frame rate, 0-based, end exclusive).
+        run: a finished ``stylemotion-reproduce`` folder.
+        name: the new style's name (not a style or model name of the run).
+        out: the new folder.
+        method: how the models come about (:data:`METHODS`).
+        action: the example's action; None = the one action of the run's primitives.
+        samples: samples per model for the report; ``seed`` draws them (None: the run's seed).
+        threads: torch threads while training (None: torch's default).
+        conversion: ``joint_map``, ``unit_scale``, ``up_axis`` for the example (None: auto-detected, Y up).
+        say: prints a progress line.
+        command: the command line to record.
+
+    Returns:
+        What ``report.json`` holds.
+
+    Raises:
+        OutputExistsError: ``out`` exists (before any work).
+        ConfigError: a bad ``method``, ``samples``, ``seed`` or ``threads``.
+        StyleExampleError: a bad example, frame range, run or name (:class:`.base_run.NameTakenError`), or an
+            example without a complete step; nothing is written then.
+    """
+    started = time.perf_counter()
+    out = check_new_output(Path(out).expanduser())
+    method = check_method(method)
+    samples = positive_int(samples, "samples")
+    threads = None if threads is None else positive_int(threads, "threads")
+    if samples < 2:
+        raise ConfigError(f"samples must be at least 2 (a spread needs two), got {samples}")
+    if seed is not None and (isinstance(seed, bool) or not isinstance(seed, int) or seed < 0):
+        raise ConfigError(f"seed must be a whole number ≥ 0 or null (the run's seed), got {seed!r}")
+    spec = parse_example(example)
+    source = load_run(run)
+    name = check_name(name, source)
+    action = run_action(source, action)
+    settings = conversion_settings(source, conversion)
+    ours = [p for p in source.primitives if parse_primitive(p)[0] == action]
+    progress = Progress(3 + len(ours), say)
+    converted = convert_example(spec, settings)
+    takeset = build_dataset(source.data_cfg)
+    converted = on_run_skeleton(converted, takeset)
+    progress(f"example {converted.name}: {converted.end - converted.start} of {converted.file_frames} frames at "
+             f"{converted.file_fps:g} fps → {len(converted.positions)} frames at {converted.fps:g} fps"
+             + (f" on the data's skeleton (data.retarget={converted.retarget['style']})" if converted.retarget else "")
+             + f"; run {source.folder} (data {takeset.name}, primitives {source.primitives})")
+    with hydra_configs():
+        node = train_config(source, ours[0], name, out, threads).datamodule.get("segment")
+        segment = OmegaConf.to_container(node, resolve=True) if node is not None else {}
+    cut = cut_example(converted, name, action, source.primitives, segment)
+    progress(f"{converted.name} cut with the run's segmentation: "
+             + ", ".join(f"{p} {len(c)}" for p, c in cut.clips.items())
+             + (f"; {cut.borrowed} take the example's other steps" if cut.borrowed else "")
+             + (f"; no model of {cut.skipped} (another action)" if cut.skipped else ""))
+    with atomic_folder(out, on_exists=lambda: check_new_output(out)) as tmp:
+        with hydra_configs():
+            checkpoints = train_models(method, source, name, converted, cut, tmp, progress, say, threads)
+        progress(f"evaluation: {samples} samples per model → {out / 'report.md'}")
+        results = evaluate(source, takeset, name, method, converted, cut, checkpoints, tmp, samples, seed, say)
+        results["meta"].update(provenance(command or None), seconds=time.perf_counter() - started,
+                               run_relative=os.path.relpath(source.folder.resolve(), out.resolve()))
+        write_example(converted, tmp / "example" / "example.npz")
+        results = _plain(results)
+        (tmp / "report.json").write_text(json.dumps(results, indent=1, allow_nan=False))
+        (tmp / "report.md").write_text(markdown(results))
+    for line in summary_lines(results):
+        say(line)
+    say(f"report: {out / 'report.md'}")
+    return results
+
+
+def conversion_settings(run: SourceRun, conversion: Mapping[str, Any] | None) -> ConversionSettings:
+    """How the example is converted: the run's frame rate, and ``joint_map``/``unit_scale``/``up_axis``."""
+    values = dict(conversion or {})
+    unknown = sorted(set(values) - set(CONVERSION_KEYS))
+    if unknown:
+        raise ConfigError(f"unknown conversion key(s) {unknown}; valid: {list(CONVERSION_KEYS)}")
+    fps = run.data_cfg.get("fps", 30.0)
+    return ConversionSettings(fps=float(fps), **{k: v for k, v in values.items() if v is not None})
+
+
+def evaluate(run: SourceRun, takeset: TakeSet, name: str, method: str, example: ConvertedExample, cut: CutExample,
+             checkpoints: Mapping[str, Path], folder: Path, samples: int, seed: int | None, say: Say) -> dict[str, Any]:
+    """The report of the new models against ``run`` and its data ``takeset`` (``report.json`` layout without
+    provenance); paths relative to ``folder``."""
+    settings = run.settings
+    seed = run.seed if seed is None else int(seed)
+    autoencoder = load_autoencoder(run.autoencoder_ckpt)
+    segmentations = {}
+    per: dict[str, dict[str, Any]] = {}
+    models = {}
+    for primitive, ckpt in checkpoints.items():
+        action = parse_primitive(primitive)[0]
+        if action not in segmentations:
+            segmentations[action] = segment_action(takeset.takes, action, settings.segment)
+        new = load_model(ckpt, settings.neutral_style, autoencoder)
+        per[primitive] = evaluate_primitive(primitive, run.models(primitive, autoencoder), new, cut.used[primitive],
+                                            takeset, autoencoder, settings, run.data_cfg.get("split"), samples, seed,
+                                            segmentations[action], lambda text: say("    " + text))
+        models[primitive] = {"checkpoint": Path(ckpt).resolve().relative_to(folder.resolve()).as_posix(),
+                             "examples": new.examples,
+                             "borrowed": primitive in cut.borrowed}
+    info = autoencoder_info(autoencoder, run.autoencoder_ckpt)
+    return {
+        "name": name, "method": method,
+        "example": {"file": example.name, "sha256": example.sha256, "file_fps": example.file_fps,
+                    "file_frames": example.file_frames, "file_range": [example.start, example.end],
+                    "frames": int(len(example.positions)), "fps": example.fps,
+                    "retarget": example.retarget, "clips": {p: len(c) for p, c in cut.clips.items()},
+                    "rejected_steps": [{"reason": r.reason, "kind": r.kind, "start": r.start, "stop": r.stop}
+                                       for r in cut.segmentation.rejections]},
+        "models": models, "skipped": cut.skipped, "samples": samples,
+        "table_5_1_row": {p: r["table_5_1_row"] for p, r in per.items()},
+        "table_5_1_columns": {p: r["columns"] for p, r in per.items()},
+        "nearest_existing_style": {p: r["nearest_existing"] for p, r in per.items()},
+        "new_column_is_minimum": {p: r["new_column_is_minimum"] for p, r in per.items()},
+        "variation": {p: r["variation"] for p, r in per.items()},
+        "foot_skating": {p: r["foot_skating"] for p, r in per.items()},
+        "foot_skating_pooled": {kind: pooled_foot_skating(per, kind) for kind in ("samples", "example")},
+        "meta": {"kind": STYLE_KIND, "name": name, "run": str(run.folder.resolve()), "data": run.data_cfg,
+                 "data_name": takeset.name, "train_seed": run.seed, "seed": seed, "samples": samples,
+                 "checkpoints": [{"path": m["checkpoint"], "primitive": p, "name": name, "style": name}
+                                 for p, m in models.items()],
+                 "autoencoder": {"path": str(Path(info["path"]).resolve()), "fingerprint": info["fingerprint"]},
+                 "paths_relative_to": ".", "settings": asdict(settings)},
+    }
+
+
+def write_example(example: ConvertedExample, path: Path) -> None:
+    """The converted example as ``positions`` (frames, 21, 3) metres, ``fps``, ``joint_names``."""
+    buffer = io.BytesIO()
+    np.savez(buffer, positions=example.positions, fps=np.float64(example.fps), joint_names=np.array(CANONICAL_JOINTS))
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_bytes(buffer.getvalue())
+
+
+def summary_lines(results: Mapping[str, Any]) -> list[str]:
+    """A few lines for the terminal: each primitive's row against the new example and the nearest existing style."""
+    name, lines = results["name"], []
+    for p, row in results["table_5_1_row"].items():
+        nearest = results["nearest_existing_style"][p]
+        lines.append(f"{p}: D to {name} {row[name]:.4g}, nearest existing style {nearest} {row[nearest]:.4g} "
+                     f"({'the new example is' if results['new_column_is_minimum'][p] else 'not'} the row's minimum)")
+    pooled = results["foot_skating_pooled"]
+    lines.append(f"foot skating of samples {_percent(pooled['samples'])}, of the example's clips "
+                 f"{_percent(pooled['example'])}")
+    return lines
+
+
+def _percent(value: Any) -> str:
+    return "–" if value is None else f"{100 * value:.1f} %"
+
+
+def add_style_from_config(cfg: DictConfig | Mapping[str, Any], say: Say = print, command: str = "") -> dict[str, Any]:
+    """:func:`add_style` with the keys of ``configs/style.yaml``; missing mandatory keys are named."""
+    if isinstance(cfg, DictConfig):
+        for key, form in (("example", "example=<BVH>[:start-end]"), ("name", "name=<the new style's name>")):
+            if OmegaConf.is_missing(cfg, key):
+                raise ConfigError(f"{key} is missing: give {form}")
+        values = OmegaConf.to_container(cfg, resolve=True)
+    else:
+        values = dict(cfg)
+    return add_style(str(values["example"]), values["run"], values["name"], values["out"],
+                     method=values.get("method", "cvae"), action=values.get("action"),
+                     samples=values.get("samples", 1000), seed=values.get("seed"), threads=values.get("threads", 1),
+                     conversion={k: values.get(k) for k in CONVERSION_KEYS}, say=say, command=command)
+

@@ -1,0 +1,164 @@
+"""The new style's models against the run: their Table 5.1 row, their variation and their foot skating.
+
+Per primitive, with the evaluation library of the run's report (:mod:`stylemotion.evaluation`):
+
+* the run's real side (:func:`stylemotion.evaluation.pipeline.real_side`: its clips split and its
+  style examples found, as the run's own evaluation does);
+* the columns of Table 5.1 (:func:`stylemotion.evaluation.pipeline._example_gram`): ``neutral`` (the
+  mean motion of the neutral training clips), each of the run's styles (its example clip(s)), and the
+  new style (the user's clips, encoded as its model was trained on them, checked against the Gram the
+  model recorded);
+* the row: D(new model, column) = mean over ``samples`` samples of the Gram distance
+  (:func:`stylemotion.evaluation.tables.distance_table`), and the existing column nearest to it;
+* variation (:func:`stylemotion.evaluation.tables.variance_stats`: pose_SD, V_SD, step_SD,
+  pose_across_SD) and raw foot skating (:func:`stylemotion.evaluation.metrics.foot_skating`, no
+  clean-up) of the samples, next to the same figures of the user's example clips (and the variation of
+  the neutral training data).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from typing import Any
+
+import torch
+
+from stylemotion.datasets import TakeSet
+from stylemotion.evaluation.markdown import DEFINITIONS, _md_table, fmt, pct
+from stylemotion.evaluation.metrics import FootSkating, foot_skating, pooled_skating
+from stylemotion.evaluation.pipeline import _example_gram, real_side
+from stylemotion.evaluation.settings import EvalSettings
+from stylemotion.evaluation.sources import NEUTRAL, EvalModel, check_one_autoencoder, motions_from_clips
+from stylemotion.evaluation.tables import VARIANCE_KEYS, VARIANCE_UNITS, distance_table, variance_stats
+from stylemotion.primitives import Clip, Segmentation
+from stylemotion.sampling import MotionSamples
+
+#: Variation figures of the report, in table order.
+VARIATION_KEYS = (*VARIANCE_KEYS, "pose_across_sd")
+
+
+def variation(motions: MotionSamples) -> dict[str, float] | None:
+    """pose_SD, V_SD, step_SD, pose_across_SD (and context figures) of ≥ 2 motions; None for one motion
+    (a spread needs two)."""
+    if len(motions.num_frames) < 2:
+        return None
+    return variance_stats(motions.frames.numpy(), motions.positions.numpy(), motions.num_frames.numpy(),
+                          motions.normalized_frames.numpy())
+
+
+def evaluate_primitive(primitive: str, run_models: Sequence[EvalModel], new: EvalModel, clips: Sequence[Clip],
+                       takeset: TakeSet, autoencoder, settings: EvalSettings, split: dict[str, Any] | None,
+                       samples: int, seed: int, segmentation: Segmentation | None = None,
+                       say: Callable[[str], None] = print) -> dict[str, Any]:
+    """The new model of ``primitive`` against the run (see the module doc).
+
+    Args:
+        run_models: the run's models of ``primitive`` (neutral VAE, style CVAEs).
+        new: the new style's model; ``new.name`` names its column.
+        clips: the user's example clips its model was trained on.
+        takeset, split: the run's data and split settings.
+        autoencoder: the run's autoencoder.
+        settings: the run's evaluation settings.
+        samples: samples of the new model; ``seed`` draws them.
+        segmentation: the action's takes segmented with ``settings.segment`` (None: segmented here).
+
+    Returns:
+        ``table_5_1_row`` {column: D}, ``columns`` {column: what its Gram is of}, ``nearest_existing``,
+        ``new_column_is_minimum``, ``variation`` {samples, example, training_data}, ``foot_skating``
+        {samples, example}, ``samples``.
+
+    Raises:
+        ValueError: the new model's timeline differs from the run's, or it was trained on other data.
+        MixedAutoencodersError, MissingExampleError: another autoencoder, or an example that is not the
+            one the model was trained with.
+    """
+    check_one_autoencoder([*run_models, new])
+    real = real_side(primitive, run_models, takeset, settings, split, say, segmentation)
+    if new.timeline_frames != real.length:
+        raise ValueError(f"{new.checkpoint}: timeline of {new.timeline_frames} frames, the run's {primitive} models "
+                         f"use {real.length}: it was not trained on the run's data")
+    real.examples[new.name] = list(clips)  # the new column: the user's clips, as the model was trained on them
+    columns = [*real.models, new]
+    grams = torch.stack([_example_gram(autoencoder, real, m) for m in columns])
+    say(f"{primitive}: {samples} samples of {new.name}, Table 5.1 row against {len(columns)} examples")
+    drawn = new.source.sample(samples, seed=seed)
+    row = distance_table(autoencoder, [drawn.normalized_frames.numpy()], grams, settings.gram_chunk)[0]
+    names = [m.name for m in columns]
+    table_row = {name: float(d) for name, d in zip(names, row)}
+    existing = {name: d for name, d in table_row.items() if name != new.name}
+    example = motions_from_clips(list(clips), real.length)
+    data = real.data
+
+    def skating(motions: MotionSamples) -> dict[str, Any]:
+        return foot_skating(motions.positions.numpy(), motions.num_frames.numpy(), motions.fps, data.rest_heights,
+                            data.stance_foot, settings.skate_speed_mps).as_dict()
+
+    return {
+        "table_5_1_row": table_row,
+        "columns": {m.name: ("mean motion of the neutral training clips" if m.name == NEUTRAL
+                             else [c.describe() for c in real.examples[m.name]]) for m in columns},
+        "nearest_existing": min(existing, key=existing.get),
+        "new_column_is_minimum": bool(table_row[new.name] <= min(existing.values())),
+        "variation": {"samples": variation(drawn), "example": variation(example),
+                      "training_data": variation(real.training)},
+        "foot_skating": {"samples": skating(drawn), "example": skating(example)},
+        "samples": int(samples),
+    }
+
+
+def pooled_foot_skating(per_primitive: dict[str, dict[str, Any]], kind: str) -> float:
+    """The foot-skating ratio of ``kind`` (``samples`` or ``example``) pooled over primitives."""
+    return pooled_skating([FootSkating(**r["foot_skating"][kind]) for r in per_primitive.values()]).ratio
+
+
+def markdown(results: dict[str, Any]) -> str:
+    """``report.md`` of a new style (``results``: the ``report.json`` layout, see ``docs/style.md``)."""
+    meta, example, name = results["meta"], results["example"], results["name"]
+    out = [f"# New style `{name}` from an example", ""]
+    rng = (f", frames {example['file_range'][0]}–{example['file_range'][1]} of {example['file_frames']} at "
+           f"{example['file_fps']:g} fps")
+    out += [f"Example `{example['file']}`{rng} (sha256 `{example['sha256'][:16]}…`), converted to "
+            f"{example['frames']} frames at {example['fps']:g} fps; method `{results['method']}`. It extends the "
+            f"reproduce run `{meta['run']}` (data `{meta['data_name']}`, seed {meta['train_seed']}); "
+            f"{fmt(results['samples'])} samples per model (seed {meta['seed']}). Git commit "
+            f"`{meta.get('git_commit', '?')}`; {fmt(meta.get('seconds'), 3)} s.", ""]
+    if meta.get("command"):
+        out += ["```", meta["command"], "```", ""]
+    out += ["Models (trained as the run's CVAE stage of the primitive, conditioned on the example's clips):", "",
+            _md_table(["primitive", "checkpoint", "example clips (frames of the file)"],
+                      [[p, f"`{m['checkpoint']}`", "; ".join(f"{c['primitive']} {c['file_frames'][0]}–"
+                                                             f"{c['file_frames'][1]}" for c in m["examples"])
+                        + (" (none of this primitive: the example's other steps)" if m["borrowed"] else "")]
+                       for p, m in results["models"].items()]), ""]
+    if results.get("skipped"):
+        out += [f"No model of {results['skipped']}: another action than the example's.", ""]
+    out += ["## Table 5.1 row", "", "D(new model, example) = mean Gram distance of its samples to each example "
+            "(lower = closer to that style); the run's columns as in its report, and the new example.", ""]
+    for p, row in results["table_5_1_row"].items():
+        low = min(row.values())
+        out += [f"**{p}**", "", _md_table(["model \\ example", *row],
+                                          [[name] + [f"**{fmt(v)}**" if v == low else fmt(v) for v in row.values()]]),
+                ""]
+        nearest = results["nearest_existing_style"][p]
+        verdict = "is" if results["new_column_is_minimum"][p] else "is not"
+        out += [f"Of the run's styles, the samples are nearest to **{nearest}** (D {fmt(row[nearest])}); the new "
+                f"example's column {verdict} the row's minimum.", ""]
+    out += ["## Variation and foot skating", "",
+            "The samples next to the example's clips (a spread needs ≥ 2 clips: – otherwise) and the neutral "
+            "training data; foot skating before any clean-up. "
+            + ", ".join(f"{k} in {VARIANCE_UNITS[k]}" for k in VARIANCE_KEYS) + ", pose_across_sd in cm.", ""]
+    for p, rows in results["variation"].items():
+        skating = results["foot_skating"][p]
+        body = []
+        for kind, v in rows.items():
+            sk = skating.get(kind)
+            body.append([kind] + [fmt(None if v is None else v[k]) for k in VARIATION_KEYS]
+                        + [pct(sk["ratio"]) if sk else "–", pct(sk["no_plant_share"]) if sk else "–"])
+        out += [f"**{p}**", "", _md_table(["motions", *VARIATION_KEYS, "foot skating", "stance foot never planted"],
+                                          body), ""]
+    pooled = results["foot_skating_pooled"]
+    out += [f"Foot skating pooled over primitives: samples {pct(pooled['samples'])}, example clips "
+            f"{pct(pooled['example'])}.", ""]
+    out += ["## Definitions", ""] + [f"* **{k}**: {DEFINITIONS[k]}" for k in
+                                     ("table_5_1", "pose_sd", "v_sd", "step_sd", "pose_across_sd", "foot_skating")]
+    return "\n".join(out) + "\n"

@@ -1,0 +1,238 @@
+"""The user's example: ``<BVH>[:start-end]`` → canonical positions → the primitives of a run.
+
+The file is read and converted exactly as the datasets convert theirs
+(:func:`stylemotion.datasets.loading.convert_motion`: any skeleton whose joints a built-in or given
+joint map names, any units, any frame rate, resampled to the run's fps). ``start-end`` are frames
+of the **file's own frame rate**, counted from 0, ``end`` exclusive (``walk.bvh:120-480`` of a
+120 fps file is seconds 1 to 4); they are cut before resampling. The converted take is labelled
+with the new style's name and the run's action and cut by
+:func:`stylemotion.primitives.segment_action` with the run's segmentation settings. When the run's
+data puts every take on one skeleton (``data.retarget``), the example is put on it too
+(:func:`on_run_skeleton`).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import re
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from stylemotion.datasets.base import Take, TakeSet
+from stylemotion.datasets.loading import ConversionSettings, convert_motion
+from stylemotion.io.bvh import parse_bvh
+from stylemotion.io.errors import MotionDataError
+from stylemotion.io.outputs import safe_name
+from stylemotion.io.sources import FileSource
+from stylemotion.primitives import Clip, Segmentation, SegmentSettings, parse_primitive, segment_action
+from stylemotion.retarget import BONE_NAMES, retarget_positions
+
+#: A frame range after the file: ``:<start>-<end>``, whatever the two parts hold (checked afterwards).
+_RANGE = re.compile(r"^(?P<path>.*[^:]):(?P<range>[^:/\\]*-[^:/\\]*)$")
+
+
+#: Rejected steps listed at most in the "no complete step" message.
+MAX_REASONS = 6
+
+
+class StyleExampleError(ValueError):
+    """A ``stylemotion-style`` input that cannot be used; the message names the key and the value."""
+
+
+@dataclass(frozen=True)
+class ExampleSpec:
+    """What ``example=`` names.
+
+    Attributes:
+        path: the BVH file, or ``archive.zip::member.bvh``.
+        start: first frame to use, at the file's frame rate (0 = the first), or None (all).
+        end: one past the last frame to use, or None (all).
+    """
+
+    path: str
+    start: int | None = None
+    end: int | None = None
+
+    @property
+    def source(self) -> FileSource:
+        path = str(Path(self.path).expanduser()) if "::" not in self.path else self.path
+        return FileSource(*path.split("::", 1)) if "::" in path else FileSource(path)
+
+    def __str__(self) -> str:
+        return self.path if self.start is None else f"{self.path}:{self.start}-{self.end}"
+
+
+def parse_example(text: str) -> ExampleSpec:
+    """``<BVH>[:start-end]`` → :class:`ExampleSpec` (the range checked for syntax only).
+
+    A value that names an existing file as a whole is that file, even if it ends like a range.
+
+    Raises:
+        StyleExampleError: an empty value, or a range that is not two whole numbers ``start < end``, ``start ≥ 0``.
+    """
+    text = str(text or "").strip()
+    if not text:
+        raise StyleExampleError("example= is empty: give a BVH file, optionally with a frame range "
+                                "(example=walk.bvh or example=walk.bvh:120-480)")
+    match = _RANGE.match(text)
+    if match is None or Path(text).expanduser().is_file():
+        return ExampleSpec(text)
+    bounds = match["range"].split("-")
+    if len(bounds) != 2 or not all(re.fullmatch(r"[0-9]+", b.strip()) for b in bounds):
+        raise StyleExampleError(f"example={text}: the frame range {match['range']!r} must be START-END, two whole "
+                                "numbers ≥ 0 of the file's frames (e.g. example=walk.bvh:120-480)")
+    start, end = (int(b) for b in bounds)
+    if start >= end:
+        raise StyleExampleError(f"example={text}: the frame range {start}-{end} is empty; START must be smaller "
+                                "than END (frames of the file, END exclusive)")
+    return ExampleSpec(match["path"], start, end)
+
+
+@dataclass
+class ConvertedExample:
+    """The example on the canonical skeleton, with where it came from.
+
+    Attributes:
+        spec: what ``example=`` named.
+        sha256: hex SHA-256 of the file's bytes (of the zip member's, for a member).
+        file_fps: the file's frame rate.
+        file_frames: frames in the whole file.
+        start, end: the frames used, at ``file_fps`` (``end`` exclusive).
+        positions: ``(frames, 21, 3)`` float32 canonical positions, metres, Y up, at ``fps``.
+        fps: frames per second of ``positions`` (the run's).
+        retarget: the skeleton it was put on (the data's ``TakeSet.retarget`` record), or None (its own bones).
+    """
+
+    spec: ExampleSpec
+    sha256: str
+    file_fps: float
+    file_frames: int
+    start: int
+    end: int
+    positions: np.ndarray
+    fps: float
+    retarget: dict[str, Any] | None = None
+
+    @property
+    def name(self) -> str:
+        """What messages and records call the file (path, or ``zip::member``)."""
+        return self.spec.source.name
+
+    def take(self, style: str, content: str) -> Take:
+        """The example as a take of ``style`` and ``content`` (named after the file)."""
+        name = safe_name(self.spec.source.stem, "example file name")
+        return Take(name, self.positions, self.fps, {"content": content, "style": style, "take": name}, self.name)
+
+    def record(self, clip: Clip) -> dict[str, Any]:
+        """Plain values that identify ``clip`` in the file: name, sha256, the clip's frames at the file's rate."""
+        scale = self.file_fps / self.fps
+        return {"file": self.name, "sha256": self.sha256, "file_fps": self.file_fps,
+                "file_range": [self.start, self.end],
+                "file_frames": [self.start + int(round(clip.start * scale)),
+                                self.start + int(round((clip.stop - 1) * scale)) + 1]}
+
+
+def convert_example(spec: ExampleSpec, settings: ConversionSettings) -> ConvertedExample:
+    """Read, cut and convert the example (see the module doc).
+
+    Raises:
+        StyleExampleError: the range lies outside the file, or the file cannot be read or converted (a
+            skeleton no joint map fits, bad units, a malformed BVH: the message names the file and says
+            which key helps).
+    """
+    source = spec.source
+    try:
+        data = source.read_bytes(settings.max_file_mb)
+        motion = parse_bvh(data, source.name, settings.max_joint_frames)
+    except MotionDataError as exc:
+        raise StyleExampleError(f"example={spec}: {exc}") from exc
+    total = motion.num_frames
+    start, end = (0, total) if spec.start is None else (spec.start, spec.end)
+    if end > total:
+        raise StyleExampleError(f"example={spec}: the frame range {start}-{end} ends after the file's last frame: "
+                                f"{source.name} has {total} frames (0-{total}) at {motion.fps:g} fps")
+    cut = replace(motion, rotations=motion.rotations[start:end], translations=motion.translations[start:end])
+    try:
+        positions = convert_motion(cut, settings)
+    except MotionDataError as exc:
+        hint = (" Name its joints with joint_map=<map.yaml> (joints: {Hips: <its hips>, ...}, all 21 canonical "
+                "joints) or a built-in map (joint_map=bandai|cmu21|cmu31)") if "joint map" in str(exc) else ""
+        raise StyleExampleError(f"example={spec}: {exc}.{hint}") from exc
+    return ConvertedExample(spec, hashlib.sha256(data).hexdigest(), float(motion.fps), total, start, end,
+                            positions, float(settings.fps))
+
+
+def on_run_skeleton(example: ConvertedExample, takeset: TakeSet) -> ConvertedExample:
+    """The example on the one skeleton of the run's data when the data is retargeted (``data.retarget``:
+    :func:`stylemotion.retarget.retarget_positions` to the bone lengths ``takeset.retarget`` records), as
+    every take of it; else ``example`` itself.
+
+    Raises:
+        StyleExampleError: its bones cannot be put on that skeleton (naming the bone).
+    """
+    record = getattr(takeset, "retarget", None)
+    if not record:
+        return example
+    target = np.array([record["bone_lengths_m"][bone] for bone in BONE_NAMES])
+    try:
+        positions = retarget_positions(example.positions, target).astype(np.float32)
+    except ValueError as exc:
+        raise StyleExampleError(f"example={example.spec}: cannot put it on the run's skeleton (data.retarget="
+                                f"{record.get('style')}): {exc}") from None
+    return replace(example, positions=positions, retarget=dict(record))
+
+
+@dataclass
+class CutExample:
+    """The example's clips for each primitive of a run.
+
+    Attributes:
+        segmentation: the example take's segmentation (clips, rejected and border steps).
+        clips: run primitive → the clips of that primitive cut from the example.
+        used: run primitive → the clips its model is conditioned on: its own, or, where the example has
+            none of that primitive, every clip of the same action (the thesis' example is one clip of any
+            primitive); primitives of another action than the example's are absent.
+        borrowed: run primitives whose ``used`` clips are of other primitives.
+        skipped: run primitives of another action than the example's.
+    """
+
+    segmentation: Segmentation
+    clips: dict[str, list[Clip]]
+    used: dict[str, list[Clip]]
+    borrowed: list[str] = field(default_factory=list)
+    skipped: list[str] = field(default_factory=list)
+
+
+def cut_example(example: ConvertedExample, style: str, action: str, primitives: Sequence[str],
+                settings: SegmentSettings | Mapping[str, Any] | None) -> CutExample:
+    """Segment the example as a take of ``action`` and pick the clips of each run primitive.
+
+    Raises:
+        StyleExampleError: no clip of any primitive of the run's ``action`` (no complete step); the
+            message lists why each step was not cut.
+    """
+    segmentation = segment_action([example.take(style, action)], action, SegmentSettings.from_dict(settings))
+    clips = {p: [c for c in segmentation.clips if f"{c.action}_{c.primitive}" == p] for p in primitives}
+    same_action = [c for c in segmentation.clips if c.action == action]
+    ours = [p for p in primitives if parse_primitive(p)[0] == action]
+    if not any(clips[p] for p in ours):
+        shown = segmentation.rejections[:MAX_REASONS]
+        reasons = "; ".join(r.reason + ("" if r.start is None else f" (frames {r.start}-{r.stop} at {example.fps:g} "
+                                                                   "fps)") for r in shown) or "no step found"
+        if len(segmentation.rejections) > len(shown):
+            reasons += f"; … {len(segmentation.rejections) - len(shown)} more"
+        cut = ", ".join(sorted({c.primitive for c in same_action})) or "none"
+        raise StyleExampleError(
+            f"example={example.spec}: no complete step of the run's primitives {ours} can be cut from it "
+            f"({example.positions.shape[0]} frames at {example.fps:g} fps after conversion; primitives cut: {cut}). "
+            f"Why: {reasons}. Give a longer {action} with at least one whole step between two support transfers")
+    used, borrowed = {}, []
+    for p in ours:
+        used[p] = clips[p] or same_action
+        if not clips[p]:
+            borrowed.append(p)
+    return CutExample(segmentation, clips, used, borrowed, [p for p in primitives if p not in ours])
