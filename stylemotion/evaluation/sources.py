@@ -109,7 +109,9 @@ def load_model(path: str | Path, neutral_style: str = "normal", autoencoder=None
                      examples=[dict(e) for e in spec.get("style_examples") or []] if styled else [],
                      autoencoder=dict(spec["autoencoder"]), checkpoint=str(path),
                      timeline_frames=int(spec["timeline_frames"]),
-                     target_gram=model.style_gram.detach().clone() if styled else None,
+                     # a centred style term keeps a covariance, not the thesis' Gram that Table 5.1 recomputes
+                     target_gram=(model.style_gram.detach().clone()
+                                  if styled and not model.hparams.get("style_centred", False) else None),
                      dataset=spec.get("dataset"), example_length=spec.get("example_length") or "canonical")
 
 

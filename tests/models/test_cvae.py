@@ -12,7 +12,7 @@ from vae_fixtures import TINY_HIDDEN, feature_module, fit, tiny_autoencoder_ckpt
 from stylemotion.datamodules.clips import NoClipsError
 from stylemotion.datamodules.features import ReceptiveFieldError, encode_examples
 from stylemotion.models.autoencoder import IncompatibleModelError, MotionAutoencoder
-from stylemotion.models.cvae import StyleCVAE
+from stylemotion.models.cvae import StyleCVAE, content_spread, margin_excess
 from stylemotion.models.style import feature_style_distance, gram, mean_gram
 from stylemotion.models.vae import PrimitiveVAE
 
@@ -107,3 +107,55 @@ def test_cvae_needs_a_style_and_keeps_it(ae_ckpt, elderly) -> None:
     other = feature_module(ae_ckpt, style="youthful")
     with pytest.raises(IncompatibleModelError, match="models style 'elderly', the data selects style 'youthful'"):
         model._check_spec(other.model_spec())
+
+
+def test_margin_excess_is_zero_inside_the_ball_and_scale_free() -> None:
+    distance = torch.tensor([0.5, 1.0, 1.5, 3.0])
+    # inside (or on) the radius costs nothing; outside, the squared excess relative to the radius
+    assert margin_excess(distance, 1.0).item() == pytest.approx((0.5**2 + 2.0**2) / 4)
+    assert margin_excess(torch.tensor([0.2, 0.9]), 1.0).item() == 0.0
+    # the same configuration in other Gram units gives the same value
+    assert margin_excess(distance * 37.0, 37.0).item() == pytest.approx(margin_excess(distance, 1.0).item())
+
+
+def test_content_spread_is_the_median_distance_to_the_mean_gram() -> None:
+    generator = torch.Generator().manual_seed(0)
+    features = torch.randn(9, 6, 5, generator=generator)
+    centre = (features @ features.transpose(1, 2) / 5).mean(0)
+    expected = torch.linalg.matrix_norm(features @ features.transpose(1, 2) / 5 - centre).median()
+    assert content_spread(features) == pytest.approx(float(expected), rel=1e-5)
+    assert content_spread(features[:1].repeat(4, 1, 1)) < 1e-3 * float(expected)  # copies: no spread
+
+
+def test_margin_and_centred_terms_in_the_model(elderly) -> None:
+    model = StyleCVAE(spec=elderly.model_spec(), style_term="margin", style_margin=2.0, style_centred=True)
+    model._install_stats(elderly)
+    train = elderly.datasets["train"].features
+    centred = train - train.mean(-1, keepdim=True)
+    assert model.style_radius == pytest.approx(2.0 * content_spread(centred), rel=1e-5)
+    # a centred term does not see a constant offset of any channel over the clip
+    shifted = train[:4] + torch.linspace(-3, 3, train.shape[1])[:, None]
+    assert torch.allclose(model.style_distance(shifted), model.style_distance(train[:4]), rtol=1e-4)
+    plain = StyleCVAE(spec=elderly.model_spec())
+    plain._install_stats(elderly)
+    assert not torch.allclose(plain.style_distance(shifted), plain.style_distance(train[:4]), rtol=1e-2)
+    # the margin term is what is optimized; the distance is still logged
+    terms = model._extra_losses(model.normalize(train[:3], elderly.datasets["train"].duration_s[:3])[None])
+    assert terms["style"][1] == 0.0 and terms["style_excess"][1] == model.hparams.style_weight
+    with pytest.raises(ValueError, match="style_term"):
+        StyleCVAE(style_term="hinge")
+    with pytest.raises(ValueError, match="style_margin"):
+        StyleCVAE(style_margin=0.0)
+
+
+def test_checkpoints_from_before_the_margin_term_still_load(elderly, tmp_path) -> None:
+    cvae = StyleCVAE(samples_per_item=2)
+    fit(cvae, elderly, steps=2, folder=tmp_path)
+    checkpoint = torch.load(tmp_path / "best.ckpt", weights_only=True)
+    del checkpoint["state_dict"]["content_spread"]
+    for key in ("style_term", "style_margin", "style_centred"):
+        checkpoint["hyper_parameters"].pop(key)
+    torch.save(checkpoint, tmp_path / "old.ckpt")
+    loaded = StyleCVAE.load_from_checkpoint(tmp_path / "old.ckpt")
+    assert loaded.hparams.style_term == "distance" and torch.isnan(loaded.content_spread)
+    assert torch.allclose(loaded.style_gram, cvae.style_gram)
