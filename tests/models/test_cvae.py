@@ -44,7 +44,7 @@ def test_style_term_pulls_samples_to_the_example_and_the_example_is_recorded(eld
     vae = PrimitiveVAE(samples_per_item=4)
     fit(vae, elderly, steps=100)
     torch.manual_seed(0)
-    cvae = StyleCVAE(samples_per_item=4, style_weight=20.0)  # the synthetic data's α (configs/budget/synthetic.yaml)
+    cvae = StyleCVAE(samples_per_item=4, style_weight=20.0)  # strong enough for 100 steps of this tiny test
     fit(cvae, elderly, steps=100, folder=tmp_path)
     (vae_direct, vae_motion), (cvae_direct, cvae_motion) = _style_distances(vae, target), _style_distances(cvae, target)
     # the CVAE's samples are much closer to the elderly example than the VAE's (the tiny autoencoder's
