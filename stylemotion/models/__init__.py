@@ -14,7 +14,8 @@ from stylemotion.models.checkpoints import load_autoencoder, load_generative
 from stylemotion.models.cvae import StyleCVAE
 from stylemotion.models.style import gram, mean_gram
 from stylemotion.models.vae import MLPVAE, PrimitiveVAE
+from stylemotion.models.zero_shot import ZeroShotStyleVAE
 
 __all__ = ["MLPVAE", "ConvAutoencoder", "IncompatibleModelError", "MotionAutoencoder", "NonFiniteLossError",
-           "PrimitiveVAE", "StyleCVAE", "gram", "load_autoencoder", "load_generative", "local_mpjpe", "mean_gram",
-           "mpjpe"]
+           "PrimitiveVAE", "StyleCVAE", "ZeroShotStyleVAE", "gram", "load_autoencoder", "load_generative",
+           "local_mpjpe", "mean_gram", "mpjpe"]

@@ -8,8 +8,10 @@ version.
 
 What a checkpoint is, from its hyperparameters (:func:`checkpoint_kind`): a
 :class:`~stylemotion.models.autoencoder.MotionAutoencoder` (frame layout keys), a
-:class:`~stylemotion.models.vae.PrimitiveVAE` (a data ``spec``) or a
-:class:`~stylemotion.models.cvae.StyleCVAE` (a ``spec`` and a ``style_weight``).
+:class:`~stylemotion.models.vae.PrimitiveVAE` (a data ``spec``), a
+:class:`~stylemotion.models.cvae.StyleCVAE` (a ``spec`` and a ``style_weight``) or a
+:class:`~stylemotion.models.zero_shot.ZeroShotStyleVAE` (a ``spec`` and an ``embedding_dim``; it samples
+only given a style example, so folder searches for evaluation, :func:`is_model_checkpoint`, skip it).
 
 Generative models decode through the autoencoder their features came from. Their checkpoints embed
 it (key :data:`EMBEDDED_AUTOENCODER`: its hyperparameters and state dict, about 2 MB), so they load
@@ -43,7 +45,9 @@ EMBEDDED_AUTOENCODER = "autoencoder"
 #: Hyperparameters every MotionAutoencoder checkpoint has.
 AUTOENCODER_KEYS = ("hidden_units", "kernel_size", "representation", "fps")
 #: Kinds of checkpoint (see :func:`checkpoint_kind`).
-KINDS = ("autoencoder", "vae", "cvae")
+KINDS = ("autoencoder", "vae", "cvae", "zero_shot")
+#: Kinds of generative model (their checkpoints embed the autoencoder; :func:`load_generative` loads them).
+GENERATIVE_KINDS = ("vae", "cvae", "zero_shot")
 
 
 class MissingAutoencoderError(FileNotFoundError):
@@ -81,8 +85,11 @@ def checkpoint_hparams(path: str | os.PathLike) -> dict[str, Any]:
 
 
 def checkpoint_kind(hparams: Mapping[str, Any]) -> str | None:
-    """``autoencoder``, ``vae`` or ``cvae`` from a checkpoint's hyperparameters; None for anything else."""
+    """``autoencoder``, ``vae``, ``cvae`` or ``zero_shot`` from a checkpoint's hyperparameters; None for anything
+    else."""
     if isinstance(hparams.get("spec"), Mapping):
+        if "embedding_dim" in hparams:
+            return "zero_shot"
         return "cvae" if "style_weight" in hparams else "vae"
     if all(k in hparams for k in AUTOENCODER_KEYS):
         return "autoencoder"
@@ -93,8 +100,10 @@ def model_class(kind: str) -> type[pl.LightningModule]:
     """The LightningModule class of a checkpoint kind (see :data:`KINDS`)."""
     from stylemotion.models.cvae import StyleCVAE  # the model modules import this one
     from stylemotion.models.vae import PrimitiveVAE
+    from stylemotion.models.zero_shot import ZeroShotStyleVAE
 
-    classes = {"autoencoder": MotionAutoencoder, "vae": PrimitiveVAE, "cvae": StyleCVAE}
+    classes = {"autoencoder": MotionAutoencoder, "vae": PrimitiveVAE, "cvae": StyleCVAE,
+               "zero_shot": ZeroShotStyleVAE}
     if kind not in classes:
         raise ValueError(f"unknown checkpoint kind {kind!r}; kinds: {list(KINDS)}")
     return classes[kind]
@@ -201,7 +210,7 @@ def load_autoencoder(path: str | os.PathLike, expected: Mapping[str, Any] | None
     checkpoint = read_checkpoint(path, "autoencoder checkpoint")
     saved = checkpoint.get("hyper_parameters") or {}
     kind = checkpoint_kind(saved)
-    if kind in ("vae", "cvae") and isinstance(checkpoint.get(EMBEDDED_AUTOENCODER), Mapping):
+    if kind in GENERATIVE_KINDS and isinstance(checkpoint.get(EMBEDDED_AUTOENCODER), Mapping):
         return autoencoder_from_record(checkpoint[EMBEDDED_AUTOENCODER], str(path), expected)
     if kind != "autoencoder":
         raise IncompatibleModelError(f"{path} is not a MotionAutoencoder checkpoint (its hyperparameters lack "
@@ -290,8 +299,8 @@ def resolve_autoencoder(info: Mapping[str, Any], record: Mapping[str, Any] | Non
 
 
 def load_generative(path: str | os.PathLike, autoencoder: MotionAutoencoder | None = None) -> pl.LightningModule:
-    """A trained :class:`~stylemotion.models.vae.PrimitiveVAE` or
-    :class:`~stylemotion.models.cvae.StyleCVAE` (class from its hyperparameters), eval mode, CPU.
+    """A trained :class:`~stylemotion.models.vae.PrimitiveVAE`, :class:`~stylemotion.models.cvae.StyleCVAE`
+    or :class:`~stylemotion.models.zero_shot.ZeroShotStyleVAE` (class from its hyperparameters), eval mode, CPU.
 
     Args:
         path: its checkpoint (``~`` expanded).
@@ -305,9 +314,9 @@ def load_generative(path: str | os.PathLike, autoencoder: MotionAutoencoder | No
     checkpoint = read_checkpoint(path, "model checkpoint")
     hparams = checkpoint.get("hyper_parameters") or {}
     kind = checkpoint_kind(hparams)
-    if kind not in ("vae", "cvae"):
-        raise IncompatibleModelError(f"{path} is not a trained PrimitiveVAE/StyleCVAE checkpoint (no data spec in "
-                                     f"its hyperparameters; it has {sorted(hparams)[:12]})")
+    if kind not in GENERATIVE_KINDS:
+        raise IncompatibleModelError(f"{path} is not a trained PrimitiveVAE/StyleCVAE/ZeroShotStyleVAE checkpoint "
+                                     f"(no data spec in its hyperparameters; it has {sorted(hparams)[:12]})")
     model = restore(model_class(kind), checkpoint, str(path))
     model.checkpoint_file = str(path.resolve())
     if autoencoder is not None:

@@ -98,7 +98,9 @@ def feature_style_distance(features: torch.Tensor, target_gram: torch.Tensor | N
     Args:
         features: ``(..., channels, time)``.
         target_gram: ``(channels, channels)``; or give its factor ``target_factor`` ``(channels, rank)``
-            (e.g. cached by a model) instead.
+            (e.g. cached by a model) instead. A factor with leading dims ``(..., channels, rank)`` gives one
+            target per sequence (broadcast against the features' leading dims), e.g. the features of each
+            sequence's own example scaled by ``1/sqrt(time)``.
 
     Returns:
         ``(...)``.
@@ -117,6 +119,6 @@ def feature_style_distance(features: torch.Tensor, target_gram: torch.Tensor | N
     ff = features.transpose(-1, -2) @ features  # (..., T, T)
     wf = target_factor.transpose(-1, -2) @ features  # (..., rank, T)
     ww = target_factor.transpose(-1, -2) @ target_factor
-    target_sq = ww.square().sum()
+    target_sq = ww.square().sum((-1, -2))
     squared = ff.square().sum((-1, -2)) / steps**2 - 2 * wf.square().sum((-1, -2)) / steps + target_sq
     return squared.clamp_min(1e-12 * target_sq.clamp_min(1e-30)).sqrt().to(dtype)
