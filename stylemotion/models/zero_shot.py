@@ -1,0 +1,459 @@
+"""One network for every style: a VAE conditioned on an embedding of one style example (beyond the thesis).
+
+The thesis trains one :class:`~stylemotion.models.cvae.StyleCVAE` per style (§5.3.3): the neutral clips
+plus a Gram term towards that style's example. :class:`ZeroShotStyleVAE` is trained **once** on the
+clips of many styles and generates a style from one example clip, also a style it never saw, with no
+further training.
+
+Feature space: that of :class:`~stylemotion.models.vae.PrimitiveVAE` (its normalization, duration value,
+decoding, checkpoint embedding of the autoencoder are inherited): ``y`` = the frozen autoencoder's
+features of a clip on the canonical timeline, normalized, plus its standardized log-duration.
+
+Style embedding ``e`` (``embedding_dim`` values, 32) of an example's raw features ``X`` ``(C, T')``::
+
+    d(X) = [mean_t X, std_t X]           each channel's mean and standard deviation over time (2C values)
+    e    = P (d(X) − d̄) / s              P: the leading principal axes (E, 2C) of d over the training
+                                          clips, d̄ their mean, s one common scale (root mean variance
+                                          of the projections)
+
+``P``, ``d̄`` and ``s`` are fitted once, at the first ``setup``, on the train split (every trained style)
+and are buffers. Several example clips: the mean of their embeddings.
+
+Why moments and not the Gram matrix: measured on the synthetic data (``walk_leftStance``, autoencoder
+of a ``stylemotion-reproduce`` run), the style of a held-out val/test clip recovered as the nearest of
+the 7 styles' single example clips, the embedding fitted without the clip's style: moments → PCA 32:
+70 % (clips of the left-out style; 73 % of the others); the full Gram's upper triangle → PCA 32: 59 %
+(64 %); the raw Gram distance itself, no embedding: 64 %; a trace-normalized Gram or a log-Gram of 16
+principal channels: 70 % but C² values per clip. The moments are as discriminative as the best, cost
+2C values per clip and leave a 32 × 512 basis in the checkpoint instead of 32 × 32,896.
+
+Network (:class:`ConditionalMLPVAE`): :class:`~stylemotion.models.vae.MLPVAE` with ``e`` concatenated to
+the encoder's and the decoder's input: ``q(z | y, e)``, ``p(y | z, e)``, prior ``N(0, I)``. With ``anchor``
+(the default) the example itself, ``a`` = its normalized features (duration value 0), is added to the
+decoder's output and taken from the encoder's input: ``y = a + decoder(z, e)``,
+``q(z | y − a, e)``: the network models a clip as its example plus a variation of the example's style.
+
+Why the anchor: leaving each style of the synthetic data out in turn (6 styles × 2 stance primitives, 30
+epochs, 1,000 samples from the style's one example; ``scripts/zero_shot_loso.py``, docs/zero_shot.md), the
+run's style classifier recognizes 17 % of the embedding-only network's samples as the left-out style (0 %
+but for ``exhausted``, which lies between trained styles: the decoder maps an unseen embedding onto the
+nearest style it knows; for elderly on walk_leftStance a Gram style term of weight 20 did not change that)
+and 99 % of the anchored network's. Conditioned on the examples of styles they were trained on, both give
+99–100 %.
+
+Training (:class:`~stylemotion.datamodules.multistyle.MultiStyleDataModule`): each clip ``y_i`` with the
+example ``X_i``, **another** clip of its style, so one example has to stand for the style::
+
+    loss = recon + kl_weight · KL + style_weight · mean ‖Gram(decoded) − Gram(X_i)‖_F
+
+the style term (optional, 0 by default: with the anchor, weight 20 collapses the samples onto the example,
+their spread across samples falling from 55 % to 18 % of the real elderly clips';
+:func:`stylemotion.models.style.feature_style_distance`, each decoded sequence against its own item's
+example) over posterior and/or prior codes (``style_latents``, as :class:`~stylemotion.models.cvae.StyleCVAE`);
+logged as ``style`` on val/test whatever its weight.
+
+Sampling: :meth:`ZeroShotStyleVAE.sample` ``(n, seed, example=…)``, or :meth:`ZeroShotStyleVAE.bind_example`,
+which returns a :class:`BoundExample` with the ``sample(n, seed)`` of every other model.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import torch
+from torch import nn
+
+from stylemotion.models.cvae import STYLE_LATENTS
+from stylemotion.models.style import feature_style_distance, mean_gram
+from stylemotion.models.vae import MLPVAE, PrimitiveVAE, kl_divergence, reconstruction_loss
+from stylemotion.primitives import time_normalize
+from stylemotion.sampling import DEFAULT_CHUNK, MotionSamples, decode_features, masked_mpjpe
+
+
+class ConditionalMLPVAE(MLPVAE):
+    """:class:`MLPVAE` whose encoder and decoder also take a condition ``e`` (concatenated to their input).
+
+    Args:
+        input_dim: ``D``, values per item.
+        condition_dim: ``E``, values of the condition.
+        latent_dim, hidden: as :class:`MLPVAE`.
+    """
+
+    def __init__(self, input_dim: int, condition_dim: int, latent_dim: int = 32,
+                 hidden: Sequence[int] = (512, 256, 128)):
+        super().__init__(input_dim, latent_dim, hidden)
+        if condition_dim < 1:
+            raise ValueError(f"condition_dim must be ≥ 1, got {condition_dim}")
+        self.condition_dim = int(condition_dim)
+        first, last = self.encoder[0], self.decoder[0]
+        self.encoder[0] = nn.Linear(first.in_features + self.condition_dim, first.out_features)
+        self.decoder[0] = nn.Linear(last.in_features + self.condition_dim, last.out_features)
+
+    def encode(self, y: torch.Tensor, e: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+        """``(batch, D)`` items and ``(batch, E)`` (or ``(E,)``) conditions → mean and log-variance ``(batch, k)``."""
+        return super().encode(torch.cat([y, e.expand(*y.shape[:-1], self.condition_dim)], -1))
+
+    def decode(self, z: torch.Tensor, e: torch.Tensor) -> torch.Tensor:
+        """``(..., k)`` codes and conditions broadcasting to ``(..., E)`` → ``(..., D)``."""
+        return super().decode(torch.cat([z, e.expand(*z.shape[:-1], self.condition_dim)], -1))
+
+    def forward(self, y: torch.Tensor, e: torch.Tensor, samples: int = 1,
+                generator: torch.Generator | None = None):
+        """Returns ``(recon (samples, batch, D), mean (batch, k), logvar (batch, k), z (samples, batch, k))``."""
+        mean, logvar = self.encode(y, e)
+        z = self.reparameterize(mean, logvar, samples, generator)
+        return self.decode(z, e), mean, logvar, z
+
+
+def style_descriptor(features: torch.Tensor) -> torch.Tensor:
+    """``(..., C, T')`` raw features → ``(..., 2C)``: each channel's mean, then its (population)
+    standard deviation over time."""
+    if features.dim() < 2 or features.shape[-1] < 1:
+        raise ValueError(f"features must be (..., channels, time ≥ 1), got shape {tuple(features.shape)}")
+    return torch.cat([features.mean(-1), features.std(-1, unbiased=False)], -1)
+
+
+def fit_style_basis(descriptors: torch.Tensor, dim: int) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+    """The embedding's PCA: mean ``(2C,)``, axes ``(dim, 2C)`` (sign: largest entry positive) and one
+    scale ``()`` (root mean variance of the projections), from descriptors ``(n, 2C)``.
+
+    Raises:
+        ValueError: ``dim`` exceeds ``n − 1`` or the descriptor size (the message names ``embedding_dim``).
+    """
+    n, width = descriptors.shape
+    if not 1 <= dim <= min(n - 1, width):
+        raise ValueError(f"model.embedding_dim={dim} needs at least {dim + 1} training clips and at most {width} "
+                         f"descriptor values; the data has {n} training clips")
+    x = descriptors.double()
+    mean = x.mean(0)
+    _, _, vt = torch.linalg.svd(x - mean, full_matrices=False)
+    axes = vt[:dim]
+    flip = axes.gather(1, axes.abs().argmax(1, keepdim=True)).sign()
+    axes = axes * torch.where(flip == 0, 1.0, flip)
+    scale = ((x - mean) @ axes.T).square().mean().sqrt().clamp_min(1e-12)
+    return mean.float(), axes.float(), scale.float()
+
+
+class ZeroShotStyleVAE(PrimitiveVAE):
+    """A primitive's generative model for any style given one example (see the module doc).
+
+    Logged per split: ``loss``, ``recon``, ``kl``, ``style`` (training: only with ``style_weight > 0``);
+    on val/test ``mpjpe`` and ``duration_error`` as :class:`PrimitiveVAE` (posterior-mean reconstructions
+    conditioned on each clip's example).
+
+    Args:
+        embedding_dim: ``E``, values of the style embedding (32).
+        anchor: also add the example's normalized features to the decoder's output (and subtract them from the
+            encoder's input): the network models a clip as its example plus a variation (see the module doc).
+        style_weight: weight of the Gram style term (0: off).
+        style_latents: codes the style term decodes: ``posterior``, ``prior`` or ``both``.
+        spec: what the model knows about its data (filled in at the first ``setup``).
+        **kwargs: :class:`PrimitiveVAE` arguments (latent_dim, hidden, samples_per_item, kl_weight, …).
+    """
+
+    def __init__(self, embedding_dim: int = 32, anchor: bool = True, style_weight: float = 0.0,
+                 style_latents: str = "both", spec: dict[str, Any] | None = None, **kwargs: Any):
+        super().__init__(**kwargs)  # built below, once this class' hyperparameters are known
+        if isinstance(embedding_dim, bool) or int(embedding_dim) != embedding_dim or embedding_dim < 1:
+            raise ValueError(f"embedding_dim must be a whole number ≥ 1, got {embedding_dim!r}")
+        if not style_weight >= 0:
+            raise ValueError(f"style_weight must be ≥ 0, got {style_weight}")
+        if style_latents not in STYLE_LATENTS:
+            raise ValueError(f"style_latents must be one of {STYLE_LATENTS}, got {style_latents!r}")
+        self.save_hyperparameters({**dict(self.hparams), "embedding_dim": int(embedding_dim), "anchor": bool(anchor),
+                                   "style_weight": float(style_weight), "style_latents": str(style_latents),
+                                   "spec": None if spec is None else dict(spec)})
+        if spec is not None:
+            self._build(spec)
+
+    # -- construction from the data
+
+    def _build(self, spec: dict[str, Any]) -> None:
+        super()._build(spec)
+        channels, steps = int(spec["feature_channels"]), int(spec["feature_steps"])
+        dim = self.hparams.embedding_dim
+        self.net = ConditionalMLPVAE(channels * steps + 1, dim, self.hparams.latent_dim, self.hparams.hidden)
+        self.register_buffer("style_mean", torch.zeros(2 * channels))
+        self.register_buffer("style_axes", torch.zeros(dim, 2 * channels))
+        self.register_buffer("style_scale", torch.ones(()))
+
+    def _adapt_spec(self, spec: dict[str, Any]) -> dict[str, Any]:
+        if "excluded_styles" not in spec:
+            raise ValueError("ZeroShotStyleVAE trains on clips of several styles paired with style examples: use "
+                             "stylemotion.datamodules.multistyle.MultiStyleDataModule (experiment=zero_shot)")
+        return dict(spec)
+
+    def _install_stats(self, datamodule) -> None:
+        super()._install_stats(datamodule)
+        mean, axes, scale = fit_style_basis(style_descriptor(datamodule.datasets["train"].features),
+                                            self.hparams.embedding_dim)
+        self.style_mean.copy_(mean)
+        self.style_axes.copy_(axes)
+        self.style_scale.copy_(scale)
+
+    # -- what the model knows
+
+    @property
+    def styles(self) -> list[str]:
+        """The styles it was trained on."""
+        return list(self.spec["styles"])
+
+    @property
+    def excluded_styles(self) -> list[str]:
+        """The data's styles it never saw (left out of training)."""
+        return list(self.spec["excluded_styles"])
+
+    # -- the condition: style embedding (and anchor)
+
+    def embed(self, features: torch.Tensor) -> torch.Tensor:
+        """Raw autoencoder features ``(..., C, T')`` (any ``T'``) → embeddings ``(..., E)``."""
+        d = style_descriptor(features.to(self.style_mean))
+        return (d - self.style_mean) @ self.style_axes.T / self.style_scale
+
+    def anchor(self, features: torch.Tensor) -> torch.Tensor:
+        """Raw features ``(..., C, T')`` of examples on the canonical timeline → ``(..., D)`` in model space (as
+        :meth:`normalize`, the duration value 0: the mean log-duration)."""
+        steps = int(self.spec["feature_steps"])
+        if features.shape[-1] != steps:
+            raise ValueError(f"an anchored model needs examples of {steps} feature steps (encoded at the canonical "
+                             f"length of {self.timeline_frames} frames), got {features.shape[-1]}")
+        z = (features.to(self.feature_mean) - self.feature_mean[:, None]) / self.feature_std[:, None]
+        return torch.cat([z.flatten(-2), z.new_zeros(z.shape[:-2] + (1,))], -1)
+
+    def batch_condition(self, examples: torch.Tensor) -> StyleCondition:
+        """The condition of each item of a batch from its example's raw features ``(batch, C, T')``."""
+        examples = examples.to(self.style_mean)
+        return StyleCondition(self.embed(examples), self.anchor(examples) if self.hparams.anchor else None)
+
+    @torch.no_grad()
+    def example_features(self, example: Any) -> list[torch.Tensor]:
+        """An example as raw features ``[(C, T'), …]`` on this model's device.
+
+        Args:
+            example: features ``(C, T')`` or ``(n, C, T')``, a list of such tensors, or clips (anything
+                with ``frames`` ``(frames, 66)``, e.g. :class:`~stylemotion.primitives.Clip`), one or a
+                list: resampled to the canonical timeline and encoded by the autoencoder, as the
+                training clips were.
+
+        Raises:
+            ValueError: nothing given, or features of another channel count.
+        """
+        items = list(example) if isinstance(example, (list, tuple)) else [example]
+        if not items or (isinstance(example, torch.Tensor) and example.dim() not in (2, 3)):
+            raise ValueError("example must be features (C, T') or (n, C, T'), a list of them, or clip(s) with "
+                             f"frames; got {type(example).__name__} {tuple(getattr(example, 'shape', ()))}")
+        out: list[torch.Tensor] = []
+        for item in items:
+            if hasattr(item, "frames") and not isinstance(item, torch.Tensor):
+                frames = torch.from_numpy(time_normalize(item.frames, self.timeline_frames)).float()
+                out.append(self.autoencoder.encode(frames[None].to(self.device))[0])
+            else:
+                tensor = torch.as_tensor(item, dtype=torch.float32, device=self.device)
+                out += list(tensor) if tensor.dim() == 3 else [tensor]
+        channels = int(self.spec["feature_channels"])
+        bad = [tuple(f.shape) for f in out if f.dim() != 2 or f.shape[0] != channels]
+        if bad:
+            raise ValueError(f"example features must be ({channels}, time) each (this model's autoencoder has "
+                             f"{channels} channels), got {bad}")
+        return out
+
+    @torch.no_grad()
+    def condition(self, example: Any) -> StyleCondition:
+        """The condition of one example (see :meth:`example_features`; a :class:`StyleCondition` is returned
+        as it is): the mean embedding of its clip(s), and with ``anchor`` their mean anchor."""
+        if isinstance(example, StyleCondition):
+            return example
+        if example is None:
+            raise ValueError("ZeroShotStyleVAE generates the style of an example: pass example=<features or clip>, "
+                             "or use model.bind_example(example).sample(n, seed)")
+        features = self.example_features(example)
+        embedding = torch.stack([self.embed(f) for f in features]).mean(0)
+        anchor = torch.stack([self.anchor(f) for f in features]).mean(0) if self.hparams.anchor else None
+        return StyleCondition(embedding, anchor)
+
+    def bind_example(self, example: Any, style: str | None = None,
+                     records: Sequence[dict[str, Any]] | None = None) -> BoundExample:
+        """This model with one style example bound: a sampler with ``sample(n, seed)`` (see :class:`BoundExample`).
+
+        Args:
+            example: as :meth:`example_features`.
+            style: the style's name (for reports).
+            records: plain-value records of the example clip(s) (take, start, stop, …).
+        """
+        return BoundExample(self, self.example_features(example), style, records)
+
+    # -- objective
+
+    def _decode(self, z: torch.Tensor, condition: StyleCondition) -> torch.Tensor:
+        """``(..., k)`` codes → ``(..., D)`` model space (plus the anchor, when there is one)."""
+        out = self.net.decode(z, condition.embedding)
+        return out if condition.anchor is None else out + condition.anchor
+
+    def _encode(self, y: torch.Tensor, condition: StyleCondition) -> tuple[torch.Tensor, torch.Tensor]:
+        """``(batch, D)`` → posterior mean and log-variance ``(batch, k)`` (of ``y`` − anchor, when anchored)."""
+        return self.net.encode(y if condition.anchor is None else y - condition.anchor, condition.embedding)
+
+    def _style_term(self, recon: torch.Tensor, condition: StyleCondition, examples: torch.Tensor,
+                    generator: torch.Generator | None) -> torch.Tensor:
+        """Mean Gram distance of decoded sequences to their item's example: ``recon`` ``(L, batch, D)``,
+        ``examples`` ``(batch, C, T_x)`` raw features."""
+        decoded = []
+        if self.hparams.style_latents in ("posterior", "both"):
+            decoded.append(recon)
+        if self.hparams.style_latents in ("prior", "both"):
+            z = torch.randn(recon.shape[:-1] + (self.hparams.latent_dim,), generator=generator,
+                            device=recon.device, dtype=recon.dtype)
+            decoded.append(self._decode(z, condition))
+        features, _ = self.denormalize(torch.cat(decoded), clamp=False)  # (L', batch, C, T')
+        factor = examples / math.sqrt(examples.shape[-1])  # Gram(X) = (X/√T)(X/√T)ᵀ
+        return feature_style_distance(features, target_factor=factor).mean()
+
+    def losses(self, batch: dict[str, torch.Tensor],
+               generator: torch.Generator | None = None) -> dict[str, torch.Tensor]:
+        """``loss`` and its terms on a batch with ``example_features`` ``(batch, C, T_x)`` (see the module doc)."""
+        y = self.normalize(batch["features"], batch["duration_s"])
+        examples = batch["example_features"].to(y)
+        condition = self.batch_condition(examples)
+        mean, logvar = self._encode(y, condition)
+        z = self.net.reparameterize(mean, logvar, self.hparams.samples_per_item, generator)
+        recon = self._decode(z, condition)
+        weights = torch.ones(y.shape[-1], device=y.device, dtype=y.dtype)
+        weights[-1] = self.hparams.duration_weight
+        out = {"recon": reconstruction_loss(recon, y, weights), "kl": kl_divergence(mean, logvar)}
+        total = out["recon"] + self.hparams.kl_weight * out["kl"]
+        if self.hparams.style_weight > 0 or not self.training:
+            out["style"] = self._style_term(recon, condition, examples, generator)
+            total = total + self.hparams.style_weight * out["style"]
+        out["loss"] = total
+        return out
+
+    def _eval_step(self, batch: dict[str, torch.Tensor], batch_idx: int, split: str) -> None:
+        generator = torch.Generator(device=self.device).manual_seed(batch_idx)  # the same noise every epoch
+        terms = self.losses(batch, generator)
+        with torch.no_grad():
+            condition = self.batch_condition(batch["example_features"])
+            recon = self.reconstruct(batch["features"], batch["duration_s"], condition)
+            terms["mpjpe"] = masked_mpjpe(recon.positions, batch["positions"].cpu(), batch["num_frames"].cpu())
+            _, decoded = self.denormalize(self._decode(recon.latent.to(self.device), condition))
+            terms["duration_error"] = (decoded - batch["duration_s"]).abs().mean()
+        size = batch["features"].shape[0]
+        for name, value in terms.items():
+            self.log(f"{split}/{name}", value, batch_size=size, sync_dist=True, prog_bar=name in ("loss", "mpjpe"))
+
+    # -- inference
+
+    @torch.no_grad()
+    def reconstruct(self, features: torch.Tensor, duration_s: torch.Tensor, example: Any = None) -> MotionSamples:
+        """Posterior-mean reconstructions of clips ``(n, C, T')`` at their durations ``(n,)`` seconds, given one
+        example for all (see :meth:`condition`) or a :class:`StyleCondition` per clip."""
+        features, duration_s = features.to(self.device), duration_s.to(self.device)
+        condition = self.condition(example)
+        mean, _ = self._encode(self.normalize(features, duration_s), condition)
+        decoded, _ = self.denormalize(self._decode(mean, condition))
+        out = decode_features(self.autoencoder, decoded, duration_s, self.timeline_frames, self.fps)
+        out.latent = mean.cpu()
+        return out
+
+    @torch.no_grad()
+    def decode_latent(self, z: torch.Tensor, chunk_size: int = DEFAULT_CHUNK, *, example: Any = None) -> MotionSamples:
+        """Motions of latent codes ``(n, k)`` in the style of ``example`` (see :meth:`condition`)."""
+        condition = self.condition(example)
+        z = torch.as_tensor(z, dtype=torch.float32)
+        features, duration = self.denormalize(self._decode(z.to(self.device), condition))
+        out = decode_features(self.autoencoder, features, duration, self.timeline_frames, self.fps, chunk_size)
+        out.latent = z.cpu()
+        return out
+
+    @torch.no_grad()
+    def sample(self, n: int, seed: int | None = None, chunk_size: int = DEFAULT_CHUNK, *,
+               example: Any = None) -> MotionSamples:
+        """``n`` motions in the style of ``example`` (see :meth:`condition`): ``z ~ N(0, I)`` decoded under its
+        condition. ``seed`` seeds a private generator (None: a fresh seed); returns :class:`MotionSamples` as
+        :meth:`PrimitiveVAE.sample`."""
+        if n < 1:
+            raise ValueError(f"n must be ≥ 1, got {n}")
+        condition = self.condition(example)
+        generator = torch.Generator()
+        if seed is None:
+            generator.seed()
+        else:
+            generator.manual_seed(int(seed))
+        z = torch.randn(n, self.hparams.latent_dim, generator=generator)
+        return self.decode_latent(z, chunk_size, example=condition)
+
+
+@dataclass
+class StyleCondition:
+    """What the network is conditioned on: the example's embedding ``(..., E)`` and, for an anchored model,
+    its anchor ``(..., D)`` (its normalized features; None otherwise)."""
+
+    embedding: torch.Tensor
+    anchor: torch.Tensor | None = None
+
+
+class BoundExample:
+    """A :class:`ZeroShotStyleVAE` with one style example bound: a sample source like any style model.
+
+    Attributes:
+        model: the network.
+        example_features: ``[(C, T'), …]`` the example clip(s), raw features.
+        condition: their :class:`StyleCondition` (computed at binding: bind again after further training).
+        style: the style's name, or None.
+        style_examples: plain-value records of the example clip(s) (take, start, stop, …).
+    """
+
+    def __init__(self, model: ZeroShotStyleVAE, example_features: list[torch.Tensor], style: str | None = None,
+                 records: Sequence[dict[str, Any]] | None = None):
+        self.model = model
+        self.example_features = list(example_features)
+        self.condition = model.condition(self.example_features)
+        self.style = style
+        self.style_examples = [dict(r) for r in records or []]
+
+    @property
+    def spec(self) -> dict[str, Any]:
+        return self.model.spec
+
+    @property
+    def primitive(self) -> str:
+        return self.model.primitive
+
+    @property
+    def timeline_frames(self) -> int:
+        return self.model.timeline_frames
+
+    @property
+    def fps(self) -> float:
+        return self.model.fps
+
+    @property
+    def latent_dim(self) -> int:
+        return int(self.model.hparams.latent_dim)
+
+    @property
+    def autoencoder(self):
+        return self.model.autoencoder
+
+    @property
+    def checkpoint_file(self) -> str | None:
+        return self.model.checkpoint_file
+
+    def attach_autoencoder(self, autoencoder) -> None:
+        """See :meth:`PrimitiveVAE.attach_autoencoder`."""
+        self.model.attach_autoencoder(autoencoder)
+
+    @property
+    def target_gram(self) -> torch.Tensor:
+        """``(C, C)`` the mean Gram of the example clip(s) (what Table 5.1's column of this example is)."""
+        return mean_gram([f.cpu() for f in self.example_features])
+
+    def sample(self, n: int, seed: int | None = None, chunk_size: int = DEFAULT_CHUNK) -> MotionSamples:
+        """``n`` motions in the bound example's style (see :meth:`ZeroShotStyleVAE.sample`)."""
+        return self.model.sample(n, seed, chunk_size, example=self.condition)
+
+    def decode_latent(self, z: torch.Tensor, chunk_size: int = DEFAULT_CHUNK) -> MotionSamples:
+        """Motions of latent codes ``(n, k)`` in the bound example's style."""
+        return self.model.decode_latent(z, chunk_size, example=self.condition)

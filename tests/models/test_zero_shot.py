@@ -1,0 +1,134 @@
+"""The zero-shot style network: it trains, its example steers its samples (towards that example's style,
+for an anchored network and for an embedding-only one), its checkpoint round-trips under
+``weights_only=True``, and a bound example is a sample source the evaluation takes as it is."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+import torch
+from vae_fixtures import TINY_DATA, feature_module, fit, tiny_autoencoder_ckpt, tiny_takeset, validate
+
+from stylemotion.datamodules.multistyle import MultiStyleDataModule
+from stylemotion.evaluation.pipeline import evaluate_models
+from stylemotion.evaluation.settings import ClassifierSettings, EvalSettings, SampleCounts
+from stylemotion.evaluation.sources import EvalModel, SampleSource
+from stylemotion.evaluation.tables import style_distances
+from stylemotion.models.checkpoints import (
+    checkpoint_hparams,
+    checkpoint_kind,
+    fingerprint,
+    is_model_checkpoint,
+    load_autoencoder,
+    load_generative,
+)
+from stylemotion.models.style import gram
+from stylemotion.models.zero_shot import ZeroShotStyleVAE
+
+torch.set_num_threads(1)
+TINY_NET = {"embedding_dim": 8, "hidden": [64, 32], "samples_per_item": 4}
+
+
+@pytest.fixture(scope="session")
+def ae_ckpt(tmp_path_factory) -> Path:
+    return tiny_autoencoder_ckpt(tmp_path_factory.mktemp("zero_shot_ae"))
+
+
+@pytest.fixture(scope="module")
+def data(ae_ckpt) -> MultiStyleDataModule:
+    dm = MultiStyleDataModule(takeset=tiny_takeset(), autoencoder_ckpt=str(ae_ckpt), split=TINY_DATA["split"],
+                              min_train_clips=8, batch_size=16)
+    dm.setup("fit")
+    return dm
+
+
+@pytest.fixture(scope="module")
+def trained(data) -> dict[bool, ZeroShotStyleVAE]:
+    """An anchored and an embedding-only network, 300 steps each (~3 s each on one core)."""
+    out = {}
+    for anchor in (True, False):
+        torch.manual_seed(0)
+        out[anchor] = ZeroShotStyleVAE(anchor=anchor, **TINY_NET)
+        out[anchor].initial_loss = validate(out[anchor], data)["val/loss"]
+        fit(out[anchor], data, steps=300)
+    return out
+
+
+@pytest.mark.parametrize("anchor", [True, False])
+def test_the_network_trains_and_its_example_sets_the_style(data, trained, anchor) -> None:
+    model = trained[anchor]
+    assert validate(model, data)["val/loss"] < 0.5 * model.initial_loss
+    examples = {s: data.example_features(s) for s in ("elderly", "youthful")}
+    grams = torch.stack([gram(examples[s]) for s in examples])
+    samples = {s: model.sample(200, seed=0, example=examples[s]) for s in examples}
+    # the same codes under two examples: different motions, each nearer (Table 5.1's distance, re-encoded) to
+    # the Gram of its own example than to the other's
+    distances = {s: style_distances(model.autoencoder, samples[s].normalized_frames, grams).mean(0) for s in examples}
+    assert distances["elderly"][0] < distances["elderly"][1], distances
+    assert distances["youthful"][1] < distances["youthful"][0], distances
+    gap = (samples["elderly"].features.mean(0) - samples["youthful"].features.mean(0)).norm()
+    spread = samples["elderly"].features.std(0).norm() / 200 ** 0.5
+    assert gap > 10 * spread
+    assert samples["elderly"].features.std(0).mean() > 0  # samples, not one copy
+
+
+def test_the_checkpoint_round_trips_under_weights_only(data, trained, tmp_path) -> None:
+    model = trained[True]
+    path = tmp_path / "zero_shot.ckpt"
+    fit(model, data, steps=1).save_checkpoint(path, weights_only=False)  # the trainer's checkpoint, as training saves
+    hparams = checkpoint_hparams(path)  # read with torch.load(weights_only=True)
+    assert checkpoint_kind(hparams) == "zero_shot" and not is_model_checkpoint(path)
+    assert hparams["spec"]["excluded_styles"] == [] and hparams["spec"]["styles"] == ["elderly", "normal", "youthful"]
+    assert load_autoencoder(path).hparams["hidden_units"] == model.autoencoder.hparams["hidden_units"]
+    assert fingerprint(load_autoencoder(path)) == fingerprint(model.autoencoder)  # embedded in the checkpoint
+    example = data.example_clip("elderly")
+    expected = model.sample(50, seed=3, example=example)
+    for loaded in (load_generative(path), ZeroShotStyleVAE.load_from_checkpoint(path, map_location="cpu")):
+        assert isinstance(loaded, ZeroShotStyleVAE) and loaded.hparams.anchor and loaded.styles == model.styles
+        for name in ("style_mean", "style_axes", "style_scale", "feature_mean"):
+            assert torch.equal(getattr(loaded, name), getattr(model, name)), name
+        got = loaded.eval().sample(50, seed=3, example=example)
+        assert torch.allclose(got.positions, expected.positions, atol=1e-5)
+
+
+def test_a_bound_example_is_a_sample_source_of_the_evaluation(data, trained) -> None:
+    model = trained[True]
+    record = model.spec["style_examples_by_style"]["elderly"]
+    bound = model.bind_example(data.example_clip("elderly"), style="elderly", records=[record])
+    assert isinstance(bound, SampleSource) and bound.primitive == "walk_leftStance"
+    assert (bound.timeline_frames, bound.fps) == (data.timeline_frames, data.fps)
+    assert torch.allclose(bound.target_gram, gram(data.example_features("elderly")), atol=1e-6)
+    assert torch.equal(bound.sample(20, seed=1).features, model.sample(20, seed=1, example=bound.condition).features)
+    spec = model.spec
+    evaluated = EvalModel("elderly", bound.primitive, "elderly", bound, [record], dict(spec["autoencoder"]), None,
+                          bound.timeline_frames, bound.target_gram, spec["dataset"], "canonical")
+    settings = EvalSettings(samples=SampleCounts(20, 20, 20), classifier=ClassifierSettings(components=6))
+    results = evaluate_models([evaluated], tiny_takeset(), model.autoencoder, settings, split=TINY_DATA["split"])
+    table = results["table_5_1"]["walk_leftStance"]
+    assert table["models"] == ["elderly"] and table["samples"] == 20
+    assert 0.0 <= results["style_recognition"]["per_model"]["elderly"] <= 1.0
+
+
+def test_sampling_needs_an_example_and_the_data_must_pair_styles(ae_ckpt, trained) -> None:
+    with pytest.raises(ValueError, match="generates the style of an example"):
+        trained[True].sample(4, seed=0)
+    with pytest.raises(ValueError, match=r"example features must be \(32, time\)"):
+        trained[True].sample(4, seed=0, example=torch.zeros(16, 9))
+    with pytest.raises(ValueError, match="MultiStyleDataModule"):
+        fit(ZeroShotStyleVAE(**TINY_NET), feature_module(ae_ckpt), steps=1)
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    ({"embedding_dim": 0}, "embedding_dim must be a whole number"),
+    ({"style_weight": -1.0}, "style_weight must be ≥ 0"),
+    ({"style_latents": "all"}, "style_latents must be one of"),
+])
+def test_bad_hyperparameters_are_refused(kwargs, message) -> None:
+    with pytest.raises(ValueError, match=message):
+        ZeroShotStyleVAE(**kwargs)
+
+
+def test_an_embedding_wider_than_the_data_is_refused(data) -> None:
+    with pytest.raises(ValueError, match="model.embedding_dim=500 needs at least 501 training clips"):
+        fit(ZeroShotStyleVAE(**{**TINY_NET, "embedding_dim": 500}), data, steps=1)
