@@ -101,8 +101,9 @@ def retarget_positions(positions: np.ndarray, target_lengths: np.ndarray) -> np.
 
     Raises:
         ValueError: bad shapes or values (naming the argument), a source bone of zero length
-            (< :data:`stylemotion.ik.MIN_BONE_LENGTH`) whose target is not zero (naming the bone and
-            frame), or a zero leg length.
+            (< :data:`stylemotion.ik.MIN_BONE_LENGTH`) whose target is not zero and whose path to its
+            child joint has zero length too (naming the bone and frame; a zero-length bone otherwise
+            takes the direction from its parent to its child joint), or a zero leg length.
     """
     source = _check_positions(positions)
     target = _check_lengths(target_lengths)
@@ -110,6 +111,7 @@ def retarget_positions(positions: np.ndarray, target_lengths: np.ndarray) -> np.
     vectors = source[:, children] - source[:, parents]  # (frames, 20, 3)
     lengths = bone_lengths(source)[:, children]  # (frames, 20)
     short = lengths < MIN_BONE_LENGTH
+    vectors, lengths, short = _through_short_bones(source, vectors, lengths, short)
     lost = short & (target >= MIN_BONE_LENGTH)
     if lost.any():
         frame, bone = (int(i) for i in np.argwhere(lost)[0])
@@ -134,6 +136,27 @@ def retarget_positions(positions: np.ndarray, target_lengths: np.ndarray) -> np.
     result[..., 1] += source[:, feet, 1].min() - result[:, feet, 1].min()
     dtype = np.asarray(positions).dtype
     return result.astype(dtype if np.issubdtype(dtype, np.floating) else np.float64)
+
+
+def _through_short_bones(source: np.ndarray, vectors: np.ndarray, lengths: np.ndarray, short: np.ndarray
+                         ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Directions for bones of zero length in the source (e.g. a clavicle that a skeleton places on the
+    neck): the direction from the bone's parent joint to its first child joint, where that is not zero
+    too. Returns the bone vectors, lengths and the still-short mask."""
+    if not short.any():
+        return vectors, lengths, short
+    vectors, lengths = vectors.copy(), lengths.copy()
+    for bone, joint in enumerate(BONE_JOINTS):
+        if not short[:, bone].any():
+            continue
+        child = next((k for k, parent in enumerate(CANONICAL_PARENTS) if parent == joint), None)
+        if child is None:
+            continue
+        through = source[:, child] - source[:, CANONICAL_PARENTS[joint]]
+        span = np.linalg.norm(through, axis=-1)
+        usable = short[:, bone] & (span >= MIN_BONE_LENGTH)
+        vectors[usable, bone], lengths[usable, bone] = through[usable], span[usable]
+    return vectors, lengths, lengths < MIN_BONE_LENGTH
 
 
 def _check_positions(positions: np.ndarray) -> np.ndarray:

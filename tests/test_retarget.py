@@ -141,3 +141,24 @@ def test_bad_input_is_refused_naming_what_is_wrong() -> None:
     zero_target[BONE_NAMES.index("Toes_L")] = 0.0  # a bone that stays of zero length has nothing to lose
     out = retarget_positions(collapsed, zero_target)
     np.testing.assert_allclose(out[:, JOINT_INDEX["Toes_L"]], out[:, JOINT_INDEX["Foot_L"]], atol=1e-12)
+
+
+def test_a_bone_of_zero_length_takes_the_direction_to_its_child() -> None:
+    """A skeleton whose clavicle sits on its parent joint (as in CMU-like files mapped to the canonical
+    joints) still retargets: the zero-length bone points from its parent to its child joint."""
+    positions, lengths = rigid_walk(seed=1)
+    shoulder, parent = JOINT_INDEX["Shoulder_L"], CANONICAL_PARENTS[JOINT_INDEX["Shoulder_L"]]
+    child = JOINT_INDEX["UpperArm_L"]
+    collapsed = positions.copy()
+    collapsed[:, shoulder] = collapsed[:, parent]
+    out = retarget_positions(collapsed, lengths)
+    bone = BONE_NAMES.index("Shoulder_L")
+    np.testing.assert_allclose(np.linalg.norm(out[:, shoulder] - out[:, parent], axis=-1), lengths[bone], rtol=1e-9)
+    through = collapsed[:, child] - collapsed[:, parent]
+    got = out[:, shoulder] - out[:, parent]
+    cosine = np.sum(got * through, -1) / np.linalg.norm(got, axis=-1) / np.linalg.norm(through, axis=-1)
+    np.testing.assert_allclose(cosine, 1.0, atol=1e-9)
+    everywhere = collapsed.copy()
+    everywhere[:, child] = everywhere[:, parent]  # the child on the same point too: no direction at all
+    with pytest.raises(ValueError, match=r"bone 'Shoulder_L' has zero length"):
+        retarget_positions(everywhere, lengths)

@@ -181,10 +181,10 @@ def add_style(example: str, run: str | os.PathLike, name: str, out: str | os.Pat
     progress = Progress(3 + len(ours), say)
     converted = convert_example(spec, settings)
     takeset = build_dataset(source.data_cfg)
-    converted = on_run_skeleton(converted, takeset)
+    converted = on_run_skeleton(converted, takeset, source.settings.neutral_style)
     progress(f"example {converted.name}: {converted.end - converted.start} of {converted.file_frames} frames at "
              f"{converted.file_fps:g} fps → {len(converted.positions)} frames at {converted.fps:g} fps"
-             + (f" on the data's skeleton (data.retarget={converted.retarget['style']})" if converted.retarget else "")
+             + f" on the run's skeleton (bones of {converted.retarget.get('style') or 'all takes'})"
              + f"; run {source.folder} (data {takeset.name}, primitives {source.primitives})")
     with hydra_configs():
         node = train_config(source, ours[0], name, out, threads).datamodule.get("segment")
@@ -255,6 +255,7 @@ def evaluate(run: SourceRun, takeset: TakeSet, name: str, method: str, example: 
         "table_5_1_row": {p: r["table_5_1_row"] for p, r in per.items()},
         "table_5_1_columns": {p: r["columns"] for p, r in per.items()},
         "nearest_existing_style": {p: r["nearest_existing"] for p, r in per.items()},
+        "example_range": {p: r["example_range"] for p, r in per.items()},
         "new_column_is_minimum": {p: r["new_column_is_minimum"] for p, r in per.items()},
         "variation": {p: r["variation"] for p, r in per.items()},
         "foot_skating": {p: r["foot_skating"] for p, r in per.items()},
@@ -283,6 +284,12 @@ def summary_lines(results: Mapping[str, Any]) -> list[str]:
         nearest = results["nearest_existing_style"][p]
         lines.append(f"{p}: D to {name} {row[name]:.4g}, nearest existing style {nearest} {row[nearest]:.4g} "
                      f"({'the new example is' if results['new_column_is_minimum'][p] else 'not'} the row's minimum)")
+        check = results.get("example_range", {}).get(p)
+        if check and check["out_of_range"]:
+            lines.append(f"WARNING {p}: the example's Gram distance to the neutral column is "
+                         f"{check['distance_to_neutral']:.4g}, the run's examples' at most "
+                         f"{check['run_examples_max']:.4g}: it lies outside what the autoencoder knows, the new "
+                         "model cannot be faithful")
     pooled = results["foot_skating_pooled"]
     lines.append(f"foot skating of samples {_percent(pooled['samples'])}, of the example's clips "
                  f"{_percent(pooled['example'])}")

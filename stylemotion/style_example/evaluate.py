@@ -85,6 +85,7 @@ def evaluate_primitive(primitive: str, run_models: Sequence[EvalModel], new: Eva
     row = distance_table(autoencoder, [drawn.normalized_frames.numpy()], grams, settings.gram_chunk)[0]
     names = [m.name for m in columns]
     table_row = {name: float(d) for name, d in zip(names, row)}
+    offsets = {name: float(torch.linalg.matrix_norm(g - grams[0])) for name, g in zip(names[1:], grams[1:])}
     existing = {name: d for name, d in table_row.items() if name != new.name}
     example = motions_from_clips(list(clips), real.length)
     data = real.data
@@ -98,12 +99,29 @@ def evaluate_primitive(primitive: str, run_models: Sequence[EvalModel], new: Eva
         "columns": {m.name: ("mean motion of the neutral training clips" if m.name == NEUTRAL
                              else [c.describe() for c in real.examples[m.name]]) for m in columns},
         "nearest_existing": min(existing, key=existing.get),
+        "example_range": example_range(offsets.pop(new.name), offsets),
         "new_column_is_minimum": bool(table_row[new.name] <= min(existing.values())),
         "variation": {"samples": variation(drawn), "example": variation(example),
                       "training_data": variation(real.training)},
         "foot_skating": {"samples": skating(drawn), "example": skating(example)},
         "samples": int(samples),
     }
+
+
+#: An example whose Gram distance to the neutral column exceeds this many times the farthest of the
+#: run's own examples lies outside what the autoencoder was trained on.
+OUT_OF_RANGE_FACTOR = 3.0
+
+
+def example_range(distance_to_neutral: float, run_examples: dict[str, float]) -> dict[str, Any]:
+    """Whether the new example is within the autoencoder's range: its Gram distance to the neutral column
+    against the run's own examples' (``out_of_range`` beyond :data:`OUT_OF_RANGE_FACTOR` × their largest).
+    An example far outside (e.g. a skeleton whose joint conventions differ from the data's: the
+    autoencoder's per-joint scales turn centimetres of convention into huge feature values) gives a model
+    that cannot be faithful, whatever its Table 5.1 row says."""
+    farthest = max(run_examples.values()) if run_examples else None
+    return {"distance_to_neutral": distance_to_neutral, "run_examples_max": farthest,
+            "out_of_range": bool(farthest is not None and distance_to_neutral > OUT_OF_RANGE_FACTOR * farthest)}
 
 
 def pooled_foot_skating(per_primitive: dict[str, dict[str, Any]], kind: str) -> float:
@@ -141,6 +159,12 @@ def markdown(results: dict[str, Any]) -> str:
                 ""]
         nearest = results["nearest_existing_style"][p]
         verdict = "is" if results["new_column_is_minimum"][p] else "is not"
+        check = results.get("example_range", {}).get(p)
+        if check and check["out_of_range"]:
+            out += [f"**Warning:** the example lies far outside the data the autoencoder knows: its Gram distance to "
+                    f"the neutral column is {fmt(check['distance_to_neutral'])}, the run's own examples' at most "
+                    f"{fmt(check['run_examples_max'])}. The new model cannot be faithful to it (check the skeleton's "
+                    "joint conventions; docs/style.md).", ""]
         out += [f"Of the run's styles, the samples are nearest to **{nearest}** (D {fmt(row[nearest])}); the new "
                 f"example's column {verdict} the row's minimum.", ""]
     out += ["## Variation and foot skating", "",

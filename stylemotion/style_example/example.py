@@ -7,8 +7,9 @@ of the **file's own frame rate**, counted from 0, ``end`` exclusive (``walk.bvh:
 120 fps file is seconds 1 to 4); they are cut before resampling. The converted take is labelled
 with the new style's name and the run's action and cut by
 :func:`stylemotion.primitives.segment_action` with the run's segmentation settings. When the run's
-data puts every take on one skeleton (``data.retarget``), the example is put on it too
-(:func:`on_run_skeleton`).
+example is then put on the run's skeleton (:func:`on_run_skeleton`): the one the data's ``data.retarget``
+chose, else the median bones of the run's neutral takes — the models only know the data's bodies,
+and an example of other proportions would otherwise be a different "style" in every frame.
 """
 
 from __future__ import annotations
@@ -29,7 +30,7 @@ from stylemotion.io.errors import MotionDataError
 from stylemotion.io.outputs import safe_name
 from stylemotion.io.sources import FileSource
 from stylemotion.primitives import Clip, Segmentation, SegmentSettings, parse_primitive, segment_action
-from stylemotion.retarget import BONE_NAMES, retarget_positions
+from stylemotion.retarget import BONE_NAMES, retarget_positions, target_bone_lengths
 
 #: A frame range after the file: ``:<start>-<end>``, whatever the two parts hold (checked afterwards).
 _RANGE = re.compile(r"^(?P<path>.*[^:]):(?P<range>[^:/\\]*-[^:/\\]*)$")
@@ -166,23 +167,26 @@ def convert_example(spec: ExampleSpec, settings: ConversionSettings) -> Converte
                             positions, float(settings.fps))
 
 
-def on_run_skeleton(example: ConvertedExample, takeset: TakeSet) -> ConvertedExample:
-    """The example on the one skeleton of the run's data when the data is retargeted (``data.retarget``:
-    :func:`stylemotion.retarget.retarget_positions` to the bone lengths ``takeset.retarget`` records), as
-    every take of it; else ``example`` itself.
+def on_run_skeleton(example: ConvertedExample, takeset: TakeSet, neutral_style: str = "normal") -> ConvertedExample:
+    """The example on the run's skeleton, by :func:`stylemotion.retarget.retarget_positions`: the bone
+    lengths ``takeset.retarget`` records (``data.retarget``), else the median bones of the takes of
+    ``neutral_style`` (every takeset's fallback; all takes if it has none of that style).
 
     Raises:
         StyleExampleError: its bones cannot be put on that skeleton (naming the bone).
     """
     record = getattr(takeset, "retarget", None)
     if not record:
-        return example
+        takes = takeset.filter(style=neutral_style) or list(takeset.takes)
+        lengths = target_bone_lengths(t.positions for t in takes)
+        record = {"style": neutral_style if takeset.filter(style=neutral_style) else None, "takes": len(takes),
+                  "bone_lengths_m": {name: round(float(x), 6) for name, x in zip(BONE_NAMES, lengths)}}
     target = np.array([record["bone_lengths_m"][bone] for bone in BONE_NAMES])
     try:
         positions = retarget_positions(example.positions, target).astype(np.float32)
     except ValueError as exc:
-        raise StyleExampleError(f"example={example.spec}: cannot put it on the run's skeleton (data.retarget="
-                                f"{record.get('style')}): {exc}") from None
+        raise StyleExampleError(f"example={example.spec}: cannot put it on the run's skeleton (bones of "
+                                f"{record.get('style') or 'all takes'}): {exc}") from None
     return replace(example, positions=positions, retarget=dict(record))
 
 

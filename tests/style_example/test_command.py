@@ -21,6 +21,7 @@ from stylemotion.config import ConfigError
 from stylemotion.io.outputs import OutputExistsError
 from stylemotion.models.cvae import StyleCVAE
 from stylemotion.style_example import NameTakenError, StyleExampleError, add_style
+from stylemotion.style_example.evaluate import example_range
 
 torch.set_num_threads(1)
 PRIMITIVES = ("walk_leftStance", "walk_rightStance")
@@ -52,6 +53,8 @@ def test_report_has_a_finite_table_5_1_row_for_every_run_column_and_the_new_exam
         assert report["variation"][p]["samples"]["motions"] == SAMPLES
         assert report["variation"][p]["example"]["pose_across_sd"] > 0  # two example clips per stance
         assert report["foot_skating"][p]["samples"]["motions"] == SAMPLES
+        check = report["example_range"][p]  # a synthetic exhausted walk: well inside the autoencoder's range
+        assert check["distance_to_neutral"] > 0 and not check["out_of_range"], check
     text = (folder / "report.md").read_text()
     assert "## Table 5.1 row" in text and f"nearest to **{report['nearest_existing_style']['walk_leftStance']}**" \
         in text
@@ -189,3 +192,10 @@ def test_a_folder_that_is_no_finished_reproduce_run_is_refused(run, style_folder
     (copy / "reproduce.json").write_text(json.dumps(summary))
     _refused(tmp_path, StyleExampleError, r"not a finished stylemotion-reproduce run: stage\(s\) \['cvae "
              r"walk_rightStance/elderly'\]", example=example, run=copy)
+
+
+def test_an_example_far_outside_the_data_is_flagged() -> None:
+    assert example_range(10.0, {"elderly": 5.0, "active": 4.0}) == {
+        "distance_to_neutral": 10.0, "run_examples_max": 5.0, "out_of_range": False}
+    assert example_range(15.1, {"elderly": 5.0})["out_of_range"]  # beyond 3 × the farthest example
+    assert not example_range(15.1, {})["out_of_range"]  # nothing to compare with: no verdict

@@ -17,7 +17,7 @@ from stylemotion.datasets.loading import ConversionSettings, load_canonical_posi
 from stylemotion.datasets.registry import load_synthetic
 from stylemotion.datasets.retarget import retarget_takeset
 from stylemotion.io.sources import FileSource
-from stylemotion.retarget import BONE_NAMES, median_bone_lengths
+from stylemotion.retarget import BONE_NAMES, median_bone_lengths, target_bone_lengths
 from stylemotion.style_example.example import (
     ExampleSpec,
     StyleExampleError,
@@ -107,18 +107,23 @@ def test_a_missing_file_is_named(tmp_path: Path) -> None:
         convert_example(parse_example(str(tmp_path / "nowhere.bvh")), ConversionSettings())
 
 
-def test_on_retargeted_data_the_example_takes_the_datas_one_skeleton(tmp_path: Path) -> None:
-    """``data.retarget=normal`` puts every take on one skeleton; the example goes onto it too (its own bones
-    differ: an exhausted walker of another size), and stays as it is on data without ``retarget``."""
+def test_the_example_is_put_on_the_runs_skeleton(tmp_path: Path) -> None:
+    """``data.retarget=normal`` puts every take on one skeleton and the example goes onto it; on data
+    without ``retarget`` the example goes onto the median bones of the neutral takes (its own bones
+    differ: an exhausted walker of another size)."""
     data = load_synthetic(takes_per_pair=2, styles=["normal", "elderly"], contents=["walk"], duration_s=2.0)
     example = convert_example(parse_example(str(example_bvh(tmp_path, fps=30.0))), ConversionSettings())
-    assert on_run_skeleton(example, data) is example
-    retargeted = retarget_takeset(data, "normal")
+    neutral = target_bone_lengths(t.positions for t in data.filter(style="normal"))
+    assert np.abs(median_bone_lengths(example.positions) - neutral).max() > 0.003  # 1 % of a shin
+    plain = on_run_skeleton(example, data, "normal")
+    np.testing.assert_allclose(median_bone_lengths(plain.positions), neutral, atol=1e-5)
+    assert plain.retarget["style"] == "normal" and plain.retarget["takes"] == 2
+    retargeted = retarget_takeset(data, "elderly")
     target = np.array([retargeted.retarget["bone_lengths_m"][b] for b in BONE_NAMES])
-    assert np.abs(median_bone_lengths(example.positions) - target).max() > 0.003  # 1 % of a shin
-    moved = on_run_skeleton(example, retargeted)
+    assert np.abs(target - neutral).max() > 0.003
+    moved = on_run_skeleton(example, retargeted, "normal")
     np.testing.assert_allclose(median_bone_lengths(moved.positions), target, atol=1e-5)
-    assert moved.retarget["style"] == "normal" and moved.positions.dtype == np.float32
+    assert moved.retarget["style"] == "elderly" and moved.positions.dtype == np.float32
     assert moved.sha256 == example.sha256 and moved.positions.shape == example.positions.shape
 
 
