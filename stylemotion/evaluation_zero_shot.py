@@ -47,7 +47,7 @@ from omegaconf import DictConfig, OmegaConf, open_dict
 
 from stylemotion.config import config_dir, positive_int, set_torch_threads
 from stylemotion.datasets import TakeSet, build_dataset
-from stylemotion.evaluation.pipeline import _example_gram, real_side, recognition
+from stylemotion.evaluation.pipeline import example_column_gram, real_side, recognition
 from stylemotion.evaluation.run import settings_from_config
 from stylemotion.evaluation.settings import EvalSettings
 from stylemotion.evaluation.sources import NEUTRAL, EvalModel, check_one_autoencoder, load_model
@@ -298,7 +298,7 @@ def evaluate_primitive(primitive: str, left_out: Mapping[str, ZeroShotStyleVAE],
     real = real_side(primitive, list(cvaes), takeset, settings, split, say)
     columns = [NEUTRAL] + [m.name for m in real.models]
     neutral = EvalModel(NEUTRAL, primitive, settings.neutral_style, source=None)  # its column: the mean motion
-    grams = torch.stack([_example_gram(autoencoder, real, m) for m in [neutral, *real.models]])
+    grams = torch.stack([example_column_gram(autoencoder, real, m) for m in [neutral, *real.models]])
     out: dict[str, Any] = {"timeline_frames": real.length, "columns": columns,
                            "column_examples": {NEUTRAL: "mean motion of the neutral training clips",
                                                **{m.name: [c.describe() for c in real.examples[m.name]]

@@ -424,14 +424,14 @@ class StyleTable:
 
 def style_table(real: RealSide, autoencoder, model_frames: Sequence[np.ndarray], settings: EvalSettings) -> StyleTable:
     """Table 5.1 from each model's first ``samples.table_5_1`` normalized sample frames (in ``real.models`` order)."""
-    grams = torch.stack([_example_gram(autoencoder, real, m) for m in real.models])
+    grams = torch.stack([example_column_gram(autoencoder, real, m) for m in real.models])
     table = distance_table(autoencoder, model_frames, grams, settings.gram_chunk)
     clips = {m.name: ("mean motion of the neutral training clips" if m.name == NEUTRAL
                       else [c.describe() for c in real.examples[m.name]]) for m in real.models}
     return StyleTable([m.name for m in real.models], table, settings.samples.table_5_1, clips)
 
 
-def _example_gram(autoencoder, real: RealSide, model: EvalModel) -> torch.Tensor:
+def example_column_gram(autoencoder, real: RealSide, model: EvalModel) -> torch.Tensor:
     """Gram of the model's column: its example clip(s), or the mean neutral training motion."""
     if model.name == NEUTRAL:
         return example_gram(autoencoder, [mean_motion(real.training.normalized_frames.numpy())])

@@ -22,6 +22,7 @@ import torch
 from stylemotion.models.autoencoder import IncompatibleModelError
 from stylemotion.models.checkpoints import load_generative
 from stylemotion.models.cvae import StyleCVAE
+from stylemotion.models.zero_shot import ZeroShotStyleVAE
 from stylemotion.primitives import Clip, time_normalize
 from stylemotion.sampling import MotionSamples, pad_motions
 
@@ -98,6 +99,10 @@ def load_model(path: str | Path, neutral_style: str = "normal", autoencoder=None
         (:func:`stylemotion.models.checkpoints.load_generative` reads it).
     """
     model = load_generative(path, autoencoder)
+    if isinstance(model, ZeroShotStyleVAE):
+        raise IncompatibleModelError(f"{path} is a zero-shot style network: it samples only given a style example "
+                                     "(bind one with model.bind_example(...), or evaluate it with "
+                                     "scripts/zero_shot_loso.py)")
     spec = model.spec
     styled = isinstance(model, StyleCVAE)
     if styled:

@@ -4,7 +4,7 @@ Per primitive, with the evaluation library of the run's report (:mod:`stylemotio
 
 * the run's real side (:func:`stylemotion.evaluation.pipeline.real_side`: its clips split and its
   style examples found, as the run's own evaluation does);
-* the columns of Table 5.1 (:func:`stylemotion.evaluation.pipeline._example_gram`): ``neutral`` (the
+* the columns of Table 5.1 (:func:`stylemotion.evaluation.pipeline.example_column_gram`): ``neutral`` (the
   mean motion of the neutral training clips), each of the run's styles (its example clip(s)), and the
   new style (the user's clips, encoded as its model was trained on them, checked against the Gram the
   model recorded);
@@ -26,7 +26,7 @@ import torch
 from stylemotion.datasets import TakeSet
 from stylemotion.evaluation.markdown import DEFINITIONS, _md_table, fmt, pct
 from stylemotion.evaluation.metrics import FootSkating, foot_skating, pooled_skating
-from stylemotion.evaluation.pipeline import _example_gram, real_side
+from stylemotion.evaluation.pipeline import example_column_gram, real_side
 from stylemotion.evaluation.settings import EvalSettings
 from stylemotion.evaluation.sources import NEUTRAL, EvalModel, check_one_autoencoder, motions_from_clips
 from stylemotion.evaluation.tables import VARIANCE_KEYS, VARIANCE_UNITS, distance_table, variance_stats
@@ -79,7 +79,7 @@ def evaluate_primitive(primitive: str, run_models: Sequence[EvalModel], new: Eva
                          f"use {real.length}: it was not trained on the run's data")
     real.examples[new.name] = list(clips)  # the new column: the user's clips, as the model was trained on them
     columns = [*real.models, new]
-    grams = torch.stack([_example_gram(autoencoder, real, m) for m in columns])
+    grams = torch.stack([example_column_gram(autoencoder, real, m) for m in columns])
     say(f"{primitive}: {samples} samples of {new.name}, Table 5.1 row against {len(columns)} examples")
     drawn = new.source.sample(samples, seed=seed)
     row = distance_table(autoencoder, [drawn.normalized_frames.numpy()], grams, settings.gram_chunk)[0]

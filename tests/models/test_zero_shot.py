@@ -13,8 +13,9 @@ from vae_fixtures import TINY_DATA, feature_module, fit, tiny_autoencoder_ckpt, 
 from stylemotion.datamodules.multistyle import MultiStyleDataModule
 from stylemotion.evaluation.pipeline import evaluate_models
 from stylemotion.evaluation.settings import ClassifierSettings, EvalSettings, SampleCounts
-from stylemotion.evaluation.sources import EvalModel, SampleSource
+from stylemotion.evaluation.sources import EvalModel, SampleSource, load_model
 from stylemotion.evaluation.tables import style_distances
+from stylemotion.models.autoencoder import IncompatibleModelError
 from stylemotion.models.checkpoints import (
     checkpoint_hparams,
     checkpoint_kind,
@@ -90,6 +91,8 @@ def test_the_checkpoint_round_trips_under_weights_only(data, trained, tmp_path) 
             assert torch.equal(getattr(loaded, name), getattr(model, name)), name
         got = loaded.eval().sample(50, seed=3, example=example)
         assert torch.allclose(got.positions, expected.positions, atol=1e-5)
+    with pytest.raises(IncompatibleModelError, match="zero-shot style network: it samples only given a style example"):
+        load_model(path)  # the evaluation's loader: no example, no samples
 
 
 def test_a_bound_example_is_a_sample_source_of_the_evaluation(data, trained) -> None:
