@@ -111,6 +111,19 @@ class MLPVAE(nn.Module):
         return self.decode(z), mean, logvar, z
 
 
+def prior_draws(n: int, latent_dim: int, seed: int | None = None) -> torch.Tensor:
+    """``(n, latent_dim)`` draws of ``N(0, I)`` from a private generator seeded with ``seed`` (None: a fresh
+    seed; the global RNG is untouched)."""
+    if n < 1:
+        raise ValueError(f"n must be ≥ 1, got {n}")
+    generator = torch.Generator()
+    if seed is None:
+        generator.seed()
+    else:
+        generator.manual_seed(int(seed))
+    return torch.randn(n, latent_dim, generator=generator)
+
+
 def reconstruction_loss(recon: torch.Tensor, target: torch.Tensor, weights: torch.Tensor | None = None) -> torch.Tensor:
     """Eq. 5.7: ``½ · mean over samples and items of Σ_d w_d (recon − target)²``.
 
@@ -417,12 +430,4 @@ class PrimitiveVAE(pl.LightningModule):
             sample's duration applied (padded, see ``num_frames``), ``frames (n, frames, 66)``,
             ``latent (n, 32)``, ``duration_s``, ``features``.
         """
-        if n < 1:
-            raise ValueError(f"n must be ≥ 1, got {n}")
-        generator = torch.Generator()
-        if seed is None:
-            generator.seed()
-        else:
-            generator.manual_seed(int(seed))
-        z = torch.randn(n, self.hparams.latent_dim, generator=generator)
-        return self.decode_latent(z, chunk_size)
+        return self.decode_latent(prior_draws(n, self.hparams.latent_dim, seed), chunk_size)

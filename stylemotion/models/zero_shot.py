@@ -68,7 +68,7 @@ from torch import nn
 
 from stylemotion.models.cvae import STYLE_LATENTS
 from stylemotion.models.style import feature_style_distance, mean_gram
-from stylemotion.models.vae import MLPVAE, PrimitiveVAE, kl_divergence, reconstruction_loss
+from stylemotion.models.vae import MLPVAE, PrimitiveVAE, kl_divergence, prior_draws, reconstruction_loss
 from stylemotion.primitives import time_normalize
 from stylemotion.sampling import DEFAULT_CHUNK, MotionSamples, decode_features, masked_mpjpe
 
@@ -373,16 +373,8 @@ class ZeroShotStyleVAE(PrimitiveVAE):
         """``n`` motions in the style of ``example`` (see :meth:`condition`): ``z ~ N(0, I)`` decoded under its
         condition. ``seed`` seeds a private generator (None: a fresh seed); returns :class:`MotionSamples` as
         :meth:`PrimitiveVAE.sample`."""
-        if n < 1:
-            raise ValueError(f"n must be ≥ 1, got {n}")
-        condition = self.condition(example)
-        generator = torch.Generator()
-        if seed is None:
-            generator.seed()
-        else:
-            generator.manual_seed(int(seed))
-        z = torch.randn(n, self.hparams.latent_dim, generator=generator)
-        return self.decode_latent(z, chunk_size, example=condition)
+        z = prior_draws(n, self.hparams.latent_dim, seed)
+        return self.decode_latent(z, chunk_size, example=self.condition(example))
 
 
 @dataclass
