@@ -1,5 +1,6 @@
 """Shared helpers of the ``stylemotion-style`` tests: a tiny finished reproduce run, an example BVH of a
-synthetic take, and a style folder made from it — each built once per pytest process.
+synthetic take, and style folders made from it (``method=cvae`` and ``method=zero_shot``) — each built once
+per pytest process.
 
 The run is ``stylemotion-reproduce`` on tiny synthetic data (straight walks of normal, elderly and youthful;
 CVAEs of elderly only, both stance primitives so that a walk can be generated), every stage a few seconds,
@@ -82,3 +83,22 @@ def tiny_style(folder: Path) -> tuple[Path, dict]:
         results = add_style(str(example_bvh(folder)), run, "tired", folder / "tired", samples=SAMPLES, say=lines.append)
         _CACHE["style"], _CACHE["results"], _CACHE["lines"] = folder / "tired", results, lines
     return _CACHE["style"], {"results": _CACHE["results"], "lines": _CACHE["lines"]}
+
+
+#: Epochs of each zero-shot network the tests train inside the command (the experiment's 100: a minute).
+NETWORK_EPOCHS = 2
+
+
+def tiny_zero_shot_style(folder: Path) -> tuple[Path, dict]:
+    """A style folder ``weary`` made from :func:`example_bvh` on :func:`tiny_run` with ``method=zero_shot``, its
+    networks trained inside the command (once per process), and what
+    :func:`stylemotion.style_example.add_style` returned and printed."""
+    if "zero_shot" not in _CACHE:
+        from stylemotion.style_example import add_style
+
+        run = tiny_run(folder)
+        lines: list[str] = []
+        results = add_style(str(example_bvh(folder)), run, "weary", folder / "weary", method="zero_shot",
+                            network_epochs=NETWORK_EPOCHS, samples=SAMPLES, say=lines.append)
+        _CACHE["zero_shot"], _CACHE["zero_shot_results"] = folder / "weary", {"results": results, "lines": lines}
+    return _CACHE["zero_shot"], _CACHE["zero_shot_results"]

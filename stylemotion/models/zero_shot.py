@@ -386,8 +386,23 @@ class StyleCondition:
     anchor: torch.Tensor | None = None
 
 
+class BoundDecoder:
+    """The network's decoder with one condition bound: :meth:`decode` maps codes to model space as a
+    :class:`~stylemotion.models.vae.PrimitiveVAE`'s ``net.decode`` does (the anchor included)."""
+
+    def __init__(self, model: ZeroShotStyleVAE, condition: StyleCondition):
+        self.model, self.condition = model, condition
+
+    def decode(self, z: torch.Tensor) -> torch.Tensor:
+        """``(..., k)`` codes → ``(..., D)`` model space (differentiable in ``z``)."""
+        return self.model._decode(z, self.condition)
+
+
 class BoundExample:
-    """A :class:`ZeroShotStyleVAE` with one style example bound: a sample source like any style model.
+    """A :class:`ZeroShotStyleVAE` with one style example bound: a sample source like any style model, and
+    what the path-following synthesis uses of a primitive model (``net.decode``, ``denormalize``,
+    ``hparams.latent_dim``, ``autoencoder``, ``timeline_frames``, ``fps``, ``decode_latent``, ``sample``,
+    ``eval``, ``requires_grad_``).
 
     Attributes:
         model: the network.
@@ -428,6 +443,30 @@ class BoundExample:
     @property
     def autoencoder(self):
         return self.model.autoencoder
+
+    @property
+    def hparams(self):
+        """The network's hyperparameters (``latent_dim``, …)."""
+        return self.model.hparams
+
+    @property
+    def net(self) -> BoundDecoder:
+        """The decoder under the bound condition (``net.decode(z)``, as a PrimitiveVAE's ``net``)."""
+        return BoundDecoder(self.model, self.condition)
+
+    def denormalize(self, y: torch.Tensor, clamp: bool = True) -> tuple[torch.Tensor, torch.Tensor]:
+        """See :meth:`PrimitiveVAE.denormalize`."""
+        return self.model.denormalize(y, clamp)
+
+    def eval(self) -> BoundExample:
+        """The network in eval mode; returns this sampler."""
+        self.model.eval()
+        return self
+
+    def requires_grad_(self, requires_grad: bool = True) -> BoundExample:
+        """The network's parameters (not) requiring gradients; returns this sampler."""
+        self.model.requires_grad_(requires_grad)
+        return self
 
     @property
     def checkpoint_file(self) -> str | None:

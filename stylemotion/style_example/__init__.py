@@ -1,12 +1,13 @@
 """A new style from the user's own example clip (``stylemotion-style``; issue 12).
 
 :func:`add_style` converts the user's BVH file like the datasets convert theirs, cuts it into the
-primitives of a finished ``stylemotion-reproduce`` run with the run's segmentation, trains the run's
-primitive models for the new style (a StyleCVAE each, exactly as the run's CVAE stage, with the user's
-clips as the style example) and evaluates them against the run's Table 5.1 columns. The folder it
-writes extends the run for ``stylemotion-generate run=<folder> style=<name>``. Modules:
-:mod:`.example` (the example), :mod:`.base_run` (the run), :mod:`.evaluate` (the report's numbers),
-:mod:`.command` (the whole command and its methods). Specification: ``docs/style.md``.
+primitives of a finished ``stylemotion-reproduce`` run with the run's segmentation, makes the run's
+primitive models for the new style (``method=cvae``: a StyleCVAE each, exactly as the run's CVAE stage, with
+the user's clips as the style example; ``method=zero_shot``: a zero-shot network each, bound to the user's
+clips) and evaluates them against the run's Table 5.1 columns. The folder it writes extends the run for
+``stylemotion-generate run=<folder> style=<name>``. Modules: :mod:`.example` (the example), :mod:`.base_run`
+(the run), :mod:`.evaluate` (the report's numbers), :mod:`.methods` (what a method does), :mod:`.zero_shot`
+(``method=zero_shot``), :mod:`.command` (the whole command and ``method=cvae``). Specification: ``docs/style.md``.
 """
 
 from stylemotion.style_example.base_run import NameTakenError, SourceRun, load_run

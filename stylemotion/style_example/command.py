@@ -9,15 +9,17 @@ Stages (one progress line each, ``[k/N]``, as ``stylemotion-reproduce`` prints t
 1. check the run (a finished reproduce run, :mod:`.base_run`), the name and the example, and convert
    the example (:func:`.example.convert_example`);
 2. cut it into the run's primitives with the run's segmentation (:func:`.example.cut_example`);
-3. one model per primitive of the example's action, by ``method`` (:func:`train_models`; ``cvae``:
-   the run's StyleCVAE training, :func:`train_cvae`);
+3. one model per primitive of the example's action, by ``method`` (:data:`METHODS`; ``cvae``: the run's
+   StyleCVAE training, :func:`train_cvae`; ``zero_shot``: a zero-shot network per primitive bound to the
+   example, :mod:`.zero_shot`);
 4. evaluate them against the run (:mod:`.evaluate`) and write ``report.md`` and ``report.json``.
 
 Everything is built in a temporary folder beside ``out`` and renamed into it at the end
 (:func:`stylemotion.io.atomic.atomic_folder`): a failure leaves nothing, an existing ``out`` is refused
 before any work. The folder holds ``cvae/<primitive>_<name>/`` (each model's training folder, as the
 run's stages have them: checkpoints, ``config_resolved.yaml``, ``run.json``, ``metrics.json``; their
-records name the temporary folder they were trained in), ``example/example.npz`` (the converted
+records name the temporary folder they were trained in; ``method=zero_shot``: ``network/<primitive>/``
+when the networks are trained here), ``example/example.npz`` (the converted
 example: ``positions`` (frames, 21, 3) metres, ``fps``, ``joint_names``), ``report.md`` and
 ``report.json`` (layout in ``docs/style.md``). Paths in ``report.json`` inside ``out`` are relative to it.
 """
@@ -28,7 +30,7 @@ import io
 import json
 import os
 import time
-from collections.abc import Callable, Iterator, Mapping
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from dataclasses import asdict
 from pathlib import Path
@@ -41,16 +43,17 @@ from stylemotion.config import ConfigError, config_dir, positive_int
 from stylemotion.datasets import TakeSet, build_dataset
 from stylemotion.datasets.loading import ConversionSettings
 from stylemotion.evaluation.report import _plain
-from stylemotion.evaluation.sources import load_model
+from stylemotion.evaluation.sources import EvalModel, load_model
 from stylemotion.io.atomic import atomic_folder
 from stylemotion.io.outputs import check_new_output, inside
 from stylemotion.models.checkpoints import autoencoder_info, load_autoencoder
-from stylemotion.primitives import parse_primitive, segment_action
+from stylemotion.primitives import Clip, parse_primitive, segment_action
 from stylemotion.provenance import provenance
 from stylemotion.skeleton import CANONICAL_JOINTS
 from stylemotion.style_example.base_run import STYLE_KIND, SourceRun, check_name, load_run, run_action, train_config
 from stylemotion.style_example.evaluate import evaluate_primitive, markdown, pooled_foot_skating
 from stylemotion.style_example.example import (
+    EXAMPLE_FILE,
     ConvertedExample,
     CutExample,
     convert_example,
@@ -58,6 +61,8 @@ from stylemotion.style_example.example import (
     on_run_skeleton,
     parse_example,
 )
+from stylemotion.style_example.methods import Method, recorded_path
+from stylemotion.style_example.zero_shot import ZeroShotMethod
 
 #: Conversion keys of the command (``stylemotion.datasets.loading.ConversionSettings`` fields).
 CONVERSION_KEYS = ("joint_map", "unit_scale", "up_axis")
@@ -117,8 +122,20 @@ def train_cvae(run: SourceRun, name: str, example: ConvertedExample, cut: CutExa
     return checkpoints
 
 
-#: ``method`` → the function that makes the style's models (one place to add another method).
-METHODS: dict[str, Callable[..., dict[str, Path]]] = {"cvae": train_cvae}
+class CVAEMethod(Method):
+    """``method=cvae``: :func:`train_cvae`; the evaluation loads each StyleCVAE as the run's own."""
+
+    def make(self, run: SourceRun, name: str, example: ConvertedExample, cut: CutExample, folder: Path,
+             progress: Progress, say: Say, threads: Any, options: Mapping[str, Any]) -> dict[str, Path]:
+        return train_cvae(run, name, example, cut, folder, progress, say, threads)
+
+    def load(self, checkpoint: Path, primitive: str, clips: Sequence[Clip], records: Sequence[Mapping[str, Any]],
+             name: str, neutral_style: str, autoencoder) -> EvalModel:
+        return load_model(checkpoint, neutral_style, autoencoder)
+
+
+#: ``method`` → how the style's models come about (one place to add another method).
+METHODS: dict[str, Method] = {"cvae": CVAEMethod(), "zero_shot": ZeroShotMethod()}
 
 
 def check_method(method: Any) -> str:
@@ -128,9 +145,14 @@ def check_method(method: Any) -> str:
     return str(method)
 
 
-def train_models(method: str, *args: Any, **kwargs: Any) -> dict[str, Path]:
-    """The style's primitive models by ``method`` (arguments as :func:`train_cvae`'s)."""
-    return METHODS[check_method(method)](*args, **kwargs)
+def method_options(method: str, options: Mapping[str, Any] | None) -> dict[str, Any]:
+    """The method's own keys of ``options``; :class:`ConfigError` for a value given to another method's key."""
+    own = METHODS[method].keys
+    for key, value in (options or {}).items():
+        if value is not None and key not in own:
+            owners = [m for m, impl in METHODS.items() if key in impl.keys]
+            raise ConfigError(f"{key}={value} is a key of method={'|'.join(owners) or '?'}, not of method={method}")
+    return {key: (options or {}).get(key) for key in own}
 
 
 # -- the command
@@ -138,8 +160,9 @@ def train_models(method: str, *args: Any, **kwargs: Any) -> dict[str, Path]:
 
 def add_style(example: str, run: str | os.PathLike, name: str, out: str | os.PathLike, method: str = "cvae",
               action: str | None = None, samples: int = 1000, seed: int | None = None, threads: Any = 1,
-              conversion: Mapping[str, Any] | None = None, say: Say = print, command: str = "") -> dict[str, Any]:
-    """Train the models of a new style ``name`` from ``example`` and evaluate them (see the module doc).
+              conversion: Mapping[str, Any] | None = None, say: Say = print, command: str = "",
+              network: Any = None, network_epochs: int | None = None) -> dict[str, Any]:
+    """Make the models of a new style ``name`` from ``example`` and evaluate them (see the module doc).
 
     Args:
         example: ``<BVH>[:start-end]`` (frames of the file's own frame rate, 0-based, end exclusive).
@@ -153,19 +176,25 @@ def add_style(example: str, run: str | os.PathLike, name: str, out: str | os.Pat
         conversion: ``joint_map``, ``unit_scale``, ``up_axis`` for the example (None: auto-detected, Y up).
         say: prints a progress line.
         command: the command line to record.
+        network: ``method=zero_shot``: the networks, a folder with ``<primitive>/checkpoints/best.ckpt`` or
+            ``{primitive: checkpoint}``; None trains them into ``out/network/`` (:mod:`.zero_shot`).
+        network_epochs: ``method=zero_shot`` with ``network`` None: epochs per network (None: the experiment's).
 
     Returns:
         What ``report.json`` holds.
 
     Raises:
         OutputExistsError: ``out`` exists (before any work).
-        ConfigError: a bad ``method``, ``samples``, ``seed`` or ``threads``.
-        StyleExampleError: a bad example, frame range, run or name (:class:`.base_run.NameTakenError`), or an
-            example without a complete step; nothing is written then.
+        ConfigError: a bad ``method``, ``samples``, ``seed``, ``threads`` or ``network_epochs``, or a key of
+            another method.
+        StyleExampleError: a bad example, frame range, run or name (:class:`.base_run.NameTakenError`), an
+            example without a complete step, or a ``network`` that is not the run's (primitive, autoencoder,
+            timeline); nothing is written then.
     """
     started = time.perf_counter()
     out = check_new_output(Path(out).expanduser())
     method = check_method(method)
+    options = method_options(method, {"network": network, "network_epochs": network_epochs})
     samples = positive_int(samples, "samples")
     threads = None if threads is None else positive_int(threads, "threads")
     if samples < 2:
@@ -178,7 +207,8 @@ def add_style(example: str, run: str | os.PathLike, name: str, out: str | os.Pat
     action = run_action(source, action)
     settings = conversion_settings(source, conversion)
     ours = [p for p in source.primitives if parse_primitive(p)[0] == action]
-    progress = Progress(3 + len(ours), say)
+    options = METHODS[method].prepare(source, ours, options)
+    progress = Progress(3 + METHODS[method].steps(ours, options), say)
     converted = convert_example(spec, settings)
     takeset = build_dataset(source.data_cfg)
     converted = on_run_skeleton(converted, takeset, source.settings.neutral_style)
@@ -196,12 +226,13 @@ def add_style(example: str, run: str | os.PathLike, name: str, out: str | os.Pat
              + (f"; no model of {cut.skipped} (another action)" if cut.skipped else ""))
     with atomic_folder(out, on_exists=lambda: check_new_output(out)) as tmp:
         with hydra_configs():
-            checkpoints = train_models(method, source, name, converted, cut, tmp, progress, say, threads)
+            checkpoints = METHODS[method].make(source, name, converted, cut, tmp, progress, say, threads, options)
         progress(f"evaluation: {samples} samples per model → {out / 'report.md'}")
-        results = evaluate(source, takeset, name, method, converted, cut, checkpoints, tmp, samples, seed, say)
+        results = evaluate(source, takeset, name, method, converted, cut, checkpoints, tmp, samples, seed, say,
+                           options)
         results["meta"].update(provenance(command or None), seconds=time.perf_counter() - started,
                                run_relative=os.path.relpath(source.folder.resolve(), out.resolve()))
-        write_example(converted, tmp / "example" / "example.npz")
+        write_example(converted, tmp / EXAMPLE_FILE)
         results = _plain(results)
         (tmp / "report.json").write_text(json.dumps(results, indent=1, allow_nan=False))
         (tmp / "report.md").write_text(markdown(results))
@@ -222,27 +253,36 @@ def conversion_settings(run: SourceRun, conversion: Mapping[str, Any] | None) ->
 
 
 def evaluate(run: SourceRun, takeset: TakeSet, name: str, method: str, example: ConvertedExample, cut: CutExample,
-             checkpoints: Mapping[str, Path], folder: Path, samples: int, seed: int | None, say: Say) -> dict[str, Any]:
+             checkpoints: Mapping[str, Path], folder: Path, samples: int, seed: int | None, say: Say,
+             options: Mapping[str, Any] | None = None) -> dict[str, Any]:
     """The report of the new models against ``run`` and its data ``takeset`` (``report.json`` layout without
-    provenance); paths relative to ``folder``."""
+    provenance); paths inside ``folder`` relative to it; ``options``: the method's keys (see :meth:`Method.prepare`)."""
+    impl = METHODS[method]
     settings = run.settings
     seed = run.seed if seed is None else int(seed)
     autoencoder = load_autoencoder(run.autoencoder_ckpt)
     segmentations = {}
     per: dict[str, dict[str, Any]] = {}
     models = {}
+    loaded: dict[str, EvalModel] = {}
     for primitive, ckpt in checkpoints.items():
         action = parse_primitive(primitive)[0]
         if action not in segmentations:
             segmentations[action] = segment_action(takeset.takes, action, settings.segment)
-        new = load_model(ckpt, settings.neutral_style, autoencoder)
+        clips = cut.used[primitive]
+        new = loaded[primitive] = impl.load(ckpt, primitive, clips, [example.record(c) for c in clips], name,
+                                            settings.neutral_style, autoencoder)
         per[primitive] = evaluate_primitive(primitive, run.models(primitive, autoencoder), new, cut.used[primitive],
                                             takeset, autoencoder, settings, run.data_cfg.get("split"), samples, seed,
                                             segmentations[action], lambda text: say("    " + text))
-        models[primitive] = {"checkpoint": Path(ckpt).resolve().relative_to(folder.resolve()).as_posix(),
+        models[primitive] = {"checkpoint": recorded_path(ckpt, folder),
                              "examples": new.examples,
                              "borrowed": primitive in cut.borrowed}
     info = autoencoder_info(autoencoder, run.autoencoder_ckpt)
+    entries = [{"path": m["checkpoint"], "primitive": p, "name": name, "style": name,
+                **({"path_relative": os.path.relpath(m["checkpoint"], folder.resolve())}
+                   if Path(m["checkpoint"]).is_absolute() else {}),
+                **impl.entry(p, cut.used[p])} for p, m in models.items()]
     return {
         "name": name, "method": method,
         "example": {"file": example.name, "sha256": example.sha256, "file_fps": example.file_fps,
@@ -262,10 +302,10 @@ def evaluate(run: SourceRun, takeset: TakeSet, name: str, method: str, example: 
         "foot_skating_pooled": {kind: pooled_foot_skating(per, kind) for kind in ("samples", "example")},
         "meta": {"kind": STYLE_KIND, "name": name, "run": str(run.folder.resolve()), "data": run.data_cfg,
                  "data_name": takeset.name, "train_seed": run.seed, "seed": seed, "samples": samples,
-                 "checkpoints": [{"path": m["checkpoint"], "primitive": p, "name": name, "style": name}
-                                 for p, m in models.items()],
+                 "checkpoints": entries,
                  "autoencoder": {"path": str(Path(info["path"]).resolve()), "fingerprint": info["fingerprint"]},
                  "paths_relative_to": ".", "settings": asdict(settings)},
+        **impl.report(loaded, folder, options or {}),
     }
 
 
@@ -312,5 +352,6 @@ def add_style_from_config(cfg: DictConfig | Mapping[str, Any], say: Say = print,
     return add_style(str(values["example"]), values["run"], values["name"], values["out"],
                      method=values.get("method", "cvae"), action=values.get("action"),
                      samples=values.get("samples", 1000), seed=values.get("seed"), threads=values.get("threads", 1),
-                     conversion={k: values.get(k) for k in CONVERSION_KEYS}, say=say, command=command)
+                     conversion={k: values.get(k) for k in CONVERSION_KEYS}, say=say, command=command,
+                     network=values.get("network"), network_epochs=values.get("network_epochs"))
 

@@ -108,6 +108,29 @@ def evaluate_primitive(primitive: str, run_models: Sequence[EvalModel], new: Eva
     }
 
 
+def _clips(model: dict[str, Any]) -> str:
+    """A model's example clips as frames of the user's file."""
+    return ("; ".join(f"{c['primitive']} {c['file_frames'][0]}–{c['file_frames'][1]}" for c in model["examples"])
+            + (" (none of this primitive: the example's other steps)" if model["borrowed"] else ""))
+
+
+def _models_section(results: dict[str, Any]) -> list[str]:
+    """The lines that say where the new models come from (``method``)."""
+    network = results.get("network")
+    if network is None:
+        return ["Models (trained as the run's CVAE stage of the primitive, conditioned on the example's clips):", "",
+                _md_table(["primitive", "checkpoint", "example clips (frames of the file)"],
+                          [[p, f"`{m['checkpoint']}`", _clips(m)] for p, m in results["models"].items()]), ""]
+    origin = (f"trained here ({network['epochs']} epochs; give `network=<this folder>/network` "
+              "to later `stylemotion-style method=zero_shot` calls to reuse it)" if network["trained_here"]
+              else f"taken from `{network['given']}`, not trained again")
+    return [f"Models: the zero-shot network of each primitive, {origin}, bound to the example's clips — no model was "
+            "trained for this style:", "",
+            _md_table(["primitive", "network checkpoint", "trained on styles", "example clips (frames of the file)"],
+                      [[p, f"`{m['checkpoint']}`", ", ".join(network["trained_styles"][p]), _clips(m)]
+                       for p, m in results["models"].items()]), ""]
+
+
 #: An example whose Gram distance to the neutral column exceeds this many times the farthest of the
 #: run's own examples lies outside what the autoencoder was trained on.
 OUT_OF_RANGE_FACTOR = 3.0
@@ -142,12 +165,7 @@ def markdown(results: dict[str, Any]) -> str:
             f"`{meta.get('git_commit', '?')}`; {fmt(meta.get('seconds'), 3)} s.", ""]
     if meta.get("command"):
         out += ["```", meta["command"], "```", ""]
-    out += ["Models (trained as the run's CVAE stage of the primitive, conditioned on the example's clips):", "",
-            _md_table(["primitive", "checkpoint", "example clips (frames of the file)"],
-                      [[p, f"`{m['checkpoint']}`", "; ".join(f"{c['primitive']} {c['file_frames'][0]}–"
-                                                             f"{c['file_frames'][1]}" for c in m["examples"])
-                        + (" (none of this primitive: the example's other steps)" if m["borrowed"] else "")]
-                       for p, m in results["models"].items()]), ""]
+    out += _models_section(results)
     if results.get("skipped"):
         out += [f"No model of {results['skipped']}: another action than the example's.", ""]
     out += ["## Table 5.1 row", "", "D(new model, example) = mean Gram distance of its samples to each example "

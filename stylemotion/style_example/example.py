@@ -38,6 +38,8 @@ _RANGE = re.compile(r"^(?P<path>.*[^:]):(?P<range>[^:/\\]*-[^:/\\]*)$")
 
 #: Rejected steps listed at most in the "no complete step" message.
 MAX_REASONS = 6
+#: Where a style folder keeps the converted example (``positions`` (frames, 21, 3) metres, ``fps``, ``joint_names``).
+EXAMPLE_FILE = "example/example.npz"
 
 
 class StyleExampleError(ValueError):

@@ -9,8 +9,10 @@ follow the foot that carries the body. A clip that ends at the transfer onto the
     beginRightStance ─▶ leftStance ─▶ …                          … ─▶ endRightStance
 
 ``end*`` primitives have no successor. Every node is a generative model: a neutral
-:class:`~stylemotion.models.vae.PrimitiveVAE` or a :class:`~stylemotion.models.cvae.StyleCVAE` of the
-chosen style, all decoding through one autoencoder.
+:class:`~stylemotion.models.vae.PrimitiveVAE`, a :class:`~stylemotion.models.cvae.StyleCVAE` of the
+chosen style, or a :class:`~stylemotion.models.zero_shot.ZeroShotStyleVAE` bound to a style's example
+(a ``stylemotion-style method=zero_shot`` folder, :func:`load_bound_style`), all decoding through one
+autoencoder.
 
 Models come from a ``stylemotion-reproduce`` run folder (its ``report/report.json`` lists every
 evaluated checkpoint with its primitive and style), from a ``stylemotion-style`` folder (its
@@ -26,14 +28,18 @@ import os
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import torch
 
 from stylemotion.evaluation.sources import NEUTRAL, load_model
-from stylemotion.models.checkpoints import load_autoencoder
+from stylemotion.models.autoencoder import IncompatibleModelError
+from stylemotion.models.checkpoints import load_autoencoder, load_generative
 from stylemotion.models.vae import PrimitiveVAE
+from stylemotion.models.zero_shot import BoundExample, ZeroShotStyleVAE
 from stylemotion.primitives import PRIMITIVES, check_primitive
+from stylemotion.representation import positions_to_frames
 
 #: Successors of each primitive (by planted foot: a clip ending on foot f is followed by one planted on f).
 TRANSITIONS: dict[str, tuple[str, ...]] = {
@@ -80,14 +86,15 @@ class MotionGraph:
     Attributes:
         action: e.g. ``walk``.
         style: ``neutral`` or a style name.
-        models: primitive name without the action (e.g. ``leftStance``) → model (eval mode, frozen).
+        models: primitive name without the action (e.g. ``leftStance``) → model (eval mode, frozen): a
+            PrimitiveVAE/StyleCVAE or a zero-shot network's :class:`BoundExample`.
         sources: primitive → checkpoint path.
         profiles: primitive → :class:`StepProfile` (filled by :meth:`profile`).
     """
 
     action: str
     style: str
-    models: dict[str, PrimitiveVAE]
+    models: dict[str, PrimitiveVAE | BoundExample]
     sources: dict[str, str] = field(default_factory=dict)
     profiles: dict[str, StepProfile] = field(default_factory=dict)
 
@@ -185,21 +192,65 @@ def report_meta(run: str | Path) -> dict:
     return json.loads(report.read_text()).get("meta", {})
 
 
-def available_models(run: str | Path, meta: dict | None = None) -> list[dict[str, str]]:
+def available_models(run: str | Path, meta: dict | None = None) -> list[dict[str, Any]]:
     """Checkpoints of a ``stylemotion-reproduce`` run: ``[{primitive, name, style, path}]`` from its
     report's ``meta`` (read from ``run`` unless given; ``name`` is ``neutral`` or the style). For a
-    ``stylemotion-style`` folder: its own style's checkpoints, then those of the run it extends."""
+    ``stylemotion-style`` folder: its own style's checkpoints, then those of the run it extends; a zero-shot
+    style's entries add ``example`` (its example file) and ``clips`` (``[start, stop)`` frames in it)."""
     meta = report_meta(run) if meta is None else meta
     if meta.get("kind") == STYLE_FOLDER_KIND:
-        own = [{**{k: str(e[k]) for k in ("primitive", "name", "style")},
-                "path": os.path.normpath(Path(run).expanduser() / e["path"])} for e in meta.get("checkpoints", [])]
-        return own + available_models(extended_run(run, meta))
+        return [_style_entry(e, Path(run).expanduser()) for e in meta.get("checkpoints", [])] + available_models(
+            extended_run(run, meta))
     entries = meta.get("checkpoints")
     if not entries:
         raise ValueError(f"{Path(run) / 'report' / 'report.json'}: meta.checkpoints is empty; no model to "
                          "synthesize with")
     return [{**{k: str(e[k]) for k in ("primitive", "name", "style")}, "path": recorded(e["path"], run, meta)}
             for e in entries]
+
+
+def _style_entry(entry: Mapping[str, Any], folder: Path) -> dict[str, Any]:
+    """An entry of a style folder's ``meta.checkpoints`` with its paths resolved: ``path`` (relative to the folder,
+    or absolute; ``path_relative`` when that file is gone: both folders moved together) and ``example``."""
+    out: dict[str, Any] = {k: str(entry[k]) for k in ("primitive", "name", "style")}
+    path = Path(os.path.normpath(folder / entry["path"]))
+    if not path.is_file() and entry.get("path_relative"):
+        path = Path(os.path.normpath(folder / entry["path_relative"]))
+    out["path"] = str(path)
+    if entry.get("example"):
+        out["example"] = os.path.normpath(folder / entry["example"])
+        out["clips"] = [[int(a), int(b)] for a, b in entry["clips"]]
+    return out
+
+
+def load_bound_style(entry: Mapping[str, Any], autoencoder=None) -> BoundExample:
+    """The zero-shot network of a style folder's entry (:func:`available_models`) bound again to the clips
+    the style was made from: ``entry["example"]`` (``positions`` (frames, 21, 3) metres, ``fps``) cut at
+    ``entry["clips"]``, as ``stylemotion-style method=zero_shot`` bound them.
+
+    Raises:
+        FileNotFoundError: the checkpoint or the example file is gone.
+        IncompatibleModelError: the checkpoint is no zero-shot network, or ``autoencoder`` is not its own.
+    """
+    network = load_generative(entry["path"], autoencoder)
+    if not isinstance(network, ZeroShotStyleVAE):
+        raise IncompatibleModelError(f"{entry['path']} is a {type(network).__name__}, not the zero-shot network the "
+                                     f"style {entry['name']} records")
+    example = Path(entry["example"])
+    if not example.is_file():
+        raise FileNotFoundError(f"style {entry['name']}: its example {example} is gone; the zero-shot network "
+                                "samples the style only with it")
+    with np.load(example) as npz:
+        frames = positions_to_frames(npz["positions"], float(npz["fps"]))[0]
+    clips = [_Frames(frames[start:stop]) for start, stop in entry["clips"]]
+    return network.bind_example(clips, entry["name"])
+
+
+@dataclass(frozen=True)
+class _Frames:
+    """A clip as :meth:`ZeroShotStyleVAE.bind_example` reads one: ``frames`` ``(frames, 66)``."""
+
+    frames: np.ndarray
 
 
 def recorded(path: str | Path, run: str | Path, meta: dict | None = None) -> str:
@@ -259,20 +310,25 @@ def load_graph(style: str, run: str | Path | None = None, models: Mapping[str, s
     """
     wanted = NEUTRAL if style in (NEUTRAL, neutral_style) else style
     if models:
-        paths = {_short(k, action): str(v) for k, v in models.items()}
+        chosen: dict[str, dict[str, Any]] = {_short(k, action): {"path": str(v)} for k, v in models.items()}
     elif run is not None:
         meta = report_meta(run)
         entries = [e for e in available_models(run, meta) if e["primitive"].startswith(f"{action}_")]
-        paths = {_short(e["primitive"], action): e["path"] for e in entries if e["name"] == wanted}
-        if not paths:
+        chosen = {_short(e["primitive"], action): e for e in entries if e["name"] == wanted}
+        if not chosen:
             have = sorted({e["name"] for e in entries})
             raise UnknownStyleError(f"style {style!r} has no {action} model in {run}; styles there: {have} "
                                     f"('{NEUTRAL}' = the neutral VAEs)")
     else:
         raise ValueError("give run=<stylemotion-reproduce folder> or models={primitive: checkpoint}")
-    loaded: dict[str, PrimitiveVAE] = {}
+    paths = {p: e["path"] for p, e in chosen.items()}
+    loaded: dict[str, PrimitiveVAE | BoundExample] = {}
     autoencoder = run_autoencoder(run, meta) if not models else None  # models= names its own checkpoints
     for primitive, path in sorted(paths.items()):
+        if chosen[primitive].get("example"):  # a zero-shot style: its network, bound to the style's example
+            loaded[primitive] = load_bound_style(chosen[primitive], autoencoder)
+            autoencoder = loaded[primitive].autoencoder
+            continue
         entry = load_model(path, neutral_style=neutral_style, autoencoder=autoencoder)
         if entry.name != wanted:
             raise UnknownStyleError(f"{path} models style {entry.name!r}, not {style!r}")

@@ -1,6 +1,7 @@
 """``stylemotion-style`` as a command: a new style from a shared-data walk of another skeleton (CMU 21 joints,
 60 fps, a frame range) on a tiny synthetic reproduce run, then ``stylemotion-generate`` with it; refused input
-is one line naming the key, with nothing written; the config names a missing mandatory key."""
+(a taken name, a ``network=`` mapping of CVAEs for ``method=zero_shot``) is one line naming the key, with
+nothing written; the config names a missing mandatory key."""
 
 from __future__ import annotations
 
@@ -69,6 +70,18 @@ def test_refused_input_is_one_line_and_writes_nothing(run: Path, tmp_path: Path)
     assert not (tmp_path / "out").exists()
 
 
+def test_a_network_that_is_no_zero_shot_network_is_one_line_and_writes_nothing(run: Path, tmp_path: Path) -> None:
+    cvae = {p: run / "cvae" / f"{p}_elderly" / "checkpoints" / "best.ckpt" for p in ("walk_leftStance",
+                                                                                   "walk_rightStance")}
+    mapping = "{" + ",".join(f"{p}:'{path}'" for p, path in cvae.items()) + "}"
+    done = command("style", f"example={example_bvh(tmp_path)}", f"run={run}", "name=mine", f"out={tmp_path / 'out'}",
+                   "method=zero_shot", f"network={mapping}", cwd=tmp_path)
+    message = one_line_error(done, "stylemotion-style")
+    assert message == (f"stylemotion-style: network: {cvae['walk_leftStance']} is a StyleCVAE, not a zero-shot style "
+                       "network (stylemotion-train experiment=zero_shot; or network=null trains one here)")
+    assert not (tmp_path / "out").exists()
+
+
 @pytest.mark.parametrize("missing, message", [("name", "name is missing: give name=<the new style's name>"),
                                               ("example", "example is missing: give example=<BVH>[:start-end]")])
 def test_the_config_names_a_missing_key(tmp_path: Path, missing: str, message: str) -> None:
@@ -80,3 +93,4 @@ def test_the_config_names_a_missing_key(tmp_path: Path, missing: str, message: s
     with pytest.raises(ConfigError, match=re.escape(message)):
         add_style_from_config(cfg, say=lambda _: None)
     assert cfg.method == "cvae" and cfg.samples == 1000 and not (tmp_path / "out").exists()
+    assert cfg.network is None and cfg.network_epochs is None

@@ -1,6 +1,7 @@
 """The zero-shot style network: it trains, its example steers its samples (towards that example's style,
 for an anchored network and for an embedding-only one), its checkpoint round-trips under
-``weights_only=True``, and a bound example is a sample source the evaluation takes as it is."""
+``weights_only=True``, and a bound example is a sample source the evaluation takes as it is and offers what
+the path-following synthesis uses of a model."""
 
 from __future__ import annotations
 
@@ -111,6 +112,22 @@ def test_a_bound_example_is_a_sample_source_of_the_evaluation(data, trained) -> 
     table = results["table_5_1"]["walk_leftStance"]
     assert table["models"] == ["elderly"] and table["samples"] == 20
     assert 0.0 <= results["style_recognition"]["per_model"]["elderly"] <= 1.0
+
+
+def test_a_bound_example_offers_what_the_path_following_uses_of_a_model(data, trained) -> None:
+    model = trained[True]
+    bound = model.bind_example(data.example_clip("elderly")).eval().requires_grad_(False)
+    assert bound.hparams.latent_dim == model.hparams.latent_dim and not model.training
+    assert not any(p.requires_grad for p in model.parameters())
+    z = torch.randn(5, bound.hparams.latent_dim, generator=torch.Generator().manual_seed(0)).requires_grad_(True)
+    features, duration = bound.denormalize(bound.net.decode(z))  # the controller's step cost, differentiable in z
+    expected = bound.decode_latent(z.detach())
+    assert torch.allclose(features, expected.features, atol=1e-5)
+    assert torch.allclose(duration, expected.duration_s, atol=1e-5)
+    features.sum().backward()
+    assert z.grad is not None and z.grad.abs().sum() > 0
+    other = model.bind_example(data.example_clip("youthful"))  # the bound condition is what decodes
+    assert not torch.allclose(other.net.decode(z.detach()), bound.net.decode(z.detach()))
 
 
 def test_sampling_needs_an_example_and_the_data_must_pair_styles(ae_ckpt, trained) -> None:

@@ -151,7 +151,7 @@ def test_an_unmapped_skeleton_is_refused(run, tmp_path: Path) -> None:
 
 
 def test_an_unknown_method_is_refused(run, tmp_path: Path) -> None:
-    _refused(tmp_path, ConfigError, r"method must be one of \['cvae'\], got 'zeroshot'",
+    _refused(tmp_path, ConfigError, r"method must be one of \['cvae', 'zero_shot'\], got 'zeroshot'",
              example=str(example_bvh(tmp_path)), run=run, method="zeroshot")
 
 
