@@ -37,8 +37,7 @@ import shutil
 import time
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
-from dataclasses import asdict, dataclass
-from functools import cached_property
+from dataclasses import asdict
 from pathlib import Path
 from typing import Any
 
@@ -48,10 +47,10 @@ from omegaconf import DictConfig, OmegaConf, open_dict
 from stylemotion.config import config_dir, positive_int, set_torch_threads
 from stylemotion.datasets import TakeSet, build_dataset
 from stylemotion.evaluation.pipeline import example_column_gram, real_side, recognition
-from stylemotion.evaluation.run import settings_from_config
 from stylemotion.evaluation.settings import EvalSettings
 from stylemotion.evaluation.sources import NEUTRAL, EvalModel, check_one_autoencoder, load_model
 from stylemotion.evaluation.tables import across_sample_sd, distance_table
+from stylemotion.finished_run import FinishedRun, read_json_object
 from stylemotion.io.atomic import atomic_write_bytes
 from stylemotion.io.outputs import check_new_output, inside
 from stylemotion.models.checkpoints import fingerprint, load_autoencoder, load_generative
@@ -73,50 +72,15 @@ class ZeroShotRunError(ValueError):
 # -- the reproduce run
 
 
-@dataclass
-class ReproduceRun:
-    """What the evaluation reads of a finished ``stylemotion-reproduce`` run (see :func:`read_run`).
-
-    Attributes:
-        folder: the run folder.
-        summary: its ``reproduce.json``.
-        meta: ``meta`` of its ``report/report.json`` (data config, seed, evaluation settings).
-    """
-
-    folder: Path
-    summary: dict[str, Any]
-    meta: dict[str, Any]
-
-    def located(self, path: str) -> Path:
-        """A path recorded by the run: relative ones are relative to its folder."""
-        return Path(path) if Path(path).is_absolute() else self.folder / path
-
-    @property
-    def data_cfg(self) -> dict[str, Any]:
-        return dict(self.meta["data"])
-
-    @property
-    def seed(self) -> int:
-        return int(self.meta.get("seed", 0))
-
-    @cached_property
-    def settings(self) -> EvalSettings:
-        """The run's evaluation settings (segmentation, neutral style, classifier, …)."""
-        values = {k: v for k, v in (self.meta.get("settings") or {}).items() if k != "seed"}
-        return settings_from_config(values, self.seed)
-
-    def _stages(self, kind: str) -> list[dict[str, Any]]:
-        return [s for s in self.summary.get("stages", []) if s.get("kind") == kind]
-
-    @property
-    def autoencoder_ckpt(self) -> Path:
-        return self.located(self._stages("autoencoder")[0]["checkpoint"])
+class ReproduceRun(FinishedRun):
+    """What the evaluation reads of a finished ``stylemotion-reproduce`` run (see :func:`read_run` and
+    :class:`stylemotion.finished_run.FinishedRun`): its CVAEs by primitive and style."""
 
     @property
     def cvaes(self) -> dict[tuple[str, str], Path]:
         """``(primitive, style)`` → the CVAE checkpoint."""
         return {(str(s["values"]["primitive"]), str(s["values"]["style"])): self.located(s["checkpoint"])
-                for s in self._stages("cvae")}
+                for s in self.stages("cvae")}
 
     @property
     def primitives(self) -> list[str]:
@@ -126,16 +90,6 @@ class ReproduceRun:
     def styles(self, primitive: str) -> list[str]:
         """The CVAE styles of ``primitive``, in the run's order."""
         return [s for p, s in self.cvaes if p == primitive]
-
-
-def _read_json(path: Path, what: str) -> dict[str, Any]:
-    try:
-        value = json.loads(path.read_text())
-    except (OSError, ValueError) as exc:
-        raise ZeroShotRunError(f"run={path.parent}: cannot read its {what} {path} ({exc})") from None
-    if not isinstance(value, dict):
-        raise ZeroShotRunError(f"{path} does not hold a JSON object")
-    return value
 
 
 def read_run(folder: str | Path) -> ReproduceRun:
@@ -150,10 +104,11 @@ def read_run(folder: str | Path) -> ReproduceRun:
     for path, what in ((summary_path, "reproduce.json"), (report_path, "report (report/report.json)")):
         if not path.is_file():
             raise ZeroShotRunError(f"run={folder} is not a finished stylemotion-reproduce run: it has no {what}")
-    run = ReproduceRun(folder, _read_json(summary_path, "summary"), _read_json(report_path, "report").get("meta", {}))
+    run = ReproduceRun(folder, read_json_object(summary_path, "summary", ZeroShotRunError),
+                       read_json_object(report_path, "report", ZeroShotRunError))
     if not run.meta.get("data"):
         raise ZeroShotRunError(f"run={folder}: {report_path} records no data config (meta.data)")
-    if not run._stages("autoencoder") or not run._stages("cvae"):
+    if not run.stages("autoencoder") or not run.stages("cvae"):
         raise ZeroShotRunError(f"run={folder} has no finished autoencoder or no style CVAE stage to compare with")
     missing = [str(p) for p in [run.autoencoder_ckpt, *run.cvaes.values()] if not p.is_file()]
     if missing:

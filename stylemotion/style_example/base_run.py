@@ -11,23 +11,19 @@ autoencoder; only the style and the output folder differ.
 
 from __future__ import annotations
 
-import json
-from dataclasses import dataclass
-from functools import cached_property
 from pathlib import Path
 from typing import Any
 
 from omegaconf import DictConfig, open_dict
 
-from stylemotion.evaluation.run import settings_from_config
-from stylemotion.evaluation.settings import EvalSettings
 from stylemotion.evaluation.sources import NEUTRAL, EvalModel, load_model
+from stylemotion.finished_run import FinishedRun, read_json_object
 from stylemotion.io.outputs import safe_name
 from stylemotion.primitives import parse_primitive
 from stylemotion.reproduction import stage_train_config
 from stylemotion.style_example.example import StyleExampleError
 from stylemotion.synthesis.graph import STYLE_FOLDER_KIND as STYLE_KIND
-from stylemotion.synthesis.graph import available_models, relocated
+from stylemotion.synthesis.graph import available_models
 
 #: Stage statuses of a finished stage in ``reproduce.json``.
 FINISHED = ("trained", "reused", "resumed")
@@ -37,43 +33,14 @@ class NameTakenError(StyleExampleError):
     """The new style's name is a style of the run's data or the name of one of its models."""
 
 
-@dataclass
-class SourceRun:
-    """A finished reproduce run (see the module doc); build it with :func:`load_run`.
-
-    Attributes:
-        folder: the run folder.
-        summary: ``reproduce.json``.
-        report: ``report/report.json``.
-    """
-
-    folder: Path
-    summary: dict[str, Any]
-    report: dict[str, Any]
-
-    @property
-    def meta(self) -> dict[str, Any]:
-        return self.report.get("meta", {})
-
-    @property
-    def data_cfg(self) -> dict[str, Any]:
-        """The run's ``data`` config node (plain values)."""
-        return dict(self.meta["data"])
-
-    @property
-    def seed(self) -> int:
-        return int(self.meta.get("seed", 0))
-
-    @cached_property
-    def settings(self) -> EvalSettings:
-        """The run's evaluation settings (segmentation, neutral style, classifier, skating threshold, …)."""
-        values = {k: v for k, v in (self.meta.get("settings") or {}).items() if k != "seed"}
-        return settings_from_config(values, self.seed)
+class SourceRun(FinishedRun):
+    """A finished reproduce run (see the module doc and :class:`stylemotion.finished_run.FinishedRun`);
+    build it with :func:`load_run`."""
 
     @property
     def primitives(self) -> list[str]:
         """The run's primitives, in its order."""
-        return [str(s["values"]["primitive"]) for s in self.summary["stages"] if s["kind"] == "vae"]
+        return [str(s["values"]["primitive"]) for s in self.stages("vae")]
 
     @property
     def data_styles(self) -> list[str]:
@@ -88,21 +55,9 @@ class SourceRun:
     def command(self) -> str:
         return str(self.summary.get("provenance", {}).get("command") or "stylemotion-reproduce …")
 
-    def located(self, path: str) -> Path:
-        """A path recorded in ``reproduce.json``: relative ones are relative to the run folder; absolute
-        ones are found under the folder if it has moved since (:func:`stylemotion.synthesis.graph.relocated`)."""
-        recorded = Path(path)
-        return Path(relocated(recorded, self.folder)) if recorded.is_absolute() else self.folder / recorded
-
-    @property
-    def autoencoder_ckpt(self) -> Path:
-        """The run's autoencoder checkpoint (what its VAE and CVAE stages were trained on)."""
-        stage = next(s for s in self.summary["stages"] if s["kind"] == "autoencoder")
-        return self.located(stage["checkpoint"])
-
     def cvae_stage(self, primitive: str) -> dict[str, Any]:
         """The run's first CVAE stage of ``primitive`` (any CVAE stage if it has none of that primitive)."""
-        stages = [s for s in self.summary["stages"] if s["kind"] == "cvae"]
+        stages = self.stages("cvae")
         return next((s for s in stages if s["values"].get("primitive") == primitive), stages[0])
 
     def models(self, primitive: str, autoencoder=None) -> list[EvalModel]:
@@ -112,13 +67,7 @@ class SourceRun:
 
 
 def _read_json(path: Path, what: str) -> dict[str, Any]:
-    try:
-        value = json.loads(path.read_text())
-    except (OSError, ValueError) as exc:
-        raise StyleExampleError(f"run={path.parent}: cannot read its {what} {path} ({exc})") from None
-    if not isinstance(value, dict):
-        raise StyleExampleError(f"run={path.parent}: {path} does not hold a JSON object")
-    return value
+    return read_json_object(path, what, StyleExampleError)
 
 
 def load_run(folder: str | Path) -> SourceRun:
