@@ -132,14 +132,16 @@ def hydra_configs() -> Iterator[None]:
         yield
 
 
-def train_config(run: ReproduceRun, primitive: str, style: str, folder: Path, epochs: int | None = None,
-                 overrides: Sequence[str] = (), threads: Any = None) -> DictConfig:
-    """The ``train`` config of the zero-shot network of ``primitive`` without ``style``: ``experiment=zero_shot``,
-    ``trainer.max_epochs=epochs`` (None: the experiment's), the ``overrides``, then the run's data, seed and
-    autoencoder, the output ``folder``; no progress bar."""
+def network_train_config(run: FinishedRun, primitive: str, folder: Path, epochs: int | None = None,
+                         overrides: Sequence[str] = (), threads: Any = None, exclude: Sequence[str] = (),
+                         epochs_key: str = "epochs") -> DictConfig:
+    """The ``train`` config of a zero-shot network of ``primitive`` on ``run``'s data, started afresh in
+    ``folder``: ``experiment=zero_shot``, ``trainer.max_epochs=epochs`` (None: the experiment's; ``epochs_key``
+    names it in errors), the ``overrides``, then the run's data, seed, autoencoder and neutral style, and
+    ``exclude`` left out. Composes inside Hydra's config search (:func:`hydra_configs`)."""
     from hydra import compose
 
-    listed = ["experiment=zero_shot"] + ([f"trainer.max_epochs={positive_int(epochs, 'epochs')}"] if epochs else [])
+    listed = ["experiment=zero_shot"] + ([f"trainer.max_epochs={positive_int(epochs, epochs_key)}"] if epochs else [])
     with hydra_configs():
         cfg = compose(config_name="train", overrides=listed + list(overrides))
     with open_dict(cfg):
@@ -150,8 +152,17 @@ def train_config(run: ReproduceRun, primitive: str, style: str, folder: Path, ep
             cfg.threads = positive_int(threads, "threads")
         cfg.primitive = primitive
         cfg.autoencoder_ckpt = str(run.autoencoder_ckpt)
-        cfg.datamodule.exclude_styles = [style]
         cfg.datamodule.neutral_style = run.settings.neutral_style
+        cfg.datamodule.exclude_styles = list(exclude)
+    return cfg
+
+
+def train_config(run: ReproduceRun, primitive: str, style: str, folder: Path, epochs: int | None = None,
+                 overrides: Sequence[str] = (), threads: Any = None) -> DictConfig:
+    """The ``train`` config of the zero-shot network of ``primitive`` without ``style``
+    (:func:`network_train_config`), without a progress bar."""
+    cfg = network_train_config(run, primitive, folder, epochs, overrides, threads, exclude=[style])
+    with open_dict(cfg):
         cfg.trainer.enable_progress_bar = False
         if cfg.get("callbacks") and "progress_bar" in cfg.callbacks:
             cfg.callbacks.progress_bar = None

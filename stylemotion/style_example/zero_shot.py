@@ -34,6 +34,7 @@ from omegaconf import Container, DictConfig, OmegaConf, open_dict
 from stylemotion.config import ConfigError, positive_int
 from stylemotion.datamodules.features import describe_clip
 from stylemotion.evaluation.sources import EvalModel
+from stylemotion.evaluation_zero_shot import network_train_config
 from stylemotion.io.outputs import inside
 from stylemotion.models.autoencoder import IncompatibleModelError
 from stylemotion.models.checkpoints import checkpoint_hparams, fingerprint, load_autoencoder, load_generative
@@ -61,11 +62,8 @@ def network_config(run: SourceRun, primitive: str, folder: Path, epochs: int | N
     (``trainer.max_epochs=epochs`` unless None), the :data:`CARRIED` keys and the timeline of the run's CVAE
     stage of ``primitive``, the run's data, seed, autoencoder and neutral style; every style of the data.
     Needs Hydra's config search initialized."""
-    from hydra import compose
-
     stage = train_config(run, primitive, str(run.cvae_stage(primitive)["values"]["style"]), folder, threads)
-    cfg = compose(config_name="train", overrides=["experiment=zero_shot"]
-                  + ([f"trainer.max_epochs={positive_int(epochs, 'network_epochs')}"] if epochs else []))
+    cfg = network_train_config(run, primitive, folder, epochs, threads=threads, epochs_key="network_epochs")
     with open_dict(cfg):
         for key in CARRIED:
             value = OmegaConf.select(stage, key, default=None)
@@ -73,16 +71,7 @@ def network_config(run: SourceRun, primitive: str, folder: Path, epochs: int | N
             OmegaConf.update(cfg, key, value, merge=False, force_add=True)
         timeline = stage.datamodule.get("timeline", "median")  # the CVAE's "median" of neutral clips is "neutral"
         cfg.datamodule.timeline = "neutral" if timeline == "median" else timeline
-        cfg.data = OmegaConf.create(run.data_cfg)
-        cfg.output_dir = str(Path(folder).resolve())
-        cfg.seed = run.seed
-        if threads is not None:
-            cfg.threads = positive_int(threads, "threads")
-        cfg.primitive = primitive
-        cfg.autoencoder_ckpt = str(run.autoencoder_ckpt)
-        cfg.datamodule.neutral_style = run.settings.neutral_style
         cfg.datamodule.styles = None
-        cfg.datamodule.exclude_styles = []
         cfg.ckpt_path = None
     return cfg
 
