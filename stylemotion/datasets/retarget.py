@@ -31,6 +31,13 @@ def check_retarget(value: Any) -> str | None:
                      f"style's takes) or null (each take keeps its own bones), got {value!r}")
 
 
+def skeleton_record(style: str | None, takes: int, lengths: np.ndarray) -> dict[str, Any]:
+    """The ``TakeSet.retarget`` record of a skeleton: the style whose takes set it (None: all takes), how
+    many takes, and its ``(20,)`` bone lengths in metres by bone name."""
+    return {"style": style, "takes": int(takes),
+            "bone_lengths_m": {name: round(float(x), 6) for name, x in zip(BONE_NAMES, lengths)}}
+
+
 def retarget_takeset(takeset: TakeSet, style: str) -> TakeSet:
     """Every take of ``takeset`` on the median bone lengths of the takes of ``style``.
 
@@ -59,8 +66,7 @@ def retarget_takeset(takeset: TakeSet, style: str) -> TakeSet:
         except ValueError as exc:
             raise ValueError(f"data.retarget={style!r}: take {take.name!r} ({take.source}): {exc}") from None
         takes.append(Take(take.name, positions, take.fps, dict(take.labels), take.source))
-    record = {"style": style, "takes": len(examples),
-              "bone_lengths_m": {name: round(float(x), 6) for name, x in zip(BONE_NAMES, target)}}
+    record = skeleton_record(style, len(examples), target)
     return replace(takeset, takes=takes, retarget=record)
 
 

@@ -149,11 +149,10 @@ class StyleCVAE(PrimitiveVAE):
             outputs.append(self.net.decode(z))
         features, _ = self.denormalize(torch.cat(outputs), clamp=False)
         distance = self.style_distance(features)
-        terms = {"style": (distance.mean(), self.hparams.style_weight)}
-        if self.hparams.style_term == "margin":
-            terms["style"] = (distance.mean(), 0.0)  # logged, not optimized
-            terms["style_excess"] = (margin_excess(distance, self.style_radius), self.hparams.style_weight)
-        return terms
+        if self.hparams.style_term == "margin":  # the distance is logged, the excess optimized
+            return {"style": (distance.mean(), 0.0),
+                    "style_excess": (margin_excess(distance, self.style_radius), self.hparams.style_weight)}
+        return {"style": (distance.mean(), self.hparams.style_weight)}
 
 
 def content_spread(features: torch.Tensor) -> float:

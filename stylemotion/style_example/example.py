@@ -25,6 +25,7 @@ import numpy as np
 
 from stylemotion.datasets.base import Take, TakeSet
 from stylemotion.datasets.loading import ConversionSettings, convert_motion
+from stylemotion.datasets.retarget import skeleton_record
 from stylemotion.io.bvh import parse_bvh
 from stylemotion.io.errors import MotionDataError
 from stylemotion.io.outputs import safe_name
@@ -179,10 +180,10 @@ def on_run_skeleton(example: ConvertedExample, takeset: TakeSet, neutral_style: 
     """
     record = getattr(takeset, "retarget", None)
     if not record:
-        takes = takeset.filter(style=neutral_style) or list(takeset.takes)
-        lengths = target_bone_lengths(t.positions for t in takes)
-        record = {"style": neutral_style if takeset.filter(style=neutral_style) else None, "takes": len(takes),
-                  "bone_lengths_m": {name: round(float(x), 6) for name, x in zip(BONE_NAMES, lengths)}}
+        neutral = takeset.filter(style=neutral_style)
+        takes = neutral or list(takeset.takes)
+        record = skeleton_record(neutral_style if neutral else None, len(takes),
+                                 target_bone_lengths(t.positions for t in takes))
     target = np.array([record["bone_lengths_m"][bone] for bone in BONE_NAMES])
     try:
         positions = retarget_positions(example.positions, target).astype(np.float32)
