@@ -357,14 +357,18 @@ def _build_column(t: int, g: np.ndarray, d: np.ndarray, skip: float, steps: tupl
 
 def _relax_vertical(cost: np.ndarray, dd: np.ndarray, vertical: list[tuple[int, np.ndarray, np.ndarray]]) -> np.ndarray:
     """Fixed point of ``cost = min(cost, d + cost[vertical predecessor])``: equal, bit for bit, to the
-    sequential recurrence over increasing database frames (``d + min(a, b) == min(d + a, d + b)``)."""
-    while vertical:
-        new = cost
-        for _, found, idx in vertical:
-            new = np.minimum(new, np.where(found[:, None], dd + new[idx], np.inf))
-        if np.array_equal(new, cost):
-            return cost
-        cost = new
+    sequential recurrence over increasing database frames (``d + min(a, b) == min(d + a, d + b)``). Takes as
+    many passes as the longest chain of improving vertical steps."""
+    masked = [(np.where(found[:, None], dd, np.inf), idx) for _, found, idx in vertical]  # inf: no predecessor
+    improved = bool(masked)
+    while improved:
+        improved = False
+        for dm, idx in masked:
+            cand = dm + cost[idx]
+            better = cand < cost
+            if better.any():
+                cost = np.where(better, cand, cost)
+                improved = True
     return cost
 
 
@@ -390,14 +394,22 @@ def _trace(g: np.ndarray, choice: np.ndarray, steps: tuple[Step, ...], pos: np.n
             trace = np.where(choice == c + 1, preds[dq][0].trace[np.maximum(pos[c], 0)] + dq, trace)
     hits = [(choice == c + 1, idx) for c, _, idx in vertical]
     hits = [(hit, idx) for hit, idx in hits if hit.any()]
-    while hits:  # acyclic chains inside the column: the fixed point is unique, reached in chain-length passes
-        new = trace
-        for hit, idx in hits:
-            new = np.where(hit, new[idx] + 1, new)
-        if np.array_equal(new, trace):
+    if not hits:
+        return trace
+    # vertical choices form chains inside the column: pointer jumping to their roots, O(log chain) passes
+    ptr = np.repeat(np.arange(choice.shape[0])[:, None], choice.shape[1], axis=1)
+    slot = np.arange(choice.shape[1])[None, :]
+    inc = np.zeros(choice.shape, dtype=np.int64)
+    for hit, idx in hits:
+        ptr = np.where(hit, idx[:, None], ptr)
+        inc = np.where(hit, 1, inc)
+    while True:
+        nxt = ptr[ptr, slot]
+        if np.array_equal(nxt, ptr):
             break
-        trace = new
-    return trace
+        inc = inc + inc[ptr, slot]
+        ptr = nxt
+    return np.where(inc > 0, trace[ptr, slot] + inc, trace)
 
 
 def _unpack(trace: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
