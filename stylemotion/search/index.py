@@ -1,0 +1,414 @@
+"""k-nearest-neighbour search over every frame of a dataset (Krüger §2.3.3, Table 2.1).
+
+:class:`FrameIndex` holds one feature set's features of every frame of a :class:`MotionDatabase` and an
+engine that answers k-NN queries on them (Euclidean distance in feature space):
+
+* ``"ckdtree"`` (default, exact): :class:`scipy.spatial.cKDTree`;
+* ``"pykdtree"`` (exact): the ``pykdtree`` package, float32, OpenMP-parallel over queries;
+* ``"faiss"`` (exact): ``faiss.IndexFlatL2`` brute force (optional extra ``search``);
+* ``"faiss-hnsw"`` (approximate, no ε guarantee): ``faiss.IndexHNSWFlat`` — the index type meant for
+  databases past one machine's exact-search budget (tens of millions of frames).
+
+Queries: exact k nearest, the up-to-k nearest within a fixed radius (missing ones padded with distance
+``inf`` and index ``-1``), and approximate ε search as in cKDTree (the i-th result is within ``1 + ε``
+of the true i-th nearest distance; the kd-tree engines honour it, ``"faiss"`` is exact anyway).
+
+Persisting: :meth:`FrameIndex.build` keeps the features and a fitted PCA in
+``<dataset cache>/search/`` as an ``.npz`` of plain arrays (read with ``allow_pickle=False``), keyed on
+the database's content digest (:attr:`MotionDatabase.digest` — so it is invalidated with the dataset:
+any changed frame, take or label gives a new key), the feature set, the normalization and
+:data:`SEARCH_FORMAT`. kd-trees are rebuilt on load (a cKDTree over 400k frames takes ~0.2 s; pickled
+trees would be arbitrary objects); an HNSW graph (~1 min for 400k frames) is stored beside the features
+as faiss' own serialized bytes with a CRC.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import io
+import json
+import os
+import warnings
+import zlib
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from stylemotion.datasets.base import TakeSet
+from stylemotion.datasets.loading import CacheWarning, default_cache_dir
+from stylemotion.io.atomic import atomic_write_bytes
+from stylemotion.io.outputs import safe_name
+from stylemotion.search.database import FrameLocation, MotionDatabase
+from stylemotion.search.features import (
+    FittedPCA,
+    compute_features,
+    feature_spec,
+    fit_features,
+)
+
+#: Bump when the features or the cache layout change, to invalidate cached indexes.
+SEARCH_FORMAT = 1
+#: Engines by name; exact ones first.
+ENGINES = ("ckdtree", "pykdtree", "faiss", "faiss-hnsw")
+EXACT_ENGINES = ("ckdtree", "pykdtree", "faiss")
+#: Engines whose built index is slow enough to build that :meth:`FrameIndex.build` caches it too.
+STORED_ENGINES = ("faiss-hnsw",)
+#: Links per node of the HNSW graph (faiss' ``M``).
+HNSW_M = 32
+_INSTALL_HINT = {"pykdtree": "pip install pykdtree", "faiss": "pip install 'stylemotion[search]' (faiss-cpu)"}
+
+
+# ---------------------------------------------------------------------------------------------
+# Engines: query(x (m, d) float32, k, eps, bound) -> (distances (m, k) float64, indices (m, k) int64),
+# with indices ≥ n or < 0 for missing neighbours (cleaned up by FrameIndex).
+
+
+class _CKDTree:
+    def __init__(self, data: np.ndarray, workers: int, leafsize: int = 16):
+        from scipy.spatial import cKDTree
+
+        self.tree = cKDTree(data, leafsize=leafsize)
+        self.workers = workers
+
+    def query(self, x: np.ndarray, k: int, eps: float, bound: float) -> tuple[np.ndarray, np.ndarray]:
+        d, i = self.tree.query(x, k=k, eps=eps, distance_upper_bound=bound, workers=self.workers)
+        return np.reshape(d, (len(x), k)), np.reshape(i, (len(x), k))
+
+
+class _PyKDTree:
+    def __init__(self, data: np.ndarray, workers: int, leafsize: int = 16):
+        try:
+            from pykdtree.kdtree import KDTree
+        except ImportError as exc:  # pragma: no cover - depends on the environment
+            raise ImportError(f"engine 'pykdtree' needs the pykdtree package: {_INSTALL_HINT['pykdtree']}") from exc
+        self.tree = KDTree(np.ascontiguousarray(data, dtype=np.float32), leafsize=leafsize)
+
+    def query(self, x: np.ndarray, k: int, eps: float, bound: float) -> tuple[np.ndarray, np.ndarray]:
+        bound_arg = None if np.isinf(bound) else float(bound)
+        d, i = self.tree.query(x, k=k, eps=eps, distance_upper_bound=bound_arg)
+        return np.reshape(d, (len(x), k)).astype(np.float64), np.reshape(i, (len(x), k)).astype(np.int64)
+
+
+def _import_faiss() -> Any:
+    try:
+        import faiss
+    except ImportError as exc:  # pragma: no cover - depends on the environment
+        raise ImportError(f"the faiss engines need faiss-cpu: {_INSTALL_HINT['faiss']}") from exc
+    return faiss
+
+
+class _Faiss:
+    """Exact (``IndexFlatL2``) or approximate (``IndexHNSWFlat``, ``hnsw_m`` links per node) faiss index."""
+
+    def __init__(self, data: np.ndarray, workers: int, approximate: bool = False, state: np.ndarray | None = None,
+                 hnsw_m: int = HNSW_M, ef_construction: int = 80, ef_search: int = 64):
+        faiss = _import_faiss()
+        if workers > 0:
+            faiss.omp_set_num_threads(workers)
+        d = data.shape[1]
+        if state is not None:  # faiss' own binary format (faiss.serialize_index), not a pickle
+            self.index = faiss.deserialize_index(np.ascontiguousarray(state, dtype=np.uint8))
+            if self.index.ntotal != data.shape[0] or self.index.d != d:
+                raise ValueError(f"stored faiss index holds {self.index.ntotal}×{self.index.d}, expected {data.shape}")
+        else:
+            self.index = faiss.IndexHNSWFlat(d, hnsw_m) if approximate else faiss.IndexFlatL2(d)
+            if approximate:
+                self.index.hnsw.efConstruction = ef_construction
+            self.index.add(np.ascontiguousarray(data, dtype=np.float32))
+        self.approximate = approximate
+        self.ef_search = ef_search
+
+    def state(self) -> np.ndarray:
+        """The index as faiss' serialized bytes ``(bytes,)`` uint8."""
+        return _import_faiss().serialize_index(self.index)
+
+    def query(self, x: np.ndarray, k: int, eps: float, bound: float) -> tuple[np.ndarray, np.ndarray]:
+        if self.approximate:
+            self.index.hnsw.efSearch = max(self.ef_search, k)
+        sq, i = self.index.search(np.ascontiguousarray(x, dtype=np.float32), k)
+        d = np.sqrt(np.maximum(sq.astype(np.float64), 0.0))
+        d[i < 0] = np.inf
+        return d, i.astype(np.int64)
+
+
+def _make_engine(engine: str, data: np.ndarray, workers: int, state: np.ndarray | None = None) -> Any:
+    if engine == "ckdtree":
+        return _CKDTree(data, workers)
+    if engine == "pykdtree":
+        return _PyKDTree(data, workers)
+    if engine in ("faiss", "faiss-hnsw"):
+        return _Faiss(data, workers, approximate=engine == "faiss-hnsw", state=state)
+    raise ValueError(f"unknown search engine {engine!r}; valid: {list(ENGINES)}")
+
+
+# ---------------------------------------------------------------------------------------------
+# Features of a whole database
+
+
+def database_features(database: MotionDatabase, feature_set: str, normalization: str = "3d",
+                      fitted: FittedPCA | None = None) -> tuple[np.ndarray, FittedPCA | None]:
+    """``(frames, d)`` float32 features of every frame (each take on its own), and the PCA fitted on all
+    takes when the set needs one and ``fitted`` is None."""
+    takes = [database.take_positions(i) for i in range(database.num_takes)]
+    if fitted is None:
+        fitted = fit_features(feature_set, takes, database.fps, normalization)
+    parts = [compute_features(feature_set, p, database.fps, fitted, normalization, allow_short=True) for p in takes]
+    return np.concatenate(parts), fitted
+
+
+def index_cache_key(database: MotionDatabase, feature_set: str, normalization: str) -> str:
+    """Hex key of an index's cached features: format, database digest, feature set and normalization."""
+    text = json.dumps({"format": SEARCH_FORMAT, "database": database.digest, "features": feature_set,
+                       "normalization": normalization}, sort_keys=True)
+    return hashlib.sha256(text.encode()).hexdigest()[:32]
+
+
+def _cache_path(cache_dir: Path, database: MotionDatabase, feature_set: str, normalization: str) -> Path:
+    key = index_cache_key(database, feature_set, normalization)
+    return cache_dir / "search" / f"{safe_name(database.name)}-{feature_set}-{normalization}-{key}.npz"
+
+
+def _write_features(path: Path, features: np.ndarray, fitted: FittedPCA | None, meta: dict[str, Any]) -> None:
+    arrays: dict[str, np.ndarray] = {"features": features, "meta": np.array(json.dumps(meta))}
+    if fitted is not None:
+        arrays.update(fitted.to_arrays())
+    buffer = io.BytesIO()
+    np.savez(buffer, **arrays)
+    atomic_write_bytes(path, buffer.getvalue())
+
+
+def _read_features(path: Path, expect_frames: int, expect_dim: int) -> tuple[np.ndarray, FittedPCA | None]:
+    """Features and PCA of a cache file; ValueError when it does not hold what the key promised."""
+    with np.load(path, allow_pickle=False) as npz:
+        meta = json.loads(str(npz["meta"]))
+        features = np.asarray(npz["features"])
+        fitted = FittedPCA.from_arrays(npz) if "pca_mean" in npz.files else None
+    if meta.get("format") != SEARCH_FORMAT:
+        raise ValueError(f"format {meta.get('format')!r}, expected {SEARCH_FORMAT}")
+    if features.dtype != np.float32 or features.shape != (expect_frames, expect_dim):
+        raise ValueError(f"features are {features.dtype} {features.shape}, expected float32 "
+                         f"({expect_frames}, {expect_dim})")
+    return features, fitted
+
+
+def _as_database(data: TakeSet | MotionDatabase | Mapping[str, Any]) -> MotionDatabase:
+    if isinstance(data, MotionDatabase):
+        return data
+    if isinstance(data, TakeSet):
+        return MotionDatabase.from_takeset(data)
+    if isinstance(data, Mapping):
+        from stylemotion.datasets.registry import build_dataset
+
+        return MotionDatabase.from_takeset(build_dataset(data))
+    raise TypeError(f"data must be a TakeSet, a MotionDatabase or a data config mapping, got {type(data).__name__}")
+
+
+# ---------------------------------------------------------------------------------------------
+# The index
+
+
+def _check_count(value: Any, key: str) -> int:
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
+        raise ValueError(f"{key} must be a whole number ≥ 1, got {value!r}")
+    return int(value)
+
+
+class FrameIndex:
+    """k-NN index over one feature set of every frame of a :class:`MotionDatabase`.
+
+    Attributes:
+        database: the frames and their takes.  feature_set, normalization: how features are made.
+        features: ``(frames, d)`` float32.  fitted: the database's PCA for ``pca*`` sets, else None.
+        engine: engine name (:data:`ENGINES`).  cache_path: where :meth:`build` keeps the features
+            (None if built directly).  from_cache: whether :meth:`build` read them from there.
+    """
+
+    def __init__(self, database: MotionDatabase, feature_set: str, features: np.ndarray | None = None,
+                 fitted: FittedPCA | None = None, *, normalization: str = "3d", engine: str = "ckdtree",
+                 workers: int = 1, engine_state: np.ndarray | None = None):
+        """Index ``features`` (computed, and a PCA fitted, when None).
+
+        ``workers``: threads (cKDTree's ``workers``, -1 = all cores; faiss' OpenMP threads, set process-wide;
+        pykdtree follows ``OMP_NUM_THREADS``). ``engine_state``: a faiss index serialized by
+        :meth:`engine_state` for these features (skips the HNSW build).
+        """
+        spec = feature_spec(feature_set)
+        if engine not in ENGINES:
+            raise ValueError(f"unknown search engine {engine!r}; valid: {list(ENGINES)}")
+        if features is None:
+            features, fitted = database_features(database, feature_set, normalization, fitted)
+        features = np.ascontiguousarray(features, dtype=np.float32)
+        if features.shape != (database.num_frames, spec.dim):
+            raise ValueError(f"features must be ({database.num_frames}, {spec.dim}) for {feature_set}, "
+                             f"got {features.shape}")
+        self.database, self.feature_set, self.normalization = database, feature_set, normalization
+        self.features, self.fitted, self.engine = features, fitted, engine
+        self.cache_path: Path | None = None
+        self.from_cache = False
+        self._engine = _make_engine(engine, features, workers, engine_state)
+
+    def engine_state(self) -> np.ndarray | None:
+        """The built faiss index as plain bytes ``(bytes,)`` uint8 (None for the kd-tree engines, which are
+        rebuilt faster than they would load)."""
+        return self._engine.state() if isinstance(self._engine, _Faiss) else None
+
+    @classmethod
+    def build(cls, data: TakeSet | MotionDatabase | Mapping[str, Any], feature_set: str = "E15", *,
+              normalization: str = "3d", engine: str = "ckdtree", workers: int = 1,
+              cache_dir: str | os.PathLike | None = None, use_cache: bool = True) -> FrameIndex:
+        """Index a dataset (a TakeSet, a MotionDatabase, or a ``data`` config as everywhere), reading the
+        features (and PCA) from the cache when they are there and writing them there otherwise.
+
+        A damaged cache file is rebuilt with a :class:`~stylemotion.datasets.loading.CacheWarning`.
+        """
+        database = _as_database(data)
+        spec = feature_spec(feature_set)
+        path = _cache_path(Path(cache_dir) if cache_dir is not None else default_cache_dir(), database,
+                           feature_set, normalization)
+        cached = _read_or_discard(path, database.num_frames, spec.dim) if use_cache and path.exists() else None
+        if cached is not None:
+            state_path = _state_path(path, engine)
+            state = _read_state(state_path) if engine in STORED_ENGINES and state_path.exists() else None
+            index = _with_state(cls, database, feature_set, cached, normalization, engine, workers, state, state_path)
+        else:
+            features, fitted = database_features(database, feature_set, normalization)
+            index = cls(database, feature_set, features, fitted, normalization=normalization, engine=engine,
+                        workers=workers)
+            if use_cache:
+                meta = {"format": SEARCH_FORMAT, "dataset": database.name, "digest": database.digest,
+                        "features": feature_set, "normalization": normalization}
+                _write_or_warn(path, features, fitted, meta)
+        if use_cache and engine in STORED_ENGINES and not _state_path(path, engine).exists():
+            _write_state(_state_path(path, engine), index.engine_state())
+        index.cache_path, index.from_cache = (path if use_cache else None), cached is not None
+        return index
+
+    @property
+    def dim(self) -> int:
+        return int(self.features.shape[1])
+
+    @property
+    def size(self) -> int:
+        return int(self.features.shape[0])
+
+    def query(self, queries: np.ndarray, k: int = 1, *, eps: float = 0.0,
+              radius: float | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """The ``k`` nearest frames of each query.
+
+        Args:
+            queries: ``(d,)`` one feature vector or ``(m, d)`` a batch.
+            k: neighbours per query, 1 ≤ k ≤ database size.
+            eps: approximation (ε ≥ 0): each returned distance is within ``(1 + ε)`` of the true one.
+            radius: if given, only neighbours at distance ≤ radius (at most k of them); missing ones are
+                padded with distance ``inf`` and index ``-1``.
+
+        Returns:
+            distances ``(m, k)`` float64 (or ``(k,)``), ascending, and global frame indices ``(m, k)``
+            int64 (or ``(k,)``) into :attr:`database`.
+        """
+        x, single = self._check_queries(queries)
+        k = _check_count(k, "k")
+        if k > self.size:
+            raise ValueError(f"k={k} exceeds the database size of {self.size} frames")
+        if not np.isfinite(eps) or eps < 0:
+            raise ValueError(f"eps must be a finite number ≥ 0, got {eps!r}")
+        if radius is not None and not (np.isfinite(radius) and radius > 0):
+            raise ValueError(f"radius must be a positive finite number or None, got {radius!r}")
+        bound = np.inf if radius is None else float(np.nextafter(radius, np.inf))
+        distances, indices = self._engine.query(x, k, float(eps), bound)
+        missing = (indices < 0) | (indices >= self.size) | ~np.isfinite(distances)
+        if radius is not None:
+            missing |= distances > radius
+        distances, indices = np.where(missing, np.inf, distances), np.where(missing, -1, indices)
+        return (distances[0], indices[0]) if single else (distances, indices)
+
+    def _check_queries(self, queries: np.ndarray) -> tuple[np.ndarray, bool]:
+        x = np.asarray(queries, dtype=np.float32)
+        single = x.ndim == 1
+        x = x[None, :] if single else x
+        if x.ndim != 2 or x.shape[1] != self.dim:
+            raise ValueError(f"queries must be ({self.dim},) or (m, {self.dim}) for {self.feature_set}, "
+                             f"got {np.shape(queries)}")
+        if not np.all(np.isfinite(x)):
+            raise ValueError("queries contain NaN or infinite values")
+        return np.ascontiguousarray(x), single
+
+    def features_of(self, positions: np.ndarray) -> np.ndarray:
+        """``(frames, d)`` features of a query motion ``(frames, 21, 3)`` at the database's fps, made like the
+        database's (same normalization and PCA); ValueError if it is shorter than the set's window."""
+        return compute_features(self.feature_set, positions, self.database.fps, self.fitted, self.normalization)
+
+    def query_positions(self, positions: np.ndarray, k: int = 1, **options: Any) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`query` for every frame of a query motion ``(frames, 21, 3)`` → ``(frames, k)`` each."""
+        return self.query(self.features_of(positions), k, **options)
+
+    def locate(self, global_index: int) -> FrameLocation:
+        """``(take, frame, content, style)`` of a hit (see :meth:`MotionDatabase.locate`)."""
+        return self.database.locate(global_index)
+
+
+def _read_or_discard(path: Path, frames: int, dim: int) -> tuple[np.ndarray, FittedPCA | None] | None:
+    try:
+        return _read_features(path, frames, dim)
+    except Exception as exc:  # noqa: BLE001 - any damage to the file means: rebuild it
+        warnings.warn(f"{path}: corrupt search index cache ({type(exc).__name__}: {exc}); rebuilding it",
+                      CacheWarning, stacklevel=3)
+        path.unlink(missing_ok=True)
+        return None
+
+
+def _state_path(path: Path, engine: str) -> Path:
+    return path.with_name(f"{path.stem}-{engine}-m{HNSW_M}.npz")
+
+
+def _read_state(path: Path) -> np.ndarray | None:
+    """A stored engine index, or None (with a CacheWarning, the file removed) when it is damaged."""
+    try:
+        with np.load(path, allow_pickle=False) as npz:
+            state, crc = np.asarray(npz["state"]), int(npz["crc32"])
+        if state.dtype != np.uint8 or state.ndim != 1 or zlib.crc32(state) != crc:
+            raise ValueError("the stored bytes do not match their CRC")
+        return state
+    except Exception as exc:  # noqa: BLE001 - any damage means: rebuild it
+        warnings.warn(f"{path}: corrupt stored search engine ({type(exc).__name__}: {exc}); rebuilding it",
+                      CacheWarning, stacklevel=3)
+        path.unlink(missing_ok=True)
+        return None
+
+
+def _write_state(path: Path, state: np.ndarray | None) -> None:
+    if state is None:
+        return
+    buffer = io.BytesIO()
+    np.savez(buffer, state=state, crc32=np.array(zlib.crc32(state), dtype=np.int64))
+    try:
+        atomic_write_bytes(path, buffer.getvalue())
+    except OSError as exc:
+        warnings.warn(f"{path}: cannot store the search engine ({exc}); it is rebuilt next time",
+                      CacheWarning, stacklevel=3)
+
+
+def _with_state(cls: type[FrameIndex], database: MotionDatabase, feature_set: str,
+                cached: tuple[np.ndarray, FittedPCA | None], normalization: str, engine: str, workers: int,
+                state: np.ndarray | None, state_path: Path) -> FrameIndex:
+    """The index from cached features and, when it loads, the stored engine (else built anew)."""
+    if state is not None:
+        try:
+            return cls(database, feature_set, cached[0], cached[1], normalization=normalization, engine=engine,
+                       workers=workers, engine_state=state)
+        except (RuntimeError, ValueError) as exc:
+            warnings.warn(f"{state_path}: stored search engine does not load ({exc}); rebuilding it",
+                          CacheWarning, stacklevel=4)
+            state_path.unlink(missing_ok=True)
+    return cls(database, feature_set, cached[0], cached[1], normalization=normalization, engine=engine,
+               workers=workers)
+
+
+def _write_or_warn(path: Path, features: np.ndarray, fitted: FittedPCA | None, meta: dict[str, Any]) -> None:
+    try:
+        _write_features(path, features, fitted, meta)
+    except OSError as exc:
+        warnings.warn(f"{path}: cannot write the search index cache ({exc}); the index is built but not cached",
+                      CacheWarning, stacklevel=3)
