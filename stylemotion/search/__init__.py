@@ -1,10 +1,13 @@
 """Motion-database search (Krüger, *Synthesizing Human Motions*, ch. 2).
 
 Feature sets of canonical positions (§2.3.2, §2.6.1), every frame of a dataset in one
-:class:`MotionDatabase`, and a k-NN :class:`FrameIndex` over one feature set, persisted in the dataset cache.
+:class:`MotionDatabase`, and a k-NN :class:`FrameIndex` over one feature set, persisted in the dataset cache;
+global motion matching of a query (:func:`search_motion`, §2.4.1), numerical and logical similarity searches
+(§2.5.1) and fast fat-graph base poses (§2.5.3). The ``stylemotion-search`` command: :mod:`.command`.
 """
 
 from stylemotion.search.database import FrameLocation, MotionDatabase
+from stylemotion.search.fat_graph import FatGraphClusters, base_poses, greedy_bases, write_clusters
 from stylemotion.search.features import (
     E15_JOINTS,
     E30_JOINTS,
@@ -25,10 +28,23 @@ from stylemotion.search.features import (
     root_frames,
 )
 from stylemotion.search.index import ENGINES, EXACT_ENGINES, SEARCH_FORMAT, FrameIndex, database_features
+from stylemotion.search.matching import (
+    DEFAULT_K,
+    MATCH_KEYS,
+    SearchResult,
+    SegmentMatch,
+    nearest_outside,
+    search_features,
+    search_motion,
+)
+from stylemotion.search.similarity import LogicalResult, logical_search, numerical_search
 
 __all__ = [
     "E15_JOINTS", "E30_JOINTS", "E39_JOINTS", "ENGINES", "EXACT_ENGINES", "FEATURE_SETS", "NORMALIZATIONS",
     "SEARCH_FORMAT", "SEGMENTS", "WINDOW_SECONDS", "FeatureSpec", "FittedPCA", "FrameIndex", "FrameLocation",
     "MotionDatabase", "body_frame_positions", "centre_of_mass", "compute_features", "database_features",
     "feature_names", "feature_spec", "fit_features", "physics_terms", "root_frames",
+    "DEFAULT_K", "MATCH_KEYS", "SearchResult", "SegmentMatch", "nearest_outside", "search_features", "search_motion",
+    "LogicalResult", "logical_search", "numerical_search",
+    "FatGraphClusters", "base_poses", "greedy_bases", "write_clusters",
 ]

@@ -49,17 +49,19 @@ class StyleExampleError(ValueError):
 
 @dataclass(frozen=True)
 class ExampleSpec:
-    """What ``example=`` names.
+    """What ``example=`` (or another command's key, e.g. ``stylemotion-search``'s ``query=``) names.
 
     Attributes:
         path: the BVH file, or ``archive.zip::member.bvh``.
         start: first frame to use, at the file's frame rate (0 = the first), or None (all).
         end: one past the last frame to use, or None (all).
+        key: the command's key that named it, for messages (not part of equality).
     """
 
     path: str
     start: int | None = None
     end: int | None = None
+    key: str = field(default="example", compare=False)
 
     @property
     def source(self) -> FileSource:
@@ -70,30 +72,31 @@ class ExampleSpec:
         return self.path if self.start is None else f"{self.path}:{self.start}-{self.end}"
 
 
-def parse_example(text: str) -> ExampleSpec:
+def parse_example(text: str, key: str = "example") -> ExampleSpec:
     """``<BVH>[:start-end]`` → :class:`ExampleSpec` (the range checked for syntax only).
 
-    A value that names an existing file as a whole is that file, even if it ends like a range.
+    A value that names an existing file as a whole is that file, even if it ends like a range. ``key``: the
+    command's key that gave the value, named in messages (``stylemotion-search`` passes ``query``).
 
     Raises:
         StyleExampleError: an empty value, or a range that is not two whole numbers ``start < end``, ``start ≥ 0``.
     """
     text = str(text or "").strip()
     if not text:
-        raise StyleExampleError("example= is empty: give a BVH file, optionally with a frame range "
-                                "(example=walk.bvh or example=walk.bvh:120-480)")
+        raise StyleExampleError(f"{key}= is empty: give a BVH file, optionally with a frame range "
+                                f"({key}=walk.bvh or {key}=walk.bvh:120-480)")
     match = _RANGE.match(text)
     if match is None or Path(text).expanduser().is_file():
-        return ExampleSpec(text)
+        return ExampleSpec(text, key=key)
     bounds = match["range"].split("-")
     if len(bounds) != 2 or not all(re.fullmatch(r"[0-9]+", b.strip()) for b in bounds):
-        raise StyleExampleError(f"example={text}: the frame range {match['range']!r} must be START-END, two whole "
-                                "numbers ≥ 0 of the file's frames (e.g. example=walk.bvh:120-480)")
+        raise StyleExampleError(f"{key}={text}: the frame range {match['range']!r} must be START-END, two whole "
+                                f"numbers ≥ 0 of the file's frames (e.g. {key}=walk.bvh:120-480)")
     start, end = (int(b) for b in bounds)
     if start >= end:
-        raise StyleExampleError(f"example={text}: the frame range {start}-{end} is empty; START must be smaller "
+        raise StyleExampleError(f"{key}={text}: the frame range {start}-{end} is empty; START must be smaller "
                                 "than END (frames of the file, END exclusive)")
-    return ExampleSpec(match["path"], start, end)
+    return ExampleSpec(match["path"], start, end, key)
 
 
 @dataclass
@@ -153,11 +156,11 @@ def convert_example(spec: ExampleSpec, settings: ConversionSettings) -> Converte
         data = source.read_bytes(settings.max_file_mb)
         motion = parse_bvh(data, source.name, settings.max_joint_frames)
     except MotionDataError as exc:
-        raise StyleExampleError(f"example={spec}: {exc}") from exc
+        raise StyleExampleError(f"{spec.key}={spec}: {exc}") from exc
     total = motion.num_frames
     start, end = (0, total) if spec.start is None else (spec.start, spec.end)
     if end > total:
-        raise StyleExampleError(f"example={spec}: the frame range {start}-{end} ends after the file's last frame: "
+        raise StyleExampleError(f"{spec.key}={spec}: the frame range {start}-{end} ends after the file's last frame: "
                                 f"{source.name} has {total} frames (0-{total}) at {motion.fps:g} fps")
     cut = replace(motion, rotations=motion.rotations[start:end], translations=motion.translations[start:end])
     try:
@@ -165,7 +168,7 @@ def convert_example(spec: ExampleSpec, settings: ConversionSettings) -> Converte
     except MotionDataError as exc:
         hint = (" Name its joints with joint_map=<map.yaml> (joints: {Hips: <its hips>, ...}, all 21 canonical "
                 "joints) or a built-in map (joint_map=bandai|cmu21|cmu31)") if "joint map" in str(exc) else ""
-        raise StyleExampleError(f"example={spec}: {exc}.{hint}") from exc
+        raise StyleExampleError(f"{spec.key}={spec}: {exc}.{hint}") from exc
     return ConvertedExample(spec, hashlib.sha256(data).hexdigest(), float(motion.fps), total, start, end,
                             positions, float(settings.fps))
 
@@ -188,7 +191,7 @@ def on_run_skeleton(example: ConvertedExample, takeset: TakeSet, neutral_style: 
     try:
         positions = retarget_positions(example.positions, target).astype(np.float32)
     except ValueError as exc:
-        raise StyleExampleError(f"example={example.spec}: cannot put it on the run's skeleton (bones of "
+        raise StyleExampleError(f"{example.spec.key}={example.spec}: cannot put it on the run's skeleton (bones of "
                                 f"{record.get('style') or 'all takes'}): {exc}") from None
     return replace(example, positions=positions, retarget=dict(record))
 

@@ -1,0 +1,133 @@
+"""Fast fat-graph base poses (Krüger §2.5.3; fat graphs: Shin and Oh 2006).
+
+The base poses cluster a motion database: poses with many close poses become base poses and absorb their
+neighbours. The thesis replaces the quadratic neighbourhood computation by k-d tree searches:
+
+1. every frame's neighbours within a fixed radius ``r`` (at most ``k``), one batched radius query of the
+   :class:`~stylemotion.search.index.FrameIndex` per chunk of frames — O(k n log n);
+2. the frame with the most neighbours is a base pose.
+
+Step 2 is repeated greedily (our reading of "base poses", plural): frames are visited once in order of
+decreasing neighbour count (ties: lower global index first); a frame not yet in a cluster becomes a base
+pose, and its listed neighbours not yet in a cluster join it. Every frame ends in exactly one cluster (a
+frame reached uncovered is its own base). The order is one sort and the sweep O(n k): O(n log n) in all
+for a constant ``k``. A frame counts itself among its neighbours (distance 0).
+
+:func:`write_clusters` exports ``clusters.json`` (per base pose: its global index, take, frame, labels,
+members, neighbour count) and ``clusters.npz`` (memberships).
+"""
+
+from __future__ import annotations
+
+import io
+import json
+import os
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from stylemotion.io.atomic import atomic_write_bytes
+from stylemotion.search.index import FrameIndex
+
+#: Frames per batched radius query (bounds the (chunk, k) arrays).
+CHUNK = 65536
+
+
+@dataclass(frozen=True, eq=False)
+class FatGraphClusters:
+    """Base poses and memberships of a database.
+
+    Attributes:
+        radius: the neighbourhood radius (feature units).  k: most neighbours per frame.
+        counts: ``(n,)`` int64 neighbours of each frame within ``radius`` (itself included, at most ``k``).
+        bases: ``(c,)`` int64 global frame of each cluster's base pose, in order of choice.
+        assignment: ``(n,)`` int64 cluster of every frame (index into ``bases``).
+    """
+
+    radius: float
+    k: int
+    counts: np.ndarray
+    bases: np.ndarray
+    assignment: np.ndarray
+
+    @property
+    def num_clusters(self) -> int:
+        return int(self.bases.shape[0])
+
+    @property
+    def sizes(self) -> np.ndarray:
+        """``(c,)`` frames in each cluster, base pose included."""
+        return np.bincount(self.assignment, minlength=self.num_clusters)
+
+
+def neighbour_lists(index: FrameIndex, radius: float, k: int, chunk: int = CHUNK) -> np.ndarray:
+    """``(n, k)`` int64 each database frame's neighbours within ``radius`` (at most ``k``, nearest first,
+    ``-1`` padding), by batched radius queries of the index over its own features."""
+    if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or not 1 <= k <= index.size:
+        raise ValueError(f"k must be a whole number between 1 and the database's {index.size} frames, got {k!r}")
+    out = np.empty((index.size, int(k)), dtype=np.int64)
+    for lo in range(0, index.size, chunk):
+        _, ind = index.query(index.features[lo:lo + chunk], int(k), radius=radius)
+        out[lo:lo + chunk] = ind
+    return out
+
+
+def greedy_bases(neighbours: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Greedy base poses from ``(n, k)`` neighbour lists (``-1`` padding): ``(counts (n,), bases (c,),
+    assignment (n,))`` as the module docstring describes."""
+    n = neighbours.shape[0]
+    counts = np.count_nonzero(neighbours >= 0, axis=1).astype(np.int64)
+    order = np.lexsort((np.arange(n), -counts))  # most neighbours first, ties by index
+    assignment = np.full(n, -1, dtype=np.int64)
+    bases: list[int] = []
+    for g in order:
+        if assignment[g] >= 0:
+            continue
+        cluster = len(bases)
+        bases.append(int(g))
+        assignment[g] = cluster
+        members = neighbours[g]
+        members = members[members >= 0]
+        assignment[members[assignment[members] < 0]] = cluster
+    return counts, np.array(bases, dtype=np.int64), assignment
+
+
+def base_poses(index: FrameIndex, radius: float, k: int = 64, chunk: int = CHUNK) -> FatGraphClusters:
+    """Fat-graph base poses of the whole database of ``index`` (its feature set, distance ≤ ``radius``,
+    at most ``k`` neighbours per frame)."""
+    neighbours = neighbour_lists(index, radius, k, chunk)
+    counts, bases, assignment = greedy_bases(neighbours)
+    return FatGraphClusters(float(radius), int(k), counts, bases, assignment)
+
+
+def cluster_records(clusters: FatGraphClusters, index: FrameIndex) -> list[dict[str, Any]]:
+    """Per base pose, in order of choice: ``{"cluster", "base", "take", "frame", "content", "style", "members",
+    "neighbours"}`` (``base``: global frame; ``frame``: in the take at the dataset's fps; ``members``: frames in
+    the cluster, the base included; ``neighbours``: its neighbour count)."""
+    sizes = clusters.sizes
+    out = []
+    for c, g in enumerate(clusters.bases):
+        where = index.locate(int(g))
+        out.append({"cluster": c, "base": int(g), "take": where.take, "frame": where.frame,
+                    "content": where.content, "style": where.style, "members": int(sizes[c]),
+                    "neighbours": int(clusters.counts[g])})
+    return out
+
+
+def write_clusters(clusters: FatGraphClusters, index: FrameIndex, folder: str | os.PathLike) -> tuple[Path, Path]:
+    """Write ``clusters.json`` (settings and :func:`cluster_records`) and ``clusters.npz`` (``assignment``
+    (n,), ``bases`` (c,), ``counts`` (n,), ``take_id`` (n,), ``frame_in_take`` (n,)) into ``folder``,
+    atomically; returns both paths."""
+    folder = Path(folder)
+    meta = {"dataset": index.database.name, "features": index.feature_set, "normalization": index.normalization,
+            "radius": clusters.radius, "k": clusters.k, "frames": index.size, "clusters": clusters.num_clusters,
+            "base_poses": cluster_records(clusters, index)}
+    json_path, npz_path = folder / "clusters.json", folder / "clusters.npz"
+    atomic_write_bytes(json_path, (json.dumps(meta, indent=1) + "\n").encode())
+    buffer = io.BytesIO()
+    np.savez(buffer, assignment=clusters.assignment, bases=clusters.bases, counts=clusters.counts,
+             take_id=index.database.take_id, frame_in_take=index.database.frame_in_take)
+    atomic_write_bytes(npz_path, buffer.getvalue())
+    return json_path, npz_path

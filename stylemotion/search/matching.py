@@ -1,0 +1,201 @@
+"""Global motion matching of a query motion against a :class:`~stylemotion.search.index.FrameIndex` (Krüger §2.4.1).
+
+One call does the thesis' steps 2–4 on an index built once (step 1): the query's features in the index's
+feature set (:meth:`FrameIndex.features_of`), one batched k-NN query for all its frames, the lazy
+neighbourhood graph over the database's takes (:func:`stylemotion.search.lng.lng_match`), and the matches
+mapped back to takes and labels::
+
+    index = FrameIndex.build(load_dataset("synthetic"), "E15")
+    result = search_motion(query_positions, index, k=16, top=10)     # (m, 21, 3) metres at index fps
+    for match in result.matches:                                      # best first, non-overlapping
+        match.take, match.content, match.style, match.start, match.end, match.cost
+        match.path                                                    # (L, 2) (query frame, frame in take)
+    result.implicit_distances(lo, hi)                                 # (m, hi - lo) k-NN distances, NaN elsewhere
+
+Frames of a match are frames of its take at the dataset's fps; ``end`` is **exclusive** (one past the last
+matched frame), so ``take[start:end]`` is the matched segment and ``query=<take>:<start>-<end>`` of
+``stylemotion-search`` cuts it again. ``cost`` is the LNG's accumulated feature distance along the path (the
+thesis' global distance; the feature set's units, see :mod:`stylemotion.search.features`).
+
+Excluding takes (e.g. the one a query was cut from): their frames are dropped from every query frame's
+neighbour list. So that each frame still has its ``k`` nearest frames *outside* them, the search asks for
+``k`` plus the excluded frame count (capped at the database) and keeps the ``k`` nearest that remain: the
+result is exactly the k-NN over the database without those takes.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Iterable
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from stylemotion.search.index import FrameIndex
+from stylemotion.search.lng import THESIS_STEPS, Match, Normalization, Step, TakeBounds, lng_match
+
+#: Neighbours per query frame by default: Table 2.1's larger k. With the thesis' steps a match needs every query
+#: frame's neighbours to hold the next frame of the same take; measured on Bandai's normal walks and runs (145
+#: takes, 21,791 frames), 1 s queries with their own take excluded found a match for 1 of 20 queries at k = 16, 13
+#: of 20 at k = 64 and 20 of 20 (ten matches each) at k = 256, in ~10 ms per query.
+DEFAULT_K = 256
+#: Keys of a match's record in ``matches.json``, in order.
+MATCH_KEYS = ("take", "content", "style", "start", "end", "cost")
+
+
+@dataclass(frozen=True, eq=False)
+class SegmentMatch:
+    """One ranked database segment.
+
+    Attributes:
+        rank: 1 for the best match.
+        take, content, style: the take's name and labels.
+        start, end: frames of the take at the dataset's fps, ``end`` exclusive.
+        cost: accumulated feature distance along the warping path (feature-set units).
+        path: ``(L, 2)`` int64 pairs (query frame, frame of the take), in path order.
+        global_start, global_end: the same frames as global database indices (``global_end`` exclusive).
+    """
+
+    rank: int
+    take: str
+    content: str
+    style: str
+    start: int
+    end: int
+    cost: float
+    path: np.ndarray = field(repr=False)
+    global_start: int = 0
+    global_end: int = 0
+
+    @property
+    def frames(self) -> int:
+        """Length of the matched segment in database frames."""
+        return self.end - self.start
+
+    def record(self) -> dict[str, Any]:
+        """The match as ``matches.json`` holds it: exactly :data:`MATCH_KEYS`."""
+        return {"take": self.take, "content": self.content, "style": self.style, "start": int(self.start),
+                "end": int(self.end), "cost": float(self.cost)}
+
+
+@dataclass(frozen=True, eq=False)
+class SearchResult:
+    """What :func:`search_features` found, and what it looked at.
+
+    Attributes:
+        matches: ranked, non-overlapping, best first.
+        indices, distances: ``(m, k)`` each query frame's neighbours (global frames, ascending distance;
+            ``-1``/``inf`` padding where a radius search found fewer) and their feature distances.
+        k: neighbours per query frame.  excluded_takes: names of takes left out of the search.
+        timings: seconds of ``features``, ``knn`` and ``lng``.
+    """
+
+    matches: list[SegmentMatch]
+    indices: np.ndarray = field(repr=False)
+    distances: np.ndarray = field(repr=False)
+    k: int = DEFAULT_K
+    excluded_takes: tuple[str, ...] = ()
+    timings: dict[str, float] = field(default_factory=dict)
+
+    @property
+    def query_frames(self) -> int:
+        return int(self.indices.shape[0])
+
+    def implicit_distances(self, lo: int, hi: int) -> np.ndarray:
+        """``(m, hi - lo)`` the distance matrix the LNG computed implicitly over global frames ``lo:hi``:
+        each query frame's k-NN distances where a neighbour lies in the range, NaN where none was computed."""
+        if not 0 <= lo < hi:
+            raise ValueError(f"the frame range must satisfy 0 <= lo < hi, got {lo}, {hi}")
+        out = np.full((self.query_frames, hi - lo), np.nan)
+        inside = (self.indices >= lo) & (self.indices < hi)
+        rows, cols = np.nonzero(inside)
+        out[rows, self.indices[rows, cols] - lo] = self.distances[rows, cols]
+        return out
+
+
+def take_bounds(index: FrameIndex) -> TakeBounds:
+    """The LNG's take layout of an index's database (cached on the database object)."""
+    database = index.database
+    cached = getattr(database, "_lng_take_bounds", None)
+    if cached is None:
+        cached = TakeBounds.from_next_in_take(database.next_in_take, database.take_id)
+        object.__setattr__(database, "_lng_take_bounds", cached)  # frozen dataclass: a derived cache only
+    return cached
+
+
+def _excluded_frames(index: FrameIndex, exclude_takes: Iterable[str]) -> tuple[tuple[str, ...], np.ndarray]:
+    names = tuple(dict.fromkeys(str(t) for t in exclude_takes))
+    ids = np.array([index.database.take_index(name) for name in names], dtype=np.int64)
+    return names, ids
+
+
+def nearest_outside(index: FrameIndex, features: np.ndarray, k: int, excluded_ids: np.ndarray, *,
+                    eps: float = 0.0, radius: float | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """``(distances, indices)`` ``(m, k)``: the ``k`` nearest frames of each query feature ``(m, d)`` among the
+    frames outside the takes ``excluded_ids`` (see the module docstring); ``-1``/``inf`` padding."""
+    database = index.database
+    blocked = int(sum(database.take_start[i + 1] - database.take_start[i] for i in excluded_ids))
+    available = database.num_frames - blocked
+    if k > available:
+        raise ValueError(f"k={k} exceeds the {available} frames of the database outside the excluded takes")
+    if blocked == 0:
+        return index.query(features, k, eps=eps, radius=radius)
+    distances, indices = index.query(features, min(k + blocked, database.num_frames), eps=eps, radius=radius)
+    keep = indices >= 0
+    keep[keep] = ~np.isin(database.take_id[indices[keep]], excluded_ids)
+    order = np.argsort(~keep, axis=1, kind="stable")[:, :k]  # kept first, in ascending distance
+    kept = np.take_along_axis(keep, order, axis=1)
+    distances = np.where(kept, np.take_along_axis(distances, order, axis=1), np.inf)
+    indices = np.where(kept, np.take_along_axis(indices, order, axis=1), -1)
+    return distances, indices
+
+
+def _segment(index: FrameIndex, match: Match, rank: int) -> SegmentMatch:
+    database = index.database
+    take = int(database.take_id[match.start])
+    first = int(database.take_start[take])
+    path = match.path.copy()
+    path[:, 1] -= first
+    return SegmentMatch(rank, database.take_names[take], database.contents[take], database.styles[take],
+                        match.start - first, match.end - first + 1, float(match.cost), path, match.start,
+                        match.end + 1)
+
+
+def search_features(features: np.ndarray, index: FrameIndex, k: int = DEFAULT_K, top: int = 10, *,
+                    exclude_takes: Iterable[str] = (), eps: float = 0.0, radius: float | None = None,
+                    steps: tuple[Step, ...] = THESIS_STEPS, normalize: Normalization = "none") -> SearchResult:
+    """Ranked database segments matching query features ``(m, d)`` (the index's feature set) as a whole.
+
+    ``k``: neighbours per query frame (1 ≤ k ≤ database frames outside ``exclude_takes``); ``top``: at most this
+    many matches; ``exclude_takes``: take names left out; ``eps``/``radius``: the k-NN search's approximation and
+    fixed radius (:meth:`FrameIndex.query`); ``steps``/``normalize``: the LNG's (:func:`lng_match`).
+
+    Raises:
+        ValueError: bad ``k``/``top``/features, an unknown take name (KeyError).
+    """
+    for value, key in ((k, "k"), (top, "top")):
+        if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
+            raise ValueError(f"{key} must be a whole number ≥ 1, got {value!r}")
+    names, ids = _excluded_frames(index, exclude_takes)
+    t0 = time.perf_counter()
+    distances, indices = nearest_outside(index, features, int(k), ids, eps=eps, radius=radius)
+    t1 = time.perf_counter()
+    found = lng_match(indices, distances, take_bounds(index), steps=steps, normalize=normalize, top=int(top),
+                      skip_cost=radius)
+    t2 = time.perf_counter()
+    matches = [_segment(index, m, rank) for rank, m in enumerate(found, start=1)]
+    return SearchResult(matches, indices, distances, int(k), names, {"knn": t1 - t0, "lng": t2 - t1})
+
+
+def search_motion(positions: np.ndarray, index: FrameIndex, k: int = DEFAULT_K, top: int = 10,
+                  **options: Any) -> SearchResult:
+    """:func:`search_features` for a query motion ``(m, 21, 3)`` (metres, Y up, at the index's fps): its
+    features are made as the database's (:meth:`FrameIndex.features_of`; ValueError for a query shorter than
+    the feature set's window, naming both frame counts)."""
+    t0 = time.perf_counter()
+    features = index.features_of(positions)
+    elapsed = time.perf_counter() - t0
+    result = search_features(features, index, k, top, **options)
+    result.timings["features"] = elapsed
+    return result
