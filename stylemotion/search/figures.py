@@ -44,8 +44,7 @@ def plot_distance_matrix(result: SearchResult, index: FrameIndex, path: str | os
     finite = np.concatenate([b[np.isfinite(b)] for b in blocks]) if any(np.isfinite(b).any() for b in blocks) \
         else np.array([0.0, 1.0])
     vmin, vmax = float(finite.min()), float(max(finite.max(), finite.min() + 1e-9))
-    greys = ListedColormap(np.linspace([0.05] * 3, [0.92] * 3, 256))
-    greys.set_bad(NOT_COMPUTED)
+    greys = ListedColormap(np.linspace([0.05] * 3, [0.92] * 3, 256)).with_extremes(bad=NOT_COMPUTED)
     fig = Figure(figsize=(3.2 * len(shown) + 0.8, 4.2))
     axes = fig.subplots(1, len(shown), squeeze=False)[0]
     image = None

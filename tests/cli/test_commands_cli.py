@@ -26,6 +26,7 @@ COMMANDS = {  # module → (console script, a phrase of its description, a key o
     "prepare": ("stylemotion-data", "build a dataset", "data.skip_broken=true"),
     "reproduce": ("stylemotion-reproduce", "resumable command", "workers=N"),
     "style": ("stylemotion-style", "add a new style to a finished stylemotion-reproduce run", "example=<BVH>"),
+    "search": ("stylemotion-search", "find the segments of a motion database most similar", "query=<BVH>"),
 }
 
 

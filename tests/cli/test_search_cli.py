@@ -1,0 +1,148 @@
+"""``stylemotion-search``: a take query finds itself first (cost 0) when its take is not excluded, and never when
+it is; ``matches.json`` holds exactly the six keys; the distance-matrix PNG is an image; exported BVH re-imports to
+the matched frames, GIFs are written; a BVH query of another skeleton (shared data) and a Bandai subset work;
+bad input (short query, unknown feature set, k past the database, an empty dataset, an unmappable skeleton, a
+range outside the take, an existing out) is one line naming the value, with nothing written."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from conftest import BANDAI_ZIP, shared_data_dir
+from PIL import Image
+from test_commands_cli import one_line_error
+
+from stylemotion.datasets.loading import ConversionSettings, load_canonical_positions
+from stylemotion.datasets.registry import load_dataset
+from stylemotion.io.outputs import OutputExistsError
+from stylemotion.io.sources import FileSource
+from stylemotion.search import MATCH_KEYS
+from stylemotion.search.command import SearchInputError, search
+
+SYNTHETIC = {"name": "synthetic", "takes_per_pair": 1, "seed": 0, "fps": 30, "duration_s": 8.0}
+TAKE = "synthetic_walk_normal_000"
+
+
+@pytest.fixture(autouse=True)
+def _cache(tmp_path_factory, monkeypatch) -> None:
+    monkeypatch.setenv("STYLEMOTION_CACHE", str(tmp_path_factory.getbasetemp() / "search-cache"))
+
+
+def command(*args: str, cwd: Path, timeout: float = 300) -> subprocess.CompletedProcess:
+    env = {**os.environ, "HYDRA_FULL_ERROR": "0", "PYTHONWARNINGS": "ignore", "OMP_NUM_THREADS": "1"}
+    return subprocess.run([sys.executable, "-m", "stylemotion.cli.search", *args, f"hydra.run.dir={cwd / 'hydra'}"],
+                          cwd=cwd, env=env, capture_output=True, text=True, timeout=timeout)
+
+
+def quiet(_: str) -> None:
+    pass
+
+
+def test_a_take_query_finds_its_own_frames_first_and_exports_them(tmp_path: Path) -> None:
+    out = tmp_path / "found"
+    done = command(f"query={TAKE}:30-90", "data.takes_per_pair=1", f"out={out}", "exclude_query_take=false",
+                   "export.bvh=true", "export.top=2", "top=4", cwd=tmp_path)
+    assert done.returncode == 0, done.stdout[-2000:] + done.stderr[-2000:]
+    matches = json.loads((out / "matches.json").read_text())
+    assert 1 <= len(matches) <= 4 and all(list(m) == list(MATCH_KEYS) for m in matches)
+    assert matches[0] == {"take": TAKE, "content": "walk", "style": "normal", "start": 30, "end": 90, "cost": 0.0}
+    assert [m["cost"] for m in matches] == sorted(m["cost"] for m in matches)
+    report = json.loads((out / "search.json").read_text())
+    assert report["matches"] == matches and report["k"] == 256 and report["features"] == "E15"
+    assert report["query"] == {"value": f"{TAKE}:30-90", "kind": "take", "take": TAKE, "start": 30, "end": 90,
+                               "fps": 30.0}
+    assert report["excluded_takes"] == [] and report["provenance"]["command"].startswith("stylemotion-search query=")
+    assert len(report["paths"][0]) == 60 and report["paths"][0][0] == [0, 30]
+    with Image.open(out / "distance_matrix.png") as image:
+        image.verify()
+        assert image.format == "PNG" and image.size[0] > 300
+    data = load_dataset("synthetic", takes_per_pair=1)
+    source = next(t for t in data.takes if t.name == TAKE).positions
+    for name, frames in ((f"01_{TAKE}_30-90.bvh", slice(30, 90)), ("query.bvh", slice(30, 90))):
+        back = load_canonical_positions(FileSource(str(out / "bvh" / name)), ConversionSettings(fps=30.0))
+        assert back.shape == (60, 21, 3)
+        assert np.linalg.norm(back - source[frames], axis=-1).mean() < 0.01  # metres
+    assert len(list((out / "bvh").glob("*.bvh"))) == 1 + min(2, len(matches))
+    assert "cost 0" in done.stdout
+
+
+def test_the_query_take_is_excluded_by_default_and_gifs_are_written(tmp_path: Path) -> None:
+    report = search(SYNTHETIC, f"{TAKE}:30-90", tmp_path / "out", top=3, export_gif=True, export_top=1, say=quiet)
+    assert report["excluded_takes"] == [TAKE] and report["matches"]
+    assert all(m["take"] != TAKE for m in report["matches"])
+    assert sorted(p.name for p in (tmp_path / "out" / "gif").iterdir()) == sorted(
+        ["query.gif", f"01_{report['matches'][0]['take']}_{report['matches'][0]['start']}-"
+                      f"{report['matches'][0]['end']}.gif"])
+    with Image.open(tmp_path / "out" / "gif" / "query.gif") as gif:
+        assert gif.format == "GIF" and gif.n_frames > 10
+
+
+@pytest.mark.parametrize("overrides, message", [
+    ({"query": f"{TAKE}:30-32", "features": "E15x3"},
+     f"query={TAKE}:30-32: 2 frames at 30 fps is shorter than the window of features=E15x3 (10 frames)"),
+    ({"features": "E16"}, "features=E16 is no feature set; valid: ['E15'"),
+    ({"k": 6721, "exclude_query_take": False}, "k=6721 exceeds the database's 6720 frames"),
+    ({"k": 6481}, f"k=6481 exceeds the database's 6480 frames outside the query's take {TAKE}"),
+    ({"k": 0}, "k must be a whole number ≥ 1, got 0"),
+    ({"data": {**SYNTHETIC, "contents": []}}, "data=synthetic: dataset 'synthetic' has no takes to search"),
+    ({"query": f"{TAKE}:200-300"}, f"query={TAKE}:200-300: the frame range 200-300 ends after the take's last "
+                                   f"frame: {TAKE} has 240 frames (0-240) at 30 fps"),
+    ({"query": f"{TAKE}:9-3"}, f"query={TAKE}:9-3: the frame range '9-3' must be START-END"),
+    ({"query": "nowhere.bvh"}, "query=nowhere.bvh: no such file, and 'nowhere.bvh' is no take of dataset"),
+    ({"eps": -1}, "eps=-1 must be a finite number ≥ 0"),
+    ({"engine": "annoy"}, "engine=annoy is no search engine"),
+])
+def test_bad_input_is_refused_naming_the_value(overrides: dict, message: str, tmp_path: Path) -> None:
+    kwargs = {"data": SYNTHETIC, "query": f"{TAKE}:30-90", "out": tmp_path / "out", **overrides}
+    with pytest.raises((SearchInputError, ValueError)) as caught:
+        search(kwargs.pop("data"), kwargs.pop("query"), kwargs.pop("out"), say=quiet, **kwargs)
+    assert str(caught.value).startswith(message), str(caught.value)
+    assert not (tmp_path / "out").exists()
+
+
+def test_an_unmappable_skeleton_and_an_existing_out_are_one_line(tmp_path: Path, tiny_bvh: str) -> None:
+    (tmp_path / "tiny.bvh").write_text(tiny_bvh)
+    done = command(f"query={tmp_path / 'tiny.bvh'}", "data.takes_per_pair=1", f"out={tmp_path / 'out'}", cwd=tmp_path)
+    message = one_line_error(done, "stylemotion-search")
+    assert message.startswith(f"stylemotion-search: query={tmp_path / 'tiny.bvh'}: ") and "joint_map=" in message
+    assert not (tmp_path / "out").exists()
+    (tmp_path / "taken").mkdir()
+    with pytest.raises(OutputExistsError, match="already exists; choose another out="):
+        search(SYNTHETIC, TAKE, tmp_path / "taken", say=quiet)
+
+
+@pytest.mark.realdata
+def test_a_bvh_query_of_another_skeleton(other_skeleton_paths, tmp_path: Path) -> None:
+    bvh = other_skeleton_paths["cmu21_walk"]
+    report = search(SYNTHETIC, f"{bvh}:0-120", tmp_path / "out", top=5, say=quiet)
+    query = report["query"]
+    assert query["kind"] == "bvh" and query["file_fps"] == 60.0 and query["file_range"] == [0, 120]
+    assert query["frames"] == 60 and query["fps"] == 30.0 and query["retargeted_to"] == "normal"
+    matches = json.loads((tmp_path / "out" / "matches.json").read_text())
+    assert matches and all(list(m) == list(MATCH_KEYS) for m in matches)
+    assert matches[0]["content"].startswith("walk") and (tmp_path / "out" / "distance_matrix.png").is_file()
+
+
+@pytest.mark.realdata
+def test_a_bandai_subset(tmp_path: Path, monkeypatch) -> None:
+    root = shared_data_dir(BANDAI_ZIP) / BANDAI_ZIP
+    data = {"name": "bandai", "root": str(root), "contents": ["walk"], "styles": ["normal"], "fps": 30,
+            "cache_dir": None, "use_cache": True, "workers": 1}
+    monkeypatch.delenv("STYLEMOTION_CACHE")  # the converted Bandai takes are cached where every test finds them
+    takes = load_dataset("bandai", root=str(root), contents=["walk"], styles=["normal"], workers=1).takes
+    query = sorted(takes, key=lambda t: t.name)[0]
+    report = search(data, f"{query.name}:0-30", tmp_path / "out", features="E15x3", top=10, say=quiet)
+    assert report["database"]["takes"] == len(takes) and report["excluded_takes"] == [query.name]
+    matches = report["matches"]
+    assert len(matches) == 10 and all(m["take"] != query.name and m["content"] == "walk" for m in matches)
+    assert all(0 <= m["start"] < m["end"] for m in matches)
+    again = search(data, f"{query.name}:0-30", tmp_path / "self", top=1, exclude_query_take=False, say=quiet)
+    assert again["matches"][0] | {"cost": 0} == {"take": query.name, "content": "walk", "style": "normal", "start": 0,
+                                                 "end": 30, "cost": 0}
+    assert again["matches"][0]["cost"] < 1e-3
