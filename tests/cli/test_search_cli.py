@@ -136,13 +136,13 @@ def test_a_bandai_subset(tmp_path: Path, monkeypatch) -> None:
             "cache_dir": None, "use_cache": True, "workers": 1}
     monkeypatch.delenv("STYLEMOTION_CACHE")  # the converted Bandai takes are cached where every test finds them
     takes = load_dataset("bandai", root=str(root), contents=["walk"], styles=["normal"], workers=1).takes
-    query = sorted(takes, key=lambda t: t.name)[0]
-    report = search(data, f"{query.name}:0-30", tmp_path / "out", features="E15x3", top=10, say=quiet)
+    query = sorted(takes, key=lambda t: t.name)[0]  # walking in frames 60-90 (takes begin standing: docs/search.md)
+    report = search(data, f"{query.name}:60-90", tmp_path / "out", features="E15x3", top=10, say=quiet)
     assert report["database"]["takes"] == len(takes) and report["excluded_takes"] == [query.name]
     matches = report["matches"]
     assert len(matches) == 10 and all(m["take"] != query.name and m["content"] == "walk" for m in matches)
     assert all(0 <= m["start"] < m["end"] for m in matches)
-    again = search(data, f"{query.name}:0-30", tmp_path / "self", top=1, exclude_query_take=False, say=quiet)
-    assert again["matches"][0] | {"cost": 0} == {"take": query.name, "content": "walk", "style": "normal", "start": 0,
-                                                 "end": 30, "cost": 0}
+    again = search(data, f"{query.name}:60-90", tmp_path / "self", top=1, exclude_query_take=False, say=quiet)
+    assert again["matches"][0] | {"cost": 0} == {"take": query.name, "content": "walk", "style": "normal", "start": 60,
+                                                 "end": 90, "cost": 0}
     assert again["matches"][0]["cost"] < 1e-3
