@@ -62,12 +62,13 @@ def available_engines() -> list[str]:
     return [e for e in ENGINES if have[e]]
 
 
-def load(args: argparse.Namespace) -> tuple[TakeSet, dict[str, Any]]:
+def load(args: argparse.Namespace) -> TakeSet:
+    """The dataset to measure on (all of Bandai, or the synthetic one)."""
     if args.data == "synthetic":
-        return load_dataset("synthetic", takes_per_pair=args.takes_per_pair, duration_s=args.duration_s), {}
+        return load_dataset("synthetic", takes_per_pair=args.takes_per_pair, duration_s=args.duration_s)
     root = args.root or os.path.join(os.environ.get("STYLEMOTION_DATA", "../shared/data"), "bandai-namco-motion-2",
                                      "data.zip")
-    return load_dataset("bandai", root=root, workers=args.workers), {}
+    return load_dataset("bandai", root=root, workers=args.workers)
 
 
 def mirrored(positions: np.ndarray) -> np.ndarray:
@@ -344,7 +345,7 @@ def main(argv: list[str] | None = None) -> int:
 
     try:
         started = time.perf_counter()
-        takeset, _ = load(args)
+        takeset = load(args)
         emit({"part": "setup", "dataset": takeset.name, "takes": len(takeset.takes), "frames": takeset.num_frames,
               "fps": takeset.fps, "parts": args.parts, "engines_available": available_engines(),
               "machine": platform.machine(), "cpus": os.cpu_count(), "python": platform.python_version(),
