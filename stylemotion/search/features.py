@@ -37,6 +37,10 @@ from stylemotion.skeleton import JOINT_INDEX, NUM_JOINTS
 NORMALIZATIONS = ("3d", "2d")
 #: Length of the windows of the windowed sets, seconds (thesis §2.3.2).
 WINDOW_SECONDS = 0.3
+#: Δt of the physics terms' scaling (§2.6.1), seconds: the interval the windowed sets consider.
+PHYSICS_INTERVAL_S = WINDOW_SECONDS
+#: Body mass of the physics terms' momentum, kg: the mean of de Leva's (1996) male reference subjects.
+PHYSICS_BODY_MASS_KG = 73.0
 #: Thesis' F_E^15: the 4 end effectors (wrists, ankles — cf. its Fig. 2.1) and the head.
 E15_JOINTS = ("Hand_L", "Hand_R", "Foot_L", "Foot_R", "Head")
 #: F_E^30: ``E15`` plus elbows (LowerArm), knees (LowerLeg) and one chest joint (Chest).
@@ -255,25 +259,34 @@ def angular_momentum(positions: np.ndarray) -> np.ndarray:
     return np.einsum("s,fsc->fc", SEGMENT_MASSES, np.cross(rel, rel_velocity))
 
 
-def physics_terms(positions: np.ndarray, fps: float, terms: int = 4) -> np.ndarray:
-    """The physics features of §2.6.1: ``(frames, terms)`` float64 in metres-like units.
+def physics_terms(positions: np.ndarray, fps: float, terms: int = 4, interval_s: float = PHYSICS_INTERVAL_S,
+                  body_mass_kg: float = PHYSICS_BODY_MASS_KG) -> np.ndarray:
+    """The physics features of §2.6.1: ``(frames, terms)`` float64.
 
     Columns (``terms`` = 2 takes the first two, as ``EP17``; 4 all, as ``EP19``):
 
     0. COM acceleration along +Y (opposite to gravity) × Δt², metres — free fall gives ``−g·Δt²``;
-    1. angular momentum per unit mass about +Y × Δt, m² — positive for a left turn (+Z towards +X,
+    1. whole-body angular momentum about +Y × Δt, kg·m² — positive for a left turn (+Z towards +X,
        the project's yaw sign);
     2. COM acceleration along the horizontal direction of motion (:func:`heading_directions`) × Δt²;
-    3. angular momentum per unit mass about the axis ⟂ to that direction and gravity (+Y × direction,
-       the body's left when it walks forwards) × Δt — positive when the body pitches forwards.
+    3. angular momentum about the axis ⟂ to that direction and gravity (+Y × direction, the body's left
+       when it walks forwards) × Δt — positive when the body pitches forwards.
 
-    Δt = 1/fps: velocity-like terms scale with Δt and acceleration-like ones with Δt², as §2.6.1 says.
+    Velocity-like terms scale with Δt and acceleration-like ones with Δt², as §2.6.1 says, with Δt =
+    ``interval_s``, "the time interval under consideration": by default the 0.3 s the windowed sets look
+    at, and the momentum of a ``body_mass_kg`` body (de Leva's male reference, 73 kg). With Δt = one frame and
+    a unit mass the terms are ~300× smaller than an E15 coordinate's spread on Bandai walks and EP17 ranks
+    exactly like E15 (docs/search.md, "Physics feature sets").
     """
     if terms not in (2, 4):
         raise ValueError(f"physics terms must be 2 or 4, got {terms}")
+    for value, key in ((fps, "fps"), (interval_s, "interval_s"), (body_mass_kg, "body_mass_kg")):
+        if not (np.isfinite(value) and value > 0):
+            raise ValueError(f"physics terms need a positive finite {key}, got {value!r}")
     positions = _check_positions(positions)
-    acceleration = _second_difference(centre_of_mass(positions))
-    momentum = angular_momentum(positions)
+    frames_per_interval = interval_s * fps
+    acceleration = _second_difference(centre_of_mass(positions)) * frames_per_interval**2
+    momentum = angular_momentum(positions) * frames_per_interval * body_mass_kg
     columns = [acceleration[:, 1], momentum[:, 1]]
     if terms == 4:
         direction = heading_directions(positions, fps)

@@ -49,7 +49,7 @@ from stylemotion.search.features import (
 )
 
 #: Bump when the features or the cache layout change, to invalidate cached indexes.
-SEARCH_FORMAT = 1
+SEARCH_FORMAT = 2  # 2: physics terms scaled by a 0.3 s interval and a 73 kg body
 #: Engines by name; exact ones first.
 ENGINES = ("ckdtree", "pykdtree", "faiss", "faiss-hnsw")
 EXACT_ENGINES = ("ckdtree", "pykdtree", "faiss")

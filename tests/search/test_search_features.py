@@ -11,6 +11,8 @@ from stylemotion.representation import positions_to_frames
 from stylemotion.search.features import (
     E15_JOINTS,
     FEATURE_SETS,
+    PHYSICS_BODY_MASS_KG,
+    PHYSICS_INTERVAL_S,
     SEGMENT_MASSES,
     SEGMENTS,
     body_frame_positions,
@@ -166,12 +168,27 @@ def test_free_fall_accelerates_the_com_by_minus_g(pose):
     t = np.arange(25) * dt
     height = 0.5 + 2.0 * t - 0.5 * G * t**2
     moving = pose[None] + np.stack([0.8 * t, height, 0.3 * t], axis=-1)[:, None, :]
-    terms = physics_terms(moving, FPS)
+    terms = physics_terms(moving, FPS, interval_s=dt, body_mass_kg=1.0)
     np.testing.assert_allclose(terms[:, 0], -G * dt**2, rtol=1e-9)  # along +Y, scaled by Δt²
     np.testing.assert_allclose(terms[:, 2], 0.0, atol=1e-12)  # no horizontal acceleration
     np.testing.assert_allclose(terms[:, [1, 3]], 0.0, atol=1e-12)  # translation only: no momentum
     com = centre_of_mass(moving)
     np.testing.assert_allclose(np.diff(com[:, 1], 2), -G * dt**2, rtol=1e-9)
+
+
+def test_physics_terms_scale_with_the_interval_and_the_body_mass(pose):
+    dt = 1.0 / FPS
+    t = np.arange(25) * dt
+    falling = pose[None] + np.stack([0.4 * t, 1.0 - 0.5 * G * t**2, 0.0 * t], axis=-1)[:, None, :]
+    default = physics_terms(falling, FPS)
+    np.testing.assert_allclose(default[:, 0], -G * PHYSICS_INTERVAL_S**2, rtol=1e-9)  # a·Δt², Δt = 0.3 s
+    spinning = _spin(pose, rotation_y, 2.0, 20, np.array([0.3, 0.0, -0.2]))
+    per_frame = physics_terms(spinning, FPS, interval_s=dt, body_mass_kg=1.0)
+    np.testing.assert_allclose(physics_terms(spinning, FPS)[:, 1],
+                               per_frame[:, 1] * (PHYSICS_INTERVAL_S / dt) * PHYSICS_BODY_MASS_KG, rtol=1e-9)
+    for key, bad in (("interval_s", 0.0), ("body_mass_kg", -1.0), ("interval_s", float("nan"))):
+        with pytest.raises(ValueError, match=key):
+            physics_terms(spinning, FPS, **{key: bad})
 
 
 def _spin(pose: np.ndarray, axis_rotation, omega: float, frames: int, pivot: np.ndarray) -> np.ndarray:
@@ -182,7 +199,7 @@ def _spin(pose: np.ndarray, axis_rotation, omega: float, frames: int, pivot: np.
 @pytest.mark.parametrize("omega", [2.0, -3.0])
 def test_spin_about_the_vertical_gives_the_momentum(pose, omega):
     moving = _spin(pose, rotation_y, omega, 20, np.array([0.3, 0.0, -0.2]))
-    terms = physics_terms(moving, FPS)
+    terms = physics_terms(moving, FPS, interval_s=1.0 / FPS, body_mass_kg=1.0)
     rel = segment_centres(pose) - centre_of_mass(pose)
     inertia = np.sum(SEGMENT_MASSES * (rel[:, 0] ** 2 + rel[:, 2] ** 2))  # per unit mass, m²
     expected = np.sin(omega / FPS) * inertia  # L·Δt with central differences, exact for a rigid spin
@@ -195,7 +212,7 @@ def test_forward_pitch_while_moving_gives_positive_side_momentum(pose):
     # Move along +Z and rotate about +X (the left of a body moving along +Z): head goes forwards.
     pitched = _spin(pose, rotation_x, 1.5, 20, centre_of_mass(pose))
     moving = pitched + (1.2 * np.arange(20) / FPS)[:, None, None] * np.array([0.0, 0.0, 1.0])
-    terms = physics_terms(moving, FPS)
+    terms = physics_terms(moving, FPS, interval_s=1.0 / FPS, body_mass_kg=1.0)
     rel = segment_centres(pose) - centre_of_mass(pose)
     inertia = np.sum(SEGMENT_MASSES * (rel[:, 1] ** 2 + rel[:, 2] ** 2))
     np.testing.assert_allclose(terms[1:-1, 3], np.sin(1.5 / FPS) * inertia, rtol=1e-9)

@@ -183,7 +183,14 @@ def test_cache_is_reused_and_follows_the_data(takeset, tmp_path):
                                         for t in takeset.takes], takeset.fps)
     assert index_cache_key(MotionDatabase.from_takeset(relabelled), "pca8", "3d") != \
         index_cache_key(first.database, "pca8", "3d")
-    assert f"{SEARCH_FORMAT}" and len(list((tmp_path / "search").glob("*.npz"))) == 3
+    assert len(list((tmp_path / "search").glob("*.npz"))) == 3
+
+
+def test_cache_key_changes_with_the_search_format(takeset, monkeypatch):
+    database = MotionDatabase.from_takeset(takeset)
+    key = index_cache_key(database, "EP17", "3d")
+    monkeypatch.setattr("stylemotion.search.index.SEARCH_FORMAT", SEARCH_FORMAT + 1)
+    assert index_cache_key(database, "EP17", "3d") != key
 
 
 def test_damaged_cache_is_rebuilt(takeset, tmp_path):
