@@ -13,7 +13,9 @@ Parts (``--parts``, comma-separated):
   copies of the dataset: copy 0 is the data, copy 1 its mirror image (left and right swapped, x negated),
   copy c ≥ 2 copy ``c mod 2`` with every joint displaced by seeded Gaussian noise (σ ``--jitter`` m) —
   rotated copies would not do: the features are invariant under rotation, so they would duplicate frames.
-  Query frames: random database frames of copy 0 with the same jitter (so none is in the database).
+  Query frames (``--queries``): ``heldout`` (default) random frames of the test takes, the database built from
+  the train and val takes; ``jitter`` random database frames of copy 0 with the same jitter (so none is in the
+  database; farther from the data than a real motion, which makes kd-trees visit many more cells).
 * ``lng`` — LNG vs subsequence DTW: ``--lng-queries`` random 1 s and as many 3 s queries cut from test takes
   (``TakeSet.split`` with the data config's split) against the train takes; Spearman ρ between the LNG's and
   DTW's best global costs, the share of queries where both return the same best segment (same take and
@@ -114,13 +116,27 @@ def timed(fn: Callable[..., Any], *args: Any, **kwargs: Any) -> tuple[float, Any
 
 
 def table21(takeset: TakeSet, args: argparse.Namespace, emit: Emit) -> None:
+    """Table 2.1 rows. ``--queries heldout`` (default): the database is the train and val takes (and their copies),
+    the queries random frames of the test takes — motions the database does not hold, as a user's query is.
+    ``--queries jitter``: the database is every take, the queries random database frames with every joint
+    displaced by N(0, jitter) — farther from the data than a real motion and hard for kd-trees."""
     engines = [e for e in args.engines if e in available_engines()]
     rng = np.random.default_rng(args.seed)
-    base_frames = takeset.num_frames
+    split = _split(takeset, args)
+    held_out = args.queries == "heldout"
+    base = TakeSet(takeset.name, split["train"] + split["val"], takeset.fps) if held_out else takeset
     for copies in args.copies:
-        database = MotionDatabase.from_takeset(copies_of(takeset, copies, args.jitter, args.seed))
-        picks = rng.choice(base_frames, size=args.table_queries, replace=base_frames < args.table_queries)
-        query_positions = database.positions[picks] + rng.normal(0, args.jitter, (len(picks), 21, 3))
+        database = MotionDatabase.from_takeset(copies_of(base, copies, args.jitter, args.seed))
+        if held_out:
+            test_frames = [(t, f) for t in split["test"] for f in range(t.num_frames)]
+            n_test = len(test_frames)
+            chosen = rng.choice(n_test, size=args.table_queries, replace=n_test < args.table_queries)
+            picks, query_positions = np.array([], dtype=np.int64), None
+            held = [test_frames[c] for c in chosen]
+        else:
+            held = []
+            picks = rng.choice(base.num_frames, size=args.table_queries, replace=base.num_frames < args.table_queries)
+            query_positions = database.positions[picks] + rng.normal(0, args.jitter, (len(picks), 21, 3))
         for fs in args.features:
             features, fitted, queries = None, None, None
             brute: dict[int, tuple[float, np.ndarray, np.ndarray]] = {}
@@ -129,9 +145,19 @@ def table21(takeset: TakeSet, args: argparse.Namespace, emit: Emit) -> None:
                                        workers=args.workers)
                 features, fitted = index.features, index.fitted
                 if queries is None:
-                    queries = _query_features(index, database, picks, query_positions)
+                    queries = (_held_out_features(index, held) if held_out
+                               else _query_features(index, database, picks, query_positions))
                 for k in (k for k in args.ks if k <= index.size):
                     emit(_table_row(takeset, args, database, index, queries, brute, copies, k, built_s))
+
+
+def _held_out_features(index: FrameIndex, frames: list[tuple[Take, int]]) -> np.ndarray:
+    """Features of the chosen frames of test takes, each computed within its own take."""
+    per_take: dict[str, np.ndarray] = {}
+    for take, _ in frames:
+        if take.name not in per_take:
+            per_take[take.name] = index.features_of(np.asarray(take.positions))
+    return np.stack([per_take[take.name][f] for take, f in frames]).astype(np.float32)
 
 
 def _table_row(takeset: TakeSet, args: argparse.Namespace, database: MotionDatabase, index: FrameIndex,
@@ -149,6 +175,8 @@ def _table_row(takeset: TakeSet, args: argparse.Namespace, database: MotionDatab
     batched_ms = 1000 * batch_s / len(queries)
     row = {"part": "table21", "dataset": takeset.name, "copies": copies, "frames": database.num_frames,
            "database_construction": "copy 0 the data, 1 its mirror, c>=2 copy c%2 + N(0, jitter) per joint",
+           "queries": ("random frames of the test takes; database = train + val takes" if args.queries == "heldout"
+                       else "random database frames + N(0, jitter) per joint; database = every take"),
            "jitter_m": args.jitter, "features": index.feature_set, "dim": index.dim, "engine": index.engine,
            "exact": index.engine != "faiss-hnsw", "k": k, "build_s": round(built_s, 3), "workers": args.workers,
            "batched_queries": len(queries), "single_queries": len(single_q),
@@ -295,6 +323,8 @@ def parse(argv: list[str] | None) -> argparse.Namespace:
     parser.add_argument("--ks", default="16,256", help="neighbours per query (table21)")
     parser.add_argument("--copies", default="1,2,3", help="database sizes as copies of the data (table21)")
     parser.add_argument("--jitter", type=float, default=0.01, help="σ of the copies' and queries' joint noise, m")
+    parser.add_argument("--queries", choices=("heldout", "jitter"), default="heldout",
+                        help="table21 queries: test-take frames (database: train + val) or jittered database frames")
     parser.add_argument("--table-queries", type=int, default=2000)
     parser.add_argument("--single-queries", type=int, default=200)
     parser.add_argument("--brute-queries", type=int, default=200)
