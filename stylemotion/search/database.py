@@ -15,6 +15,7 @@ from typing import NamedTuple
 import numpy as np
 
 from stylemotion.datasets.base import TakeSet
+from stylemotion.search.lng import TakeBounds
 from stylemotion.skeleton import NUM_JOINTS
 
 
@@ -133,6 +134,11 @@ class MotionDatabase:
         same = np.zeros(self.num_frames, dtype=bool)
         same[:-1] = self.take_id[1:] == self.take_id[:-1]
         return same
+
+    @cached_property
+    def take_bounds(self) -> TakeBounds:
+        """The take layout the lazy neighbourhood graph walks within (:class:`~stylemotion.search.lng.TakeBounds`)."""
+        return TakeBounds.from_next_in_take(self.next_in_take, self.take_id)
 
     def has_next(self, global_index: int | np.ndarray) -> bool | np.ndarray:
         """Whether the frame after each global index is in the same take (scalar in, bool out)."""

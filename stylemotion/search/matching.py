@@ -33,7 +33,7 @@ from typing import Any
 import numpy as np
 
 from stylemotion.search.index import FrameIndex
-from stylemotion.search.lng import THESIS_STEPS, Match, Normalization, Step, TakeBounds, lng_match
+from stylemotion.search.lng import THESIS_STEPS, Match, Normalization, Step, lng_match
 
 #: Neighbours per query frame by default: Table 2.1's larger k. With the thesis' steps a match needs every query
 #: frame's neighbours to hold the next frame of the same take; measured on Bandai's normal walks and runs (145
@@ -114,16 +114,6 @@ class SearchResult:
         return out
 
 
-def take_bounds(index: FrameIndex) -> TakeBounds:
-    """The LNG's take layout of an index's database (cached on the database object)."""
-    database = index.database
-    cached = getattr(database, "_lng_take_bounds", None)
-    if cached is None:
-        cached = TakeBounds.from_next_in_take(database.next_in_take, database.take_id)
-        object.__setattr__(database, "_lng_take_bounds", cached)  # frozen dataclass: a derived cache only
-    return cached
-
-
 def _excluded_frames(index: FrameIndex, exclude_takes: Iterable[str]) -> tuple[tuple[str, ...], np.ndarray]:
     names = tuple(dict.fromkeys(str(t) for t in exclude_takes))
     ids = np.array([index.database.take_index(name) for name in names], dtype=np.int64)
@@ -181,7 +171,7 @@ def search_features(features: np.ndarray, index: FrameIndex, k: int = DEFAULT_K,
     t0 = time.perf_counter()
     distances, indices = nearest_outside(index, features, int(k), ids, eps=eps, radius=radius)
     t1 = time.perf_counter()
-    found = lng_match(indices, distances, take_bounds(index), steps=steps, normalize=normalize, top=int(top),
+    found = lng_match(indices, distances, index.database.take_bounds, steps=steps, normalize=normalize, top=int(top),
                       skip_cost=radius)
     t2 = time.perf_counter()
     matches = [_segment(index, m, rank) for rank, m in enumerate(found, start=1)]
