@@ -146,3 +146,11 @@ def test_a_bandai_subset(tmp_path: Path, monkeypatch) -> None:
     assert again["matches"][0] | {"cost": 0} == {"take": query.name, "content": "walk", "style": "normal", "start": 60,
                                                  "end": 90, "cost": 0}
     assert again["matches"][0]["cost"] < 1e-3
+
+
+def test_fewer_matches_than_asked_for_says_that_a_larger_k_finds_more(tmp_path: Path) -> None:
+    lines: list[str] = []
+    report = search(SYNTHETIC, f"{TAKE}:30-90", tmp_path / "out", k=256, top=500, say=lines.append)
+    found = len(report["matches"])
+    assert 0 < found < 500
+    assert any(f"{found} of top=500 found" in line and "larger k" in line for line in lines)
