@@ -42,6 +42,7 @@ from stylemotion.io.atomic import atomic_write_bytes
 from stylemotion.io.outputs import safe_name
 from stylemotion.search.database import FrameLocation, MotionDatabase
 from stylemotion.search.features import (
+    FEATURE_SETS,
     FittedPCA,
     compute_features,
     feature_spec,
@@ -228,20 +229,25 @@ class FrameIndex:
     def __init__(self, database: MotionDatabase, feature_set: str, features: np.ndarray | None = None,
                  fitted: FittedPCA | None = None, *, normalization: str = "3d", engine: str = "ckdtree",
                  workers: int = 1, engine_state: np.ndarray | None = None):
-        """Index ``features`` (computed, and a PCA fitted, when None).
+        """Index ``features`` (computed, and a PCA fitted, when None). With ``features`` given, a
+        ``feature_set`` that is none of :data:`FEATURE_SETS` names custom features of any width (``features_of``
+        cannot compute those for a query: pass the query's own features to :meth:`query`).
 
         ``workers``: threads (cKDTree's ``workers``, -1 = all cores; faiss' OpenMP threads, set process-wide;
         pykdtree follows ``OMP_NUM_THREADS``). ``engine_state``: a faiss index serialized by
         :meth:`engine_state` for these features (skips the HNSW build).
         """
-        spec = feature_spec(feature_set)
+        if features is None or feature_set in FEATURE_SETS:
+            dim = feature_spec(feature_set).dim
+        else:  # custom features under a name of the caller's (e.g. marker-only ones): any (frames, d)
+            dim = int(np.shape(features)[1]) if np.ndim(features) == 2 else -1
         if engine not in ENGINES:
             raise ValueError(f"unknown search engine {engine!r}; valid: {list(ENGINES)}")
         if features is None:
             features, fitted = database_features(database, feature_set, normalization, fitted)
         features = np.ascontiguousarray(features, dtype=np.float32)
-        if features.shape != (database.num_frames, spec.dim):
-            raise ValueError(f"features must be ({database.num_frames}, {spec.dim}) for {feature_set}, "
+        if features.shape != (database.num_frames, dim):
+            raise ValueError(f"features must be ({database.num_frames}, {dim}) for {feature_set}, "
                              f"got {features.shape}")
         self.database, self.feature_set, self.normalization = database, feature_set, normalization
         self.features, self.fitted, self.engine = features, fitted, engine
