@@ -1,0 +1,116 @@
+"""Reconstruction from sparse markers: exactness on database takes, better than the nearest neighbour on held-out
+takes, invariance to where the motion is, bad inputs."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from conftest import BANDAI_ZIP, shared_data_dir
+
+from stylemotion.datasets.base import TakeSet
+from stylemotion.datasets.registry import load_dataset
+from stylemotion.geometry import rotate_yaw
+from stylemotion.reconstruct import (
+    DEFAULT_MARKERS,
+    MarkerInputError,
+    SparseReconstructor,
+    joint_errors_cm,
+    marker_frames,
+    tracks_from_positions,
+)
+from stylemotion.search.database import MotionDatabase
+
+
+@pytest.fixture(scope="module")
+def split():
+    ts = load_dataset("synthetic", takes_per_pair=1)
+    parts = ts.split(0, 0.0, 0.15, group_by=("content",))
+    return MotionDatabase.from_takeset(TakeSet("synthetic", parts["train"], ts.fps)), parts["train"], parts["test"]
+
+
+@pytest.fixture(scope="module")
+def reconstructor(split):
+    return SparseReconstructor(split[0], DEFAULT_MARKERS)
+
+
+def test_a_take_of_the_database_comes_back_exactly(split, reconstructor):
+    take = split[1][3]
+    result = reconstructor.reconstruct(tracks_from_positions(take.positions, DEFAULT_MARKERS, 30.0))
+    errors = joint_errors_cm(result.positions, take.positions)
+    assert errors["mean_cm"] < 0.05 and errors["max_cm"] < 0.5
+    assert result.positions.shape == take.positions.shape
+
+
+def test_held_out_takes_beat_the_nearest_neighbour(split, reconstructor):
+    rng = np.random.default_rng(1)
+    ours, baseline = [], []
+    for take in split[2]:
+        markers = tracks_from_positions(take.positions, DEFAULT_MARKERS, 30.0).positions
+        markers = markers + rng.uniform(-0.001, 0.001, markers.shape)
+        ours.append(joint_errors_cm(reconstructor.reconstruct(markers).positions, take.positions)["mean_cm"])
+        baseline.append(joint_errors_cm(reconstructor.nearest_neighbour(markers), take.positions)["mean_cm"])
+    assert np.mean(ours) < 0.5 * np.mean(baseline), (ours, baseline)
+    assert np.mean(ours) < 2.0
+
+
+def test_moved_and_turned_markers_give_the_moved_and_turned_pose(split, reconstructor):
+    take = split[2][0]
+    markers = tracks_from_positions(take.positions[:40], DEFAULT_MARKERS, 30.0).positions
+    first = reconstructor.reconstruct(markers).positions
+    moved = rotate_yaw(markers, np.full((40, 1), 1.1)) + np.array([3.0, 0.0, -2.0])
+    second = reconstructor.reconstruct(moved).positions
+    expected = rotate_yaw(first, np.full((40, 1), 1.1)) + np.array([3.0, 0.0, -2.0])
+    np.testing.assert_allclose(second, expected, atol=1e-6)
+
+
+@pytest.mark.parametrize("features", ["E15x3", "E30", "pca16"])
+def test_other_feature_sets_reconstruct_held_out_takes(split, features):
+    take = split[2][1]
+    rec = SparseReconstructor(split[0], DEFAULT_MARKERS, features=features)
+    markers = tracks_from_positions(take.positions[:60], DEFAULT_MARKERS, 30.0)
+    result = rec.reconstruct(markers)
+    assert result.settings["search"] == ("markers" if features == "E15x3" else "pose-guided")
+    assert joint_errors_cm(result.positions, take.positions[:60])["mean_cm"] < 4.0
+
+
+def test_marker_frame_faces_with_the_left_right_pairs():
+    markers = np.zeros((1, 6, 3))
+    markers[0, 0] = [0.0, 1.0, 0.3]  # Hand_L on +Z, Hand_R on -Z: left is +Z
+    markers[0, 1] = [0.0, 1.0, -0.3]
+    rotation, origin = marker_frames(markers, DEFAULT_MARKERS)
+    np.testing.assert_allclose(rotation[0, :, 0], [0, 0, 1], atol=1e-12)  # left
+    np.testing.assert_allclose(np.linalg.det(rotation[0]), 1.0)
+
+
+def test_bad_settings_and_inputs_name_the_value(split, reconstructor):
+    db = split[0]
+    with pytest.raises(ValueError, match="features=EP17"):
+        SparseReconstructor(db, DEFAULT_MARKERS, features="EP17")
+    with pytest.raises(ValueError, match="k=1 "):
+        SparseReconstructor(db, DEFAULT_MARKERS, k=1)
+    with pytest.raises(ValueError, match="marker_sd=-1"):
+        SparseReconstructor(db, DEFAULT_MARKERS, marker_sd=-1)
+    with pytest.raises(MarkerInputError, match="'Toe'"):
+        SparseReconstructor(db, ["Hips", "Toe"])
+    markers = np.zeros((5, 6, 3))
+    markers[2, 3, 1] = np.nan
+    with pytest.raises(MarkerInputError, match="Foot_R is not finite at frame 2"):
+        reconstructor.reconstruct(markers)
+    tracks = tracks_from_positions(split[2][0].positions[:5], DEFAULT_MARKERS, 60.0)
+    with pytest.raises(MarkerInputError, match="60 fps"):
+        reconstructor.reconstruct(tracks)
+
+
+@pytest.mark.realdata
+def test_bandai_walk_from_six_markers(tmp_path):
+    root = shared_data_dir(BANDAI_ZIP) / BANDAI_ZIP
+    ts = load_dataset("bandai", root=root, contents=["walk"], styles=["normal", "active"], cache_dir=tmp_path,
+                      workers=1)
+    parts = ts.split(0, 0.0, 0.2)
+    database = MotionDatabase.from_takeset(TakeSet("bandai", parts["train"], ts.fps))
+    rec = SparseReconstructor(database, DEFAULT_MARKERS)
+    take = parts["test"][0]
+    markers = tracks_from_positions(take.positions[:150], DEFAULT_MARKERS, ts.fps).positions
+    ours = joint_errors_cm(rec.reconstruct(markers).positions, take.positions[:150])["mean_cm"]
+    baseline = joint_errors_cm(rec.nearest_neighbour(markers), take.positions[:150])["mean_cm"]
+    assert ours < baseline and ours < 5.0, (ours, baseline)
