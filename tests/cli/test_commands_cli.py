@@ -27,6 +27,8 @@ COMMANDS = {  # module → (console script, a phrase of its description, a key o
     "reproduce": ("stylemotion-reproduce", "resumable command", "workers=N"),
     "style": ("stylemotion-style", "add a new style to a finished stylemotion-reproduce run", "example=<BVH>"),
     "search": ("stylemotion-search", "find the segments of a motion database most similar", "query=<BVH>"),
+    "reconstruct": ("stylemotion-reconstruct", "reconstruct full 21-joint poses from a few marker tracks",
+                    "markers=<BVH[:start-end]|NPZ|CSV|take>"),
 }
 
 

@@ -1,0 +1,168 @@
+"""What ``stylemotion-reconstruct`` runs: full poses from a few marker tracks (Krüger §2.5.2).
+
+    stylemotion-reconstruct markers=tracks.csv data=bandai out=runs/reconstruct/mine
+    stylemotion-reconstruct markers=synthetic_walk_normal_000 features=E15x3 k=64 'joints=[Hand_L,Hand_R,Hips]'
+
+``markers`` is a BVH (``file.bvh[:start-end]``, any skeleton a joint map names; its canonical joints become the
+markers), an NPZ as ``stylemotion-convert`` writes it, a CSV of marker tracks
+(:mod:`stylemotion.reconstruct.markers`), or the name of a take of the dataset (then left out of the database
+unless ``exclude_markers_take=false``). ``joints`` picks the markers (default: hands, feet, head, hips; a CSV's
+own columns). ``noise_mm`` adds uniform noise of ± that many millimetres to the markers (the thesis' ±1 mm).
+
+The folder ``out`` (refused when it exists unless ``force``; built beside it and renamed into place):
+
+* ``motion.npz``: ``positions`` ``(frames, 21, 3)`` float32 metres in the markers' world frame, ``joint_names``,
+  ``fps`` — as ``stylemotion-convert`` writes;
+* ``motion.bvh``: the same through :func:`stylemotion.export.write_motion_bvh`;
+* ``summary.json``: the settings, the markers' source and filled gaps, frames/s, the database, provenance and,
+  when the input was a complete motion, the mean/max per-joint error in cm (also of the nearest-neighbour
+  baseline for marker-only feature sets).
+"""
+
+from __future__ import annotations
+
+import io
+import json
+import os
+import time
+import warnings
+from collections.abc import Callable, Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from omegaconf import DictConfig, OmegaConf
+
+from stylemotion.config import ConfigError, positive_int
+from stylemotion.datasets import TakeSet, build_dataset
+from stylemotion.io.atomic import atomic_folder, atomic_write_bytes
+from stylemotion.io.outputs import check_new_output, inside
+from stylemotion.provenance import provenance
+from stylemotion.reconstruct.markers import (
+    DEFAULT_MARKERS,
+    MarkerGapWarning,
+    MarkerInputError,
+    MarkerTracks,
+    read_markers,
+    tracks_from_positions,
+)
+from stylemotion.reconstruct.sparse import RECONSTRUCT_FEATURE_SETS, SparseReconstructor, joint_errors_cm
+from stylemotion.search.database import MotionDatabase
+from stylemotion.skeleton import CANONICAL_JOINTS
+
+Say = Callable[[str], None]
+
+
+def _number(value: Any, key: str, low: float = 0.0) -> float:
+    ok = isinstance(value, (int, float)) and not isinstance(value, bool) and np.isfinite(value) and value >= low
+    if not ok:
+        raise ConfigError(f"{key}={value} must be a finite number ≥ {low:g}")
+    return float(value)
+
+
+def load_tracks(text: str, takeset: TakeSet, joints: Sequence[str] | None,
+                conversion: Mapping[str, Any] | None = None) -> tuple[MarkerTracks, str | None]:
+    """The marker tracks ``markers=`` names, and the take they were cut from (None for a file)."""
+    names = {t.name: t for t in takeset.takes}
+    if text in names and not Path(text).expanduser().is_file():
+        take = names[text]
+        return tracks_from_positions(take.positions, DEFAULT_MARKERS if joints is None else joints, takeset.fps,
+                                     text), text
+    if not text:
+        raise MarkerInputError("markers= is empty: give a BVH, NPZ or CSV file or a take of the dataset")
+    return read_markers(text, joints, takeset.fps, dict(conversion or {})), None
+
+
+def reconstruct_command(data: Mapping[str, Any], markers: str, out: str | os.PathLike, *, features: str = "E15",
+                        k: int = 64, joints: Sequence[str] | None = None, noise_mm: float = 0.0, seed: int = 0,
+                        exclude_markers_take: bool = True, model: Mapping[str, Any] | None = None,
+                        conversion: Mapping[str, Any] | None = None, force: bool = False, say: Say = print,
+                        command: str = "") -> dict[str, Any]:
+    """Reconstruct ``markers`` on the database ``data`` (a ``data`` config) and write ``out`` (module docstring).
+
+    ``model``: further :class:`SparseReconstructor` settings (variance, marker_sd, smooth_sd, prior_weight,
+    iterations, weighted). Returns what ``summary.json`` holds.
+
+    Raises:
+        OutputExistsError: ``out`` exists and ``force`` is off (before any work).
+        MarkerInputError, ConfigError: a bad value (naming it); nothing is written then.
+    """
+    started = time.perf_counter()
+    out = check_new_output(out, force)
+    if features not in RECONSTRUCT_FEATURE_SETS:
+        raise ConfigError(f"features={features} cannot be used; valid: {list(RECONSTRUCT_FEATURE_SETS)}")
+    k = positive_int(k, "k")
+    noise_mm = _number(noise_mm, "noise_mm")
+    try:
+        takeset = build_dataset(data)
+    except (KeyError, ValueError) as exc:
+        raise ConfigError(f"data={data.get('name')}: {exc}") from None
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", MarkerGapWarning)
+        tracks, take = load_tracks(str(markers or "").strip(), takeset, joints, conversion)
+    for warning in caught:
+        say(f"warning: {warning.message}")
+    if abs(tracks.fps - takeset.fps) > 1e-6:
+        raise MarkerInputError(f"markers={markers}: {tracks.fps:g} fps, the dataset {takeset.fps:g} fps; give the "
+                               f"CSV's fps as '# fps: {takeset.fps:g}' tracks or resample them")
+    kept = [t for t in takeset.takes if not (exclude_markers_take and t.name == take)]
+    database = MotionDatabase.from_takeset(TakeSet(takeset.name, kept, takeset.fps, retarget=takeset.retarget))
+    if not 2 <= k <= database.num_frames:
+        raise ConfigError(f"k={k} must be from 2 to the database's {database.num_frames} frames")
+    say(f"database {database.name}: {database.num_takes} takes, {database.num_frames} frames; markers "
+        f"{list(tracks.joints)}: {tracks.num_frames} frames")
+    try:
+        reconstructor = SparseReconstructor(database, tracks.joints, features, k, **dict(model or {}))
+    except TypeError as exc:
+        raise ConfigError(f"model: {exc}") from None
+    except ValueError as exc:
+        raise ConfigError(str(exc)) from None
+    positions = tracks.positions
+    if noise_mm > 0:
+        positions = positions + np.random.default_rng(seed).uniform(-noise_mm, noise_mm, positions.shape) / 1000.0
+    result = reconstructor.reconstruct(positions)
+    summary: dict[str, Any] = {
+        "markers": {"value": str(markers), "source": tracks.source, "joints": list(tracks.joints),
+                    "frames": tracks.num_frames, "fps": tracks.fps, "filled_frames": tracks.filled or {},
+                    "noise_mm": noise_mm, "seed": seed, "excluded_take": take if exclude_markers_take else None},
+        "settings": result.settings,
+        "database": {**result.settings["database"], "digest": database.digest},
+        "frames_per_s": round(result.frames_per_second, 2),
+        "timing_s": {key: round(v, 4) for key, v in result.timings.items()},
+    }
+    if tracks.full is not None:
+        summary["error"] = joint_errors_cm(result.positions, tracks.full)
+        if not reconstructor.guided:
+            baseline = joint_errors_cm(reconstructor.nearest_neighbour(positions), tracks.full)
+            summary["error_nearest_neighbour"] = {key: baseline[key] for key in ("mean_cm", "max_cm")}
+    summary["provenance"] = provenance(command or None)
+    with atomic_folder(out, on_exists=lambda: check_new_output(out, force)) as tmp:
+        buffer = io.BytesIO()
+        np.savez(buffer, positions=result.positions.astype(np.float32), joint_names=np.array(CANONICAL_JOINTS),
+                 fps=np.float64(database.fps))
+        atomic_write_bytes(inside(tmp, "motion.npz"), buffer.getvalue())
+        from stylemotion.export import write_motion_bvh
+
+        write_motion_bvh(result.positions, inside(tmp, "motion.bvh"), database.fps)
+        summary["timing_s"]["command"] = round(time.perf_counter() - started, 3)
+        atomic_write_bytes(inside(tmp, "summary.json"), (json.dumps(summary, indent=1) + "\n").encode())
+    error = summary.get("error")
+    say(f"{tracks.num_frames} frames reconstructed at {summary['frames_per_s']:g} frames/s into {out}"
+        + (f"; error {error['mean_cm']:.2f} cm mean, {error['max_cm']:.2f} cm max per joint" if error else ""))
+    return summary
+
+
+def reconstruct_from_config(cfg: DictConfig, say: Say = print, command: str = "") -> dict[str, Any]:
+    """:func:`reconstruct_command` with the keys of ``stylemotion/configs/reconstruct.yaml``."""
+    plain = OmegaConf.to_container(cfg, resolve=True)
+    if not isinstance(plain, dict):
+        raise ConfigError("the reconstruct config must be a mapping")
+    joints = plain.get("joints")
+    if joints is not None and not isinstance(joints, list):
+        raise ConfigError(f"joints={joints} must be a list of canonical joints, e.g. '[Hand_L,Hand_R,Hips]'")
+    return reconstruct_command(
+        plain["data"], plain["markers"], plain["out"], features=str(plain.get("features", "E15")),
+        k=plain.get("k", 64), joints=joints, noise_mm=plain.get("noise_mm", 0.0), seed=int(plain.get("seed", 0)),
+        exclude_markers_take=bool(plain.get("exclude_markers_take", True)), model=plain.get("model") or {},
+        conversion={key: plain.get(key) for key in ("joint_map", "unit_scale", "up_axis")},
+        force=bool(plain.get("force", False)), say=say, command=command)

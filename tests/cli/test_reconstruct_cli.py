@@ -1,0 +1,77 @@
+"""``stylemotion-reconstruct``: the synthetic default end to end, its files, and bad inputs in one line."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from stylemotion.config import ConfigError
+from stylemotion.datasets.registry import load_dataset
+from stylemotion.io.outputs import OutputExistsError
+from stylemotion.reconstruct.command import reconstruct_command
+from stylemotion.reconstruct.markers import MarkerInputError, write_marker_csv
+from stylemotion.skeleton import CANONICAL_JOINTS, JOINT_INDEX
+
+DATA = {"name": "synthetic", "takes_per_pair": 1}
+TAKE = "synthetic_walk_normal_000"
+
+
+def test_a_take_of_the_synthetic_default_left_out_of_the_database(tmp_path):
+    summary = reconstruct_command(DATA, TAKE, tmp_path / "out", say=lambda _: None)
+    with np.load(tmp_path / "out" / "motion.npz", allow_pickle=False) as npz:
+        assert npz["positions"].shape == (240, 21, 3) and float(npz["fps"]) == 30.0
+        assert list(npz["joint_names"]) == list(CANONICAL_JOINTS)
+    assert (tmp_path / "out" / "motion.bvh").read_text().startswith("HIERARCHY")
+    written = json.loads((tmp_path / "out" / "summary.json").read_text())
+    assert written["markers"]["excluded_take"] == TAKE and written["database"]["takes"] == 27
+    assert written["error"]["mean_cm"] < written["error_nearest_neighbour"]["mean_cm"]
+    assert summary["error"]["mean_cm"] < 2.0 and written["frames_per_s"] > 0
+    with pytest.raises(OutputExistsError):
+        reconstruct_command(DATA, TAKE, tmp_path / "out", say=lambda _: None)
+
+
+def test_csv_with_a_gap_is_filled_and_said(tmp_path):
+    take = load_dataset("synthetic", takes_per_pair=1).takes[0]
+    joints = ["Hand_L", "Hand_R", "Hips"]
+    markers = take.positions[:40, [JOINT_INDEX[j] for j in joints]].astype(np.float64)
+    markers[10:13, 0] = np.nan
+    write_marker_csv(tmp_path / "m.csv", joints, markers, 30)
+    said: list[str] = []
+    summary = reconstruct_command(DATA, str(tmp_path / "m.csv"), tmp_path / "out", say=said.append)
+    assert summary["markers"]["joints"] == joints and "error" not in summary
+    assert summary["markers"]["filled_frames"] == {"Hand_L": [10, 11, 12]}
+    assert any("Hand_L missing at frames 10-12" in line for line in said)
+    with np.load(tmp_path / "out" / "motion.npz") as npz:
+        np.testing.assert_allclose(npz["positions"][:, JOINT_INDEX["Hips"]], take.positions[:40, JOINT_INDEX["Hips"]],
+                                   atol=0.05)
+
+
+def test_bad_values_are_named_and_nothing_is_written(tmp_path):
+    with pytest.raises(ConfigError, match="features=EP19"):
+        reconstruct_command(DATA, TAKE, tmp_path / "a", features="EP19", say=lambda _: None)
+    with pytest.raises(MarkerInputError, match="'Knee_L'"):
+        reconstruct_command(DATA, TAKE, tmp_path / "a", joints=["Hips", "Knee_L"], say=lambda _: None)
+    with pytest.raises(MarkerInputError, match="no such file"):
+        reconstruct_command(DATA, str(tmp_path / "none.csv"), tmp_path / "a", say=lambda _: None)
+    with pytest.raises(ConfigError, match="noise_mm=-1"):
+        reconstruct_command(DATA, TAKE, tmp_path / "a", noise_mm=-1, say=lambda _: None)
+    assert not (tmp_path / "a").exists()
+
+
+def test_the_console_command_runs_and_refuses_in_one_line(tmp_path):
+    env = {**os.environ, "HYDRA_FULL_ERROR": "0", "PYTHONWARNINGS": "ignore"}
+    root = Path(__file__).resolve().parents[2]
+    run = [sys.executable, "-m", "stylemotion.cli.reconstruct", f"markers={TAKE}", "data.takes_per_pair=1"]
+    done = subprocess.run(run + [f"out={tmp_path / 'o'}", "k=16"], cwd=root, env=env, capture_output=True,
+                          text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert json.loads((tmp_path / "o" / "summary.json").read_text())["settings"]["k"] == 16
+    done = subprocess.run(run + [f"out={tmp_path / 'p'}", "joints=[Hips,Tail]"], cwd=root, env=env,
+                          capture_output=True, text=True, timeout=120)
+    assert done.returncode == 1 and "'Tail'" in done.stderr and "Traceback" not in done.stderr
