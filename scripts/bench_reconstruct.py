@@ -51,7 +51,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--data", choices=("bandai", "synthetic"), default="bandai")
     parser.add_argument("--root", default=None, help="Bandai folder or data.zip (default: $STYLEMOTION_DATA/...)")
     parser.add_argument("--workers", type=int, default=1)
-    parser.add_argument("--contents", default="walk,run,wave,raise-up", help="query contents (test takes)")
+    parser.add_argument("--contents", default="walk,run,wave-both-hands,raise-up-both-hands",
+                        help="query contents (test takes), comma-separated content labels of the data")
     parser.add_argument("--features", default="E15,E30,E39,E15x3,pca16")
     parser.add_argument("--databases", default="HDM,CMU-")
     parser.add_argument("--k", type=int, default=64)
@@ -68,6 +69,10 @@ def main(argv: list[str] | None = None) -> int:
     parts = data.split(args.seed, 0.0, 0.15 if args.data == "synthetic" else 0.1, group_by=group)
     train, test = parts["train"], parts["test"]
     contents = [c for c in args.contents.split(",") if c]
+    missing = sorted(set(contents) - {t.content for t in test})
+    if missing:
+        known = sorted({t.content for t in test})
+        raise SystemExit(f"--contents: no test take of {missing}; the data's contents: {known}")
     queries = [t for c in contents for t in [t for t in test if t.content == c][: args.takes]]
     emit({"kind": "setup", "data": data.name, "fps": data.fps, "train_takes": len(train), "test_takes": len(test),
           "queries": [q.name for q in queries], "k": args.k, "noise_mm": args.noise_mm, "markers": DEFAULT_MARKERS})
