@@ -29,6 +29,8 @@ COMMANDS = {  # module → (console script, a phrase of its description, a key o
     "search": ("stylemotion-search", "find the segments of a motion database most similar", "query=<BVH>"),
     "reconstruct": ("stylemotion-reconstruct", "reconstruct full 21-joint poses from a few marker tracks",
                     "markers=<BVH[:start-end]|NPZ|CSV|take>"),
+    "texture": ("stylemotion-texture", "complete or texture a motion with a motion database",
+                "motion=<BVH[:start-end]|NPZ|take>"),
 }
 
 
