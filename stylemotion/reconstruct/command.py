@@ -21,8 +21,6 @@ The folder ``out`` (refused when it exists unless ``force``; built beside it and
 
 from __future__ import annotations
 
-import io
-import json
 import os
 import time
 import warnings
@@ -35,8 +33,7 @@ from omegaconf import DictConfig, OmegaConf
 
 from stylemotion.config import ConfigError, positive_int
 from stylemotion.datasets import TakeSet, build_dataset
-from stylemotion.io.atomic import atomic_folder, atomic_write_bytes
-from stylemotion.io.outputs import check_new_output, inside
+from stylemotion.io.outputs import check_new_output
 from stylemotion.provenance import provenance
 from stylemotion.reconstruct.markers import (
     DEFAULT_MARKERS,
@@ -46,9 +43,9 @@ from stylemotion.reconstruct.markers import (
     read_markers,
     tracks_from_positions,
 )
+from stylemotion.reconstruct.output import write_motion_folder
 from stylemotion.reconstruct.sparse import RECONSTRUCT_FEATURE_SETS, SparseReconstructor, joint_errors_cm
 from stylemotion.search.database import MotionDatabase
-from stylemotion.skeleton import CANONICAL_JOINTS
 
 Say = Callable[[str], None]
 
@@ -136,16 +133,7 @@ def reconstruct_command(data: Mapping[str, Any], markers: str, out: str | os.Pat
             baseline = joint_errors_cm(reconstructor.nearest_neighbour(positions), tracks.full)
             summary["error_nearest_neighbour"] = {key: baseline[key] for key in ("mean_cm", "max_cm")}
     summary["provenance"] = provenance(command or None)
-    with atomic_folder(out, on_exists=lambda: check_new_output(out, force)) as tmp:
-        buffer = io.BytesIO()
-        np.savez(buffer, positions=result.positions.astype(np.float32), joint_names=np.array(CANONICAL_JOINTS),
-                 fps=np.float64(database.fps))
-        atomic_write_bytes(inside(tmp, "motion.npz"), buffer.getvalue())
-        from stylemotion.export import write_motion_bvh
-
-        write_motion_bvh(result.positions, inside(tmp, "motion.bvh"), database.fps)
-        summary["timing_s"]["command"] = round(time.perf_counter() - started, 3)
-        atomic_write_bytes(inside(tmp, "summary.json"), (json.dumps(summary, indent=1) + "\n").encode())
+    write_motion_folder(out, force, result.positions, database.fps, summary, started)
     error = summary.get("error")
     say(f"{tracks.num_frames} frames reconstructed at {summary['frames_per_s']:g} frames/s into {out}"
         + (f"; error {error['mean_cm']:.2f} cm mean, {error['max_cm']:.2f} cm max per joint" if error else ""))

@@ -14,8 +14,6 @@ joints, with the nearest-neighbour baseline).
 
 from __future__ import annotations
 
-import io
-import json
 import os
 import time
 from collections.abc import Callable, Mapping, Sequence
@@ -27,10 +25,10 @@ from omegaconf import DictConfig, OmegaConf
 
 from stylemotion.config import ConfigError
 from stylemotion.datasets import TakeSet, build_dataset
-from stylemotion.io.atomic import atomic_folder, atomic_write_bytes
-from stylemotion.io.outputs import check_new_output, inside
+from stylemotion.io.outputs import check_new_output
 from stylemotion.provenance import provenance
 from stylemotion.reconstruct.markers import read_markers
+from stylemotion.reconstruct.output import write_motion_folder
 from stylemotion.reconstruct.texture import LEG_JOINTS, MODES, MotionTexturer, TextureInputError, check_joints
 from stylemotion.search.database import MotionDatabase
 from stylemotion.skeleton import CANONICAL_JOINTS, JOINT_INDEX, NUM_JOINTS
@@ -114,16 +112,7 @@ def texture_command(data: Mapping[str, Any], motion: str, out: str | os.PathLike
         if mode == "complete":
             summary["error_nearest_neighbour"] = _errors_cm(result.nearest_neighbour, truth, scored)
     summary["provenance"] = provenance(command or None)
-    with atomic_folder(out, on_exists=lambda: check_new_output(out, force)) as tmp:
-        buffer = io.BytesIO()
-        np.savez(buffer, positions=result.positions.astype(np.float32), joint_names=np.array(CANONICAL_JOINTS),
-                 fps=np.float64(database.fps))
-        atomic_write_bytes(inside(tmp, "motion.npz"), buffer.getvalue())
-        from stylemotion.export import write_motion_bvh
-
-        write_motion_bvh(result.positions, inside(tmp, "motion.bvh"), database.fps)
-        summary["timing_s"]["command"] = round(time.perf_counter() - started, 3)
-        atomic_write_bytes(inside(tmp, "summary.json"), (json.dumps(summary, indent=1) + "\n").encode())
+    write_motion_folder(out, force, result.positions, database.fps, summary, started)
     error = summary.get("error")
     say(f"{len(positions)} frames ({mode}) into {out}"
         + (f"; error {error['mean_cm']:.2f} cm mean per joint" if error else ""))

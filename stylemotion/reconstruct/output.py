@@ -1,0 +1,39 @@
+"""The output folder of the reconstruction commands: ``motion.npz``, ``motion.bvh``, ``summary.json``, atomically."""
+
+from __future__ import annotations
+
+import io
+import json
+import os
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from stylemotion.io.atomic import atomic_folder, atomic_write_bytes
+from stylemotion.io.outputs import check_new_output, inside
+from stylemotion.skeleton import CANONICAL_JOINTS
+
+
+def write_motion_folder(out: str | os.PathLike, force: bool, positions: np.ndarray, fps: float,
+                        summary: dict[str, Any], started: float) -> None:
+    """Write a motion and its summary into the new folder ``out`` (refused if it holds a result, unless ``force``).
+
+    Args:
+        positions: ``(frames, 21, 3)`` metres; ``motion.npz`` holds them as ``stylemotion-convert`` writes
+            (``positions`` float32, ``joint_names``, ``fps``), ``motion.bvh`` with rotations fitted.
+        summary: written as ``summary.json`` after ``timing_s.command`` (seconds since ``started``, a
+            ``time.perf_counter()`` reading) is added to it.
+    """
+    out = Path(out)
+    with atomic_folder(out, on_exists=lambda: check_new_output(out, force)) as tmp:
+        buffer = io.BytesIO()
+        np.savez(buffer, positions=np.asarray(positions, dtype=np.float32), joint_names=np.array(CANONICAL_JOINTS),
+                 fps=np.float64(fps))
+        atomic_write_bytes(inside(tmp, "motion.npz"), buffer.getvalue())
+        from stylemotion.export import write_motion_bvh
+
+        write_motion_bvh(positions, inside(tmp, "motion.bvh"), fps)
+        summary.setdefault("timing_s", {})["command"] = round(time.perf_counter() - started, 3)
+        atomic_write_bytes(inside(tmp, "summary.json"), (json.dumps(summary, indent=1) + "\n").encode())
