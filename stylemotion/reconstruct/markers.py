@@ -48,19 +48,25 @@ class MarkerGapWarning(UserWarning):
     """Gaps in a marker track were filled by linear interpolation (the message names joint and frames)."""
 
 
-def check_marker_names(joints: Sequence[str]) -> tuple[str, ...]:
-    """The marker names as a tuple; MarkerInputError for none, a repeat, or a name not on the skeleton."""
+def check_joint_names(joints: Sequence[str], what: str, error: type[ValueError], empty: str) -> tuple[str, ...]:
+    """Canonical joint names as a tuple; ``error`` for none (message ``empty``), a repeat, or a name not on the
+    skeleton, each message calling the names ``what`` (e.g. ``marker``)."""
     names = tuple(str(j) for j in joints)
     if not names:
-        raise MarkerInputError("the marker set is empty; name at least one canonical joint")
+        raise error(empty)
     for name in names:
         if name not in JOINT_INDEX:
-            raise MarkerInputError(f"marker {name!r} is not a joint of the canonical skeleton; valid: "
-                                   f"{list(CANONICAL_JOINTS)}")
+            raise error(f"{what} {name!r} is not a joint of the canonical skeleton; valid: {list(CANONICAL_JOINTS)}")
     repeated = sorted({n for n in names if names.count(n) > 1})
     if repeated:
-        raise MarkerInputError(f"marker(s) {repeated} named more than once")
+        raise error(f"{what}(s) {repeated} named more than once")
     return names
+
+
+def check_marker_names(joints: Sequence[str]) -> tuple[str, ...]:
+    """The marker names as a tuple; MarkerInputError for none, a repeat, or a name not on the skeleton."""
+    return check_joint_names(joints, "marker", MarkerInputError,
+                             "the marker set is empty; name at least one canonical joint")
 
 
 @dataclass(frozen=True)

@@ -46,6 +46,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.linalg import splu
 
+from stylemotion.reconstruct.markers import check_joint_names
 from stylemotion.reconstruct.sparse import marker_frames, to_local, to_world
 from stylemotion.search.database import MotionDatabase
 from stylemotion.search.features import stack_window, window_offsets
@@ -89,18 +90,9 @@ class TextureResult:
 
 
 def check_joints(joints: Sequence[str]) -> tuple[str, ...]:
-    """The trusted joints as a tuple; TextureInputError naming an unknown or repeated one, or no Hips."""
-    names = tuple(str(j) for j in joints)
-    if not names:
-        raise TextureInputError("joints=[] is empty; name the trusted canonical joints")
-    for name in names:
-        if name not in JOINT_INDEX:
-            raise TextureInputError(f"joint {name!r} is not a joint of the canonical skeleton; valid: "
-                                    f"{list(CANONICAL_JOINTS)}")
-    repeated = sorted({n for n in names if names.count(n) > 1})
-    if repeated:
-        raise TextureInputError(f"joint(s) {repeated} named more than once")
-    return names
+    """The trusted joints as a tuple; TextureInputError naming an unknown or repeated one, or none."""
+    return check_joint_names(joints, "joint", TextureInputError,
+                             "joints=[] is empty; name the trusted canonical joints")
 
 
 def _per_take_derivatives(positions: np.ndarray, take_start: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
