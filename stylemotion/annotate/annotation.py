@@ -1,0 +1,249 @@
+"""Annotation of a document by class motion templates (Krüger §3.2.2; Müller, Baak & Seidel 2009).
+
+For each class ``p`` the subsequence DTW cost ``Δ_p(ℓ)`` of its template against the document's features
+(:mod:`stylemotion.annotate.subsequence`) is turned into a frame-wise ``Δ̄_p^τ`` iteratively: take the
+smallest ``Δ_p(ℓ*) < τ``, mark its segment ``[start(ℓ*), ℓ*]`` (the frames not yet marked get the value
+``Δ_p(ℓ*)``), forbid every later hit whose segment overlaps a marked one, repeat until no value is below ``τ``.
+Each frame then gets the class of the smallest ``Δ̄_p^τ`` (eqs. 3.1–3.2), or none where all are ``inf``.
+
+Key-frame preselection: a class's key frames are a few columns of its quantized template (spread over its
+length, each the column with most consistent entries in its neighbourhood). A hit survives only when the
+document has frames matching its key frames (at most ``keyframe_tolerance`` of their consistent entries
+contradicted) in the right order inside the hit's segment.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from stylemotion.annotate.subsequence import subsequence_dtw
+from stylemotion.annotate.templates import MotionTemplate, local_cost
+
+#: Matching threshold τ of the thesis (its experiments: 0.13).
+DEFAULT_TAU = 0.13
+
+
+class AnnotationInputError(ValueError):
+    """A document or template set the annotation cannot use; the message names the value."""
+
+
+@dataclass(frozen=True)
+class Hit:
+    """A document segment matched by a class: frames ``start``–``end`` (inclusive), cost ``Δ_p(end)``."""
+
+    label: str
+    start: int
+    end: int
+    cost: float
+
+    def record(self) -> dict[str, object]:
+        return {"label": self.label, "start": self.start, "end": self.end, "cost": round(self.cost, 5)}
+
+
+@dataclass(frozen=True)
+class Annotation:
+    """Frame labels and the hits they came from.
+
+    Attributes:
+        labels: ``(frames,)`` int, index into ``classes`` or -1 for none.
+        distance: ``(frames,)`` ``Δ^min``, ``inf`` where unlabelled.
+        classes: class names.
+        hits: the accepted hits of every class, by start frame.
+    """
+
+    labels: np.ndarray
+    distance: np.ndarray
+    classes: tuple[str, ...]
+    hits: tuple[Hit, ...]
+
+    def label_names(self) -> list[str]:
+        """Per frame the class name, ``""`` where none."""
+        return ["" if i < 0 else self.classes[i] for i in self.labels]
+
+
+def keyframe_columns(template: MotionTemplate, count: int = 3) -> np.ndarray:
+    """Indices of ``count`` key frames of a template: in each of ``count`` equal parts of its length, the
+    column with the most consistent entries (the first such)."""
+    consistent = template.mask.sum(1)
+    edges = np.linspace(0, template.num_frames, count + 1).round().astype(int)
+    return np.array([a + int(np.argmax(consistent[a:b])) for a, b in zip(edges[:-1], edges[1:]) if b > a])
+
+
+def keyframe_matches(template: MotionTemplate, document: np.ndarray, keys: np.ndarray,
+                     tolerance: float) -> np.ndarray:
+    """``(keys, frames)`` bool: document frame matches key frame (≤ ``tolerance`` of its consistent entries
+    contradicted)."""
+    key_template = MotionTemplate(template.label, template.values[keys], template.examples, template.delta)
+    return local_cost(key_template, document) <= tolerance
+
+
+def keys_in_order(matches: np.ndarray, start: np.ndarray) -> np.ndarray:
+    """``(frames,)`` bool: for the segment ``[start[e], e]`` ending at each frame ``e``, whether every key frame
+    has a matching frame in it, each no earlier than the previous key's (``start`` -1: no segment)."""
+    keys, n = matches.shape
+    big = n                                                       # "no match at or after t"
+    t = np.where(start >= 0, start, big).astype(np.int64)
+    for row in matches:
+        nxt = np.full(n + 1, big, dtype=np.int64)                 # first matching frame ≥ t
+        idx = np.flatnonzero(row)
+        pos = np.searchsorted(idx, np.arange(n))
+        nxt[:n] = np.where(pos < idx.size, idx[np.minimum(pos, max(idx.size - 1, 0))] if idx.size else big, big)
+        t = nxt[np.minimum(t, n)]
+    return t <= np.arange(n)
+
+
+def class_hits(delta: np.ndarray, start: np.ndarray, tau: float, label: str,
+               keep: np.ndarray | None = None) -> tuple[list[Hit], np.ndarray]:
+    """Iterative hits of one class and its frame-wise ``Δ̄^τ`` ``(frames,)`` (see the module docstring).
+
+    Args:
+        delta, start: ``Δ_p`` and its start frames, ``(frames,)``.
+        keep: optional ``(frames,)`` bool, whether a hit ending at that frame passes preselection; hits
+            failing it are dropped without marking frames.
+    """
+    n = delta.shape[0]
+    bar = np.full(n, np.inf)
+    covered = np.zeros(n, dtype=bool)
+    hits: list[Hit] = []
+    order = np.argsort(delta, kind="stable")
+    for end in order:
+        cost = float(delta[end])
+        if not cost < tau:
+            break
+        a = int(start[end])
+        if a < 0:
+            continue
+        if covered[a:end + 1].any():
+            continue
+        if keep is not None and not keep[end]:
+            continue
+        hits.append(Hit(label, a, int(end), cost))
+        bar[a:end + 1] = np.minimum(bar[a:end + 1], cost)
+        covered[a:end + 1] = True
+    return hits, bar
+
+
+@dataclass(frozen=True)
+class AnnotationSettings:
+    """``tau``: matching threshold; ``keyframes``: use key-frame preselection; ``keyframe_count`` key frames
+    per class; ``keyframe_tolerance``: fraction of a key frame's consistent entries a matching frame may
+    contradict."""
+
+    tau: float = DEFAULT_TAU
+    keyframes: bool = True
+    keyframe_count: int = 3
+    keyframe_tolerance: float = 0.1
+
+
+@dataclass(frozen=True)
+class ClassDistances:
+    """``Δ_p`` and its starts for every class of a document, computed once and re-thresholded cheaply."""
+
+    classes: tuple[str, ...]
+    delta: np.ndarray          # (classes, frames)
+    start: np.ndarray          # (classes, frames)
+    keep: np.ndarray           # (classes, frames) bool: the hit ending there passes key-frame preselection
+
+
+def class_distances(document: np.ndarray, templates: Sequence[MotionTemplate],
+                    settings: AnnotationSettings = AnnotationSettings()) -> ClassDistances:
+    """Subsequence-DTW distance functions of every template over a document's ``(frames, features)`` features.
+
+    Raises:
+        AnnotationInputError: no template, feature counts that differ, or a document shorter than the
+            shortest template's minimum match (half its length).
+    """
+    doc = np.asarray(document)
+    if not templates:
+        raise AnnotationInputError("no class templates to annotate with")
+    if doc.ndim != 2 or any(t.values.shape[1] != doc.shape[1] for t in templates):
+        raise AnnotationInputError(f"document features {doc.shape} do not fit the templates' "
+                                   f"{sorted({t.values.shape[1] for t in templates})} features")
+    shortest = min(templates, key=lambda t: t.num_frames)
+    if doc.shape[0] < (shortest.num_frames + 1) // 2:
+        raise AnnotationInputError(f"the document has {doc.shape[0]} frames, shorter than any template can match "
+                                   f"(the shortest, {shortest.label!r}, has {shortest.num_frames} frames and needs "
+                                   f"≥ {(shortest.num_frames + 1) // 2})")
+    deltas, starts, keeps = [], [], []
+    for template in templates:
+        d, s = subsequence_dtw(local_cost(template, doc))
+        keep = np.ones(doc.shape[0], dtype=bool)
+        if settings.keyframes:
+            keys = keyframe_columns(template, settings.keyframe_count)
+            matches = keyframe_matches(template, doc, keys, settings.keyframe_tolerance)
+            keep = keys_in_order(matches, s) & np.isfinite(d)
+        deltas.append(d)
+        starts.append(s)
+        keeps.append(keep)
+    return ClassDistances(tuple(t.label for t in templates), np.stack(deltas), np.stack(starts), np.stack(keeps))
+
+
+def annotate_distances(distances: ClassDistances, tau: float, keyframes: bool) -> Annotation:
+    """Frame labels from precomputed class distances at threshold ``tau`` (eqs. 3.1–3.2)."""
+    bars, hits = [], []
+    for p, label in enumerate(distances.classes):
+        h, bar = class_hits(distances.delta[p], distances.start[p], tau, label,
+                            distances.keep[p] if keyframes else None)
+        bars.append(bar)
+        hits.extend(h)
+    bar = np.stack(bars)
+    best = np.argmin(bar, axis=0)
+    minimum = bar[best, np.arange(bar.shape[1])]
+    labels = np.where(np.isfinite(minimum), best, -1)
+    return Annotation(labels, minimum, distances.classes, tuple(sorted(hits, key=lambda h: (h.start, h.label))))
+
+
+def annotate_features(document: np.ndarray, templates: Sequence[MotionTemplate],
+                      settings: AnnotationSettings = AnnotationSettings()) -> Annotation:
+    """Annotate a document given as ``(frames, features)`` relational features."""
+    return annotate_distances(class_distances(document, templates, settings), settings.tau, settings.keyframes)
+
+
+def segments(labels: Sequence[str] | np.ndarray) -> list[tuple[int, int, str]]:
+    """Maximal runs of one non-empty label: ``(start, end_exclusive, label)``."""
+    out: list[tuple[int, int, str]] = []
+    labels = list(labels)
+    i = 0
+    while i < len(labels):
+        j = i
+        while j < len(labels) and labels[j] == labels[i]:
+            j += 1
+        if labels[i] not in ("", None):
+            out.append((i, j, str(labels[i])))
+        i = j
+    return out
+
+
+def frame_scores(truth: Sequence[str], predicted: Sequence[str]) -> dict[str, float | int]:
+    """Frame-level precision/recall/F (P1, R1, F1) of labelled frames; ``""`` means unlabelled."""
+    t, p = np.asarray(list(truth), dtype=object), np.asarray(list(predicted), dtype=object)
+    if t.shape != p.shape:
+        raise ValueError(f"truth has {t.shape[0]} frames, prediction {p.shape[0]}")
+    relevant, retrieved = t != "", p != ""
+    correct = int((relevant & retrieved & (t == p)).sum())
+    return _prf(correct, int(retrieved.sum()), correct, int(relevant.sum()), "1")
+
+
+def segment_scores(truth: Sequence[str], predicted: Sequence[str]) -> dict[str, float | int]:
+    """Segment-level P2/R2/F2: a segment counts when it overlaps a segment of the other side with its label."""
+    ts, ps = segments(truth), segments(predicted)
+
+    def overlaps(seg: tuple[int, int, str], others: list[tuple[int, int, str]]) -> bool:
+        return any(o[2] == seg[2] and o[0] < seg[1] and seg[0] < o[1] for o in others)
+
+    good_p = sum(overlaps(s, ts) for s in ps)
+    good_t = sum(overlaps(s, ps) for s in ts)
+    return _prf(good_p, len(ps), good_t, len(ts), "2")
+
+
+def _prf(hit_p: int, n_p: int, hit_r: int, n_r: int, suffix: str) -> dict[str, float | int]:
+    precision = hit_p / n_p if n_p else 0.0
+    recall = hit_r / n_r if n_r else 0.0
+    f = 2 * precision * recall / (precision + recall) if precision + recall else 0.0
+    return {f"P{suffix}": precision, f"R{suffix}": recall, f"F{suffix}": f, f"retrieved{suffix}": n_p,
+            f"relevant{suffix}": n_r}
+
+
