@@ -121,14 +121,19 @@ def _difference_operators(frames: int) -> tuple[sp.csr_matrix, sp.csr_matrix]:
     return first, second
 
 
+#: Weight of a pinned frame's control term relative to the energy's largest weight (a hard constraint in effect).
+PIN_WEIGHT = 1e8
+
+
 def solve_energy(pose: np.ndarray, velocity: np.ndarray, acceleration: np.ndarray, control: np.ndarray,
-                 control_weight: np.ndarray, weights: dict) -> np.ndarray:
+                 control_weight: np.ndarray, weights: dict, pinned: Sequence[int] = ()) -> np.ndarray:
     """Minimize eq. 4.7 (module docstring, step 3) for independent channels.
 
     Args:
         pose, velocity, acceleration: ``(frames, c)`` targets (metres, m/frame, m/frame²) per channel.
         control: ``(frames, c)`` the input.  control_weight: ``(c,)`` E_control weight per channel; ``inf`` keeps
-            the input.  weights: ``pose``, ``motion``, ``smooth``.
+            the input.  weights: ``pose``, ``motion``, ``smooth``.  pinned: frames where every channel keeps
+            the input (the keyframes of a dynamic motion graph, §4.3.4).
 
     Returns:
         ``(frames, c)`` the minimizer.
@@ -139,10 +144,16 @@ def solve_energy(pose: np.ndarray, velocity: np.ndarray, acceleration: np.ndarra
     base = weights["motion"] * (first.T @ first) + weights["smooth"] * (second.T @ second)
     rhs_base = (weights["pose"] * pose + weights["motion"] * (first.T @ velocity[1:-1])
                 + weights["smooth"] * (second.T @ acceleration[1:-1]))
+    pin = np.zeros(frames)
+    pin[np.asarray(pinned, dtype=np.int64)] = PIN_WEIGHT * max(weights["pose"], weights["motion"], weights["smooth"],
+                                                               1.0)
     for lam in np.unique(control_weight[np.isfinite(control_weight)]):
         cols = np.flatnonzero(control_weight == lam)
-        matrix = (base + (weights["pose"] + lam) * sp.identity(frames)).tocsc()
-        out[:, cols] = splu(matrix).solve(np.ascontiguousarray(rhs_base[:, cols] + lam * control[:, cols]))
+        diagonal = weights["pose"] + lam + pin
+        matrix = (base + sp.diags(diagonal)).tocsc()
+        rhs = rhs_base[:, cols] + (lam + pin)[:, None] * control[:, cols]
+        out[:, cols] = splu(matrix).solve(np.ascontiguousarray(rhs))
+    out[np.asarray(pinned, dtype=np.int64)] = control[np.asarray(pinned, dtype=np.int64)]
     return out
 
 
@@ -244,12 +255,20 @@ class MotionTexturer:
                 weights[t, :n] = 1.0 / (distances[t, :n] + self.distance_sd) ** 2
         return chosen, weights / weights.sum(axis=1, keepdims=True)
 
-    def apply(self, motion: np.ndarray) -> TextureResult:
+    def apply(self, motion: np.ndarray, pinned: Sequence[int] = ()) -> TextureResult:
         """Complete or texture ``motion`` ``(frames, 21, 3)`` metres (at the database's fps; in complete mode the
-        untrusted joints may be NaN) → :class:`TextureResult`."""
+        untrusted joints may be NaN) → :class:`TextureResult`. ``pinned``: frames kept exactly as given (every
+        joint; they must be complete), e.g. keyframes."""
         started = time.perf_counter()
         query = self._check_motion(motion)
         frames = len(query)
+        pinned = np.unique(np.asarray(pinned, dtype=np.int64))
+        if pinned.size and (pinned.min() < 0 or pinned.max() >= frames):
+            raise TextureInputError(f"pinned frame {int(pinned.max() if pinned.max() >= frames else pinned.min())} "
+                                    f"is outside the motion's {frames} frames")
+        if pinned.size and not np.isfinite(query[pinned]).all():
+            raise TextureInputError(f"pinned frame {int(pinned[~np.isfinite(query[pinned]).all(axis=(1, 2))][0])} "
+                                    f"has joints that are not finite")
         rotation, origin = marker_frames(query[:, self.trusted_idx], self.joints)
         q_local = to_local(np.nan_to_num(query), rotation, origin)
         features = stack_window(q_local[:, self.trusted_idx].reshape(frames, -1), self.offsets)
@@ -273,7 +292,7 @@ class MotionTexturer:
         control_weight[self.trusted_idx] = self.weights["control"]
         control = np.where(np.isfinite(query), query, pose_w)
         raw = solve_energy(pose_w.reshape(frames, -1), vel_w.reshape(frames, -1), acc_w.reshape(frames, -1),
-                           control.reshape(frames, -1), np.repeat(control_weight, 3), self.weights)
+                           control.reshape(frames, -1), np.repeat(control_weight, 3), self.weights, pinned)
         raw = raw.reshape(frames, NUM_JOINTS, 3)
         baseline = to_world(baseline_local, rotation, origin)
         if self.mode == "complete":
@@ -286,6 +305,7 @@ class MotionTexturer:
             positions = clean_foot_skating(raw, self.database.fps)
             if self.mode == "complete":
                 positions[:, self.trusted_idx] = query[:, self.trusted_idx]
+            positions[pinned] = query[pinned]
         done = time.perf_counter()
         timings = {"knn": t_knn - started, "lng": t_lng - t_knn, "solve": done - t_lng, "total": done - started}
         return TextureResult(positions, raw, baseline, chosen[:, 0], self.settings(), timings)
