@@ -1,6 +1,15 @@
-"""Data-driven reconstruction on the motion database (Krüger §2.5.2, §4.2): full poses from a few markers, motion
-completion and texturing."""
+"""Data-driven reconstruction on the motion database (Krüger §2.5.2, §4.2, §4.3): full poses from a few markers,
+motion completion and texturing, motion from a few keyframes (dynamic motion graphs)."""
 
+from stylemotion.reconstruct.keyframes import (
+    DynamicMotionGraph,
+    FarKeyframeWarning,
+    Keyframe,
+    KeyframeError,
+    KeyframeResult,
+    NoConnectionError,
+    keys_from_motion,
+)
 from stylemotion.reconstruct.markers import (
     DEFAULT_MARKERS,
     MarkerGapWarning,
@@ -29,6 +38,8 @@ from stylemotion.reconstruct.texture import (
 )
 
 __all__ = [
+    "DynamicMotionGraph", "FarKeyframeWarning", "Keyframe", "KeyframeError", "KeyframeResult", "NoConnectionError",
+    "keys_from_motion",
     "LEG_JOINTS", "MotionTexturer", "TextureInputError", "TextureResult", "key_spline", "texture_motion",
     "DEFAULT_MARKERS", "MarkerGapWarning", "MarkerInputError", "MarkerTracks", "RECONSTRUCT_FEATURE_SETS",
     "Reconstruction", "SparseReconstructor", "fill_gaps", "joint_errors_cm", "marker_frames", "read_markers",

@@ -14,6 +14,7 @@ The folder ``out`` (refused when it exists unless ``force``; built beside it and
 * ``motion.npz``: ``positions`` ``(frames, 21, 3)`` float32 metres in the markers' world frame, ``joint_names``,
   ``fps`` — as ``stylemotion-convert`` writes;
 * ``motion.bvh``: the same through :func:`stylemotion.export.write_motion_bvh`;
+* ``motion.gif``: the stick figure along its ground track (unless ``gif=false``);
 * ``summary.json``: the settings, the markers' source and filled gaps, frames/s, the database, provenance and,
   when the input was a complete motion, the mean/max per-joint error in cm (also of the nearest-neighbour
   baseline for marker-only feature sets).
@@ -73,8 +74,8 @@ def load_tracks(text: str, takeset: TakeSet, joints: Sequence[str] | None,
 def reconstruct_command(data: Mapping[str, Any], markers: str, out: str | os.PathLike, *, features: str = "E15",
                         k: int = 64, joints: Sequence[str] | None = None, noise_mm: float = 0.0, seed: int = 0,
                         exclude_markers_take: bool = True, model: Mapping[str, Any] | None = None,
-                        conversion: Mapping[str, Any] | None = None, force: bool = False, say: Say = print,
-                        command: str = "") -> dict[str, Any]:
+                        conversion: Mapping[str, Any] | None = None, force: bool = False, gif: bool = True,
+                        say: Say = print, command: str = "") -> dict[str, Any]:
     """Reconstruct ``markers`` on the database ``data`` (a ``data`` config) and write ``out`` (module docstring).
 
     ``model``: further :class:`SparseReconstructor` settings (variance, marker_sd, smooth_sd, prior_weight,
@@ -133,7 +134,7 @@ def reconstruct_command(data: Mapping[str, Any], markers: str, out: str | os.Pat
             baseline = joint_errors_cm(reconstructor.nearest_neighbour(positions), tracks.full)
             summary["error_nearest_neighbour"] = {key: baseline[key] for key in ("mean_cm", "max_cm")}
     summary["provenance"] = provenance(command or None)
-    write_motion_folder(out, force, result.positions, database.fps, summary, started)
+    write_motion_folder(out, force, result.positions, database.fps, summary, started, gif=gif)
     error = summary.get("error")
     say(f"{tracks.num_frames} frames reconstructed at {summary['frames_per_s']:g} frames/s into {out}"
         + (f"; error {error['mean_cm']:.2f} cm mean, {error['max_cm']:.2f} cm max per joint" if error else ""))
@@ -153,4 +154,4 @@ def reconstruct_from_config(cfg: DictConfig, say: Say = print, command: str = ""
         k=plain.get("k", 64), joints=joints, noise_mm=plain.get("noise_mm", 0.0), seed=int(plain.get("seed", 0)),
         exclude_markers_take=bool(plain.get("exclude_markers_take", True)), model=plain.get("model") or {},
         conversion={key: plain.get(key) for key in ("joint_map", "unit_scale", "up_axis")},
-        force=bool(plain.get("force", False)), say=say, command=command)
+        force=bool(plain.get("force", False)), gif=bool(plain.get("gif", True)), say=say, command=command)

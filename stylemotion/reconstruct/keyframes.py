@@ -141,14 +141,16 @@ class _Tree:
     node_edge: list[int] = field(default_factory=list)  # edge that made it (-1: root)
     node_frames: list[int] = field(default_factory=list)  # frames of the path root → node, the node's included
     node_cost: list[float] = field(default_factory=list)  # C_edge of that path, metres
+    node_anchor: list[float] = field(default_factory=list)  # Σ_J distance of its root edge's first pose to the key
     expanded: list[bool] = field(default_factory=list)
     edge_frames: list[np.ndarray] = field(default_factory=list)  # database frames, in time order
     edge_turn: list[float] = field(default_factory=list)  # yaw added to a database frame's placement
     edge_shift: list[np.ndarray] = field(default_factory=list)  # ground shift after the turn (3,)
     edge_parent: list[int] = field(default_factory=list)  # node it grew from
+    edge_child: list[int] = field(default_factory=list)  # node it made
 
     def add_node(self, frame: int, ground: np.ndarray, yaw: float, effectors: np.ndarray, edge: int, frames: int,
-                 cost: float) -> int:
+                 cost: float, anchor: float = 0.0) -> int:
         self.node_frame.append(frame)
         self.node_ground.append(ground)
         self.node_yaw.append(float(yaw))
@@ -156,6 +158,7 @@ class _Tree:
         self.node_edge.append(edge)
         self.node_frames.append(frames)
         self.node_cost.append(cost)
+        self.node_anchor.append(anchor)
         self.expanded.append(False)
         return len(self.node_frame) - 1
 
@@ -216,6 +219,7 @@ class DynamicMotionGraph:
                  voxel_m: float = 0.1, min_segment_frames: int = 4, max_segment_s: float = 1.0,
                  max_turn_deg: float = 30.0, max_pose_m: float = 0.15, max_velocity_m_s: float = 0.6,
                  blend_frames: int = 10, duration_weight: float = 1.0, facing_weight_m: float = 1.0,
+                 key_weight: float = 10.0, extra_iterations: int = 1,
                  retime: bool = True, clean: bool = True,
                  index: FrameIndex | None = None, texturer: MotionTexturer | None = None):
         for key, value, low in (("k", k, 1), ("b", b, 1), ("max_iterations", max_iterations, 1),
@@ -226,7 +230,11 @@ class DynamicMotionGraph:
                            ("max_pose_m", max_pose_m), ("max_velocity_m_s", max_velocity_m_s)):
             if not (isinstance(value, (int, float)) and np.isfinite(value) and value > 0):
                 raise KeyframeError(f"{key}={value} must be a positive number")
-        for key, value in (("duration_weight", duration_weight), ("facing_weight_m", facing_weight_m)):
+        if isinstance(extra_iterations, bool) or not isinstance(extra_iterations, (int, np.integer)) \
+                or extra_iterations < 0:
+            raise KeyframeError(f"extra_iterations={extra_iterations} must be a whole number ≥ 0")
+        for key, value in (("duration_weight", duration_weight), ("facing_weight_m", facing_weight_m),
+                           ("key_weight", key_weight)):
             if not (isinstance(value, (int, float)) and np.isfinite(value) and value >= 0):
                 raise KeyframeError(f"{key}={value} must be a number ≥ 0")
         if database.num_frames < 2:
@@ -238,7 +246,8 @@ class DynamicMotionGraph:
         self.max_turn = np.deg2rad(float(max_turn_deg))
         self.max_pose_m, self.max_velocity_m_s = float(max_pose_m), float(max_velocity_m_s)
         self.blend_frames, self.duration_weight = int(blend_frames), float(duration_weight)
-        self.facing_weight_m = float(facing_weight_m)
+        self.facing_weight_m, self.key_weight = float(facing_weight_m), float(key_weight)
+        self.extra_iterations = int(extra_iterations)
         self.retime, self.clean = bool(retime), bool(clean)
         self._prepare_database()
         self.index = index if index is not None else FrameIndex.build(database, "E15")
@@ -349,8 +358,13 @@ class DynamicMotionGraph:
                 end = int(frames[-1] if tree.forward else frames[0])
                 world_end = rotate_yaw(np.asarray(self.database.positions[end], np.float64), turn) + shift
                 cost = float(self.speed[frames].sum())
-                tree.add_node(end, world_end[HIPS] * np.array([1.0, 0.0, 1.0]), self.yaw[end] + turn,
-                              world_end[EFFECTORS], edge, tree.node_frames[v] + len(frames), tree.node_cost[v] + cost)
+                anchor = tree.node_anchor[v]
+                if root:
+                    placed = rotate_yaw(np.asarray(self.database.positions[n], np.float64), turn) + shift
+                    anchor = float(np.linalg.norm(placed - key.pose, axis=-1).sum())
+                tree.edge_child.append(tree.add_node(
+                    end, world_end[HIPS] * np.array([1.0, 0.0, 1.0]), self.yaw[end] + turn, world_end[EFFECTORS], edge,
+                    tree.node_frames[v] + len(frames), tree.node_cost[v] + cost, anchor))
                 new_edges.append(edge)
         return new_edges
 
@@ -450,7 +464,9 @@ class DynamicMotionGraph:
         cost = (out_tree.node_cost[parent_o] + in_tree.node_cost[parent_i] + float(self.speed[frames_o].sum())
                 + float(self.speed[frames_i].sum()))
         frames = out_tree.node_frames[parent_o] + len(frames_o) + len(frames_i) - 1 + in_tree.node_frames[parent_i]
-        score = cost + self.duration_weight * abs(frames - target_frames) * self.median_frame_cost
+        score = (cost + self.duration_weight * abs(frames - target_frames) * self.median_frame_cost
+                 + self.key_weight * (out_tree.node_anchor[out_tree.edge_child[eo]]
+                                      + in_tree.node_anchor[in_tree.edge_child[ei]]))
         return cost, frames, score
 
     def _in_take(self, frames: np.ndarray, like: int) -> np.ndarray:
@@ -500,19 +516,21 @@ class DynamicMotionGraph:
         in_edges: list[int] = []
         target_frames = int(round((second.time_s - first.time_s) * self.fps)) + 1
         connections: list[tuple[int, int, int, int]] = []
-        iteration = 0
+        iteration, met = 0, None
         for iteration in range(1, self.max_iterations + 1):
             new_out = self._expand(out_tree, self._select(out_tree, in_tree), first)
             new_in = self._expand(in_tree, self._select(in_tree, out_tree), second)
             out_edges += new_out
             in_edges += new_in
             out_all, in_all = self._frame_table(out_tree, out_edges), self._frame_table(in_tree, in_edges)
-            connections = (self._connections(self._frame_table(out_tree, new_out), in_all)
-                           + self._connections(out_all, self._frame_table(in_tree, new_in)))
+            connections += (self._connections(self._frame_table(out_tree, new_out), in_all)
+                            + self._connections(out_all, self._frame_table(in_tree, new_in)))
             if say:
                 say(f"  iteration {iteration}: {len(out_tree.node_frame)} + {len(in_tree.node_frame)} nodes, "
                     f"{len(connections)} connection(s)")
-            if connections:
+            if connections and met is None:
+                met = iteration
+            if met is not None and iteration >= met + self.extra_iterations:
                 break
         if not connections:
             gap = float(self._node_distance(out_tree, in_tree).min())
@@ -527,7 +545,7 @@ class DynamicMotionGraph:
         positions = self._assemble(out_tree, in_tree, connections[best])
         cost, _, _ = figures[best]
         return PairResult(positions, {
-            "from_s": first.time_s, "to_s": second.time_s, "iterations": iteration,
+            "from_s": first.time_s, "to_s": second.time_s, "iterations": iteration, "met_at_iteration": met,
             "nodes": [len(out_tree.node_frame), len(in_tree.node_frame)], "connections": len(connections),
             "frames": len(positions), "duration_s": round((len(positions) - 1) / self.fps, 4),
             "duration_error_s": round((len(positions) - target_frames) / self.fps, 4),
@@ -541,6 +559,7 @@ class DynamicMotionGraph:
                 "max_turn_deg": round(float(np.rad2deg(self.max_turn)), 3), "max_pose_m": self.max_pose_m,
                 "max_velocity_m_s": self.max_velocity_m_s, "blend_frames": self.blend_frames,
                 "duration_weight": self.duration_weight, "facing_weight_m": self.facing_weight_m,
+                "key_weight": self.key_weight, "extra_iterations": self.extra_iterations,
                 "retime": self.retime, "clean": self.clean,
                 "database": {"name": self.database.name, "takes": self.database.num_takes,
                              "frames": self.database.num_frames, "fps": self.fps}}

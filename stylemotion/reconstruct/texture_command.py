@@ -7,9 +7,9 @@
 untrusted joints may be NaN) or a take of the dataset (left out of the database unless
 ``exclude_motion_take=false``). The folder ``out`` (refused when it exists unless ``force``; built beside it and
 renamed into place) holds ``motion.npz`` (``positions`` (frames, 21, 3) float32 metres in the input's world frame,
-``joint_names``, ``fps``), ``motion.bvh`` and ``summary.json``: settings, database, timings, foot skating before and
-after, provenance and, for a complete input motion, the error per joint in cm (complete mode: on the untrusted
-joints, with the nearest-neighbour baseline).
+``joint_names``, ``fps``), ``motion.bvh``, ``motion.gif`` (unless ``gif=false``) and ``summary.json``: settings,
+database, timings, foot skating before and after, provenance and, for a complete input motion, the error per
+joint in cm (complete mode: on the untrusted joints, with the nearest-neighbour baseline).
 """
 
 from __future__ import annotations
@@ -64,7 +64,7 @@ def _errors_cm(positions: np.ndarray, truth: np.ndarray, joints: Sequence[str]) 
 def texture_command(data: Mapping[str, Any], motion: str, out: str | os.PathLike, *, mode: str = "complete",
                     joints: Sequence[str] | None = None, k: int = 32, exclude_motion_take: bool = True,
                     model: Mapping[str, Any] | None = None, conversion: Mapping[str, Any] | None = None,
-                    force: bool = False, say: Say = print, command: str = "") -> dict[str, Any]:
+                    force: bool = False, gif: bool = True, say: Say = print, command: str = "") -> dict[str, Any]:
     """Complete or texture ``motion`` on the database ``data`` (a ``data`` config) and write ``out`` (module
     docstring). ``model``: further :class:`MotionTexturer` settings. Returns what ``summary.json`` holds.
 
@@ -112,7 +112,7 @@ def texture_command(data: Mapping[str, Any], motion: str, out: str | os.PathLike
         if mode == "complete":
             summary["error_nearest_neighbour"] = _errors_cm(result.nearest_neighbour, truth, scored)
     summary["provenance"] = provenance(command or None)
-    write_motion_folder(out, force, result.positions, database.fps, summary, started)
+    write_motion_folder(out, force, result.positions, database.fps, summary, started, gif=gif)
     error = summary.get("error")
     say(f"{len(positions)} frames ({mode}) into {out}"
         + (f"; error {error['mean_cm']:.2f} cm mean per joint" if error else ""))
@@ -134,4 +134,4 @@ def texture_from_config(cfg: DictConfig, say: Say = print, command: str = "") ->
         plain["data"], plain["motion"], plain["out"], mode=str(plain.get("mode", "complete")), joints=joints, k=k,
         exclude_motion_take=bool(plain.get("exclude_motion_take", True)), model=plain.get("model") or {},
         conversion={key: plain.get(key) for key in ("joint_map", "unit_scale", "up_axis")},
-        force=bool(plain.get("force", False)), say=say, command=command)
+        force=bool(plain.get("force", False)), gif=bool(plain.get("gif", True)), say=say, command=command)
