@@ -7,7 +7,8 @@ The motions are synthetic walks, runs and turns of several styles (stylemotion.d
 :func:`stylemotion.viewer.page.write_viewer`; the page is opened from disk in Debian's chromium (headless,
 software WebGL, Playwright) at 1280×720. Load time: ``page.goto`` until the first frame is drawn
 (``document.body.dataset.ready``), median of ``--loads`` fresh pages. Frame rate: frames drawn per second
-while playing, over ``--seconds``.
+while playing, over ``--seconds``, with ``?quality=auto`` (on software WebGL: no shadows, no antialiasing) and
+``?quality=high`` (shadows and antialiasing); the screenshot is taken at high quality.
 """
 
 from __future__ import annotations
@@ -55,7 +56,7 @@ def main() -> int:
     with tempfile.TemporaryDirectory() as tmp:
         started = time.perf_counter()
         index = write_viewer(motions(args.motions, args.frames), Path(tmp) / "view", title=(
-            f"stylemotion-view: {args.motions} synthetic motions (walk, turns, run; 7 styles)"))
+            f"stylemotion-view: {args.motions} synthetic motions of {min(args.motions, len(STYLES))} styles"))
         write_s = time.perf_counter() - started
         size = folder_size(index.parent)
         data_size = (index.parent / "data.js").stat().st_size
@@ -71,23 +72,28 @@ def main() -> int:
                 page.wait_for_function("document.body.dataset.ready === '1'", timeout=60_000)
                 loads.append(time.perf_counter() - t0)
                 page.close()
-            page = browser.new_page(viewport={"width": 1280, "height": 720})
-            page.goto(index.as_uri())
-            page.wait_for_function("document.body.dataset.ready === '1'", timeout=60_000)
-            page.wait_for_timeout(1000)
-            r0, t0 = page.evaluate("window.stylemotionViewer.rendered"), time.perf_counter()
-            page.wait_for_timeout(args.seconds * 1000)
-            r1, t1 = page.evaluate("window.stylemotionViewer.rendered"), time.perf_counter()
-            skeletons = int(page.evaluate("document.body.dataset.skeletons"))
-            if args.screenshot:
-                page.evaluate("window.stylemotionViewer.pause(); window.stylemotionViewer.setFrame(45)")
-                page.wait_for_timeout(500)
-                page.screenshot(path=args.screenshot)
+            fps, quality = {}, {}
+            for asked in ("auto", "high"):
+                page = browser.new_page(viewport={"width": 1280, "height": 720})
+                page.goto(index.as_uri() + f"?quality={asked}")
+                page.wait_for_function("document.body.dataset.ready === '1'", timeout=60_000)
+                page.wait_for_timeout(1000)
+                r0, t0 = page.evaluate("window.stylemotionViewer.rendered"), time.perf_counter()
+                page.wait_for_timeout(args.seconds * 1000)
+                r1, t1 = page.evaluate("window.stylemotionViewer.rendered"), time.perf_counter()
+                fps[asked] = round((r1 - r0) / (t1 - t0), 1)
+                quality[asked] = page.evaluate("document.body.dataset.quality")
+                skeletons = int(page.evaluate("document.body.dataset.skeletons"))
+                if args.screenshot and asked == "high":
+                    page.evaluate("window.stylemotionViewer.pause(); window.stylemotionViewer.setFrame(45)")
+                    page.wait_for_timeout(1500)
+                    page.screenshot(path=args.screenshot)
+                page.close()
             browser.close()
     print(json.dumps({
         "motions": args.motions, "frames": args.frames, "skeletons_drawn": skeletons,
         "load_s_median": round(statistics.median(loads), 3), "load_s": [round(x, 3) for x in loads],
-        "fps_playing": round((r1 - r0) / (t1 - t0), 1), "write_s": round(write_s, 2),
+        "fps_playing": fps, "quality_used": quality, "write_s": round(write_s, 2),
         "folder_mb": round(size / 1e6, 2), "data_js_mb": round(data_size / 1e6, 2),
         "viewport": "1280x720", "browser": "Debian chromium, headless, --disable-gpu (software WebGL)",
         "console_errors": errors, "load_average": [round(x, 2) for x in os.getloadavg()],

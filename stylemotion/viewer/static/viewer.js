@@ -40,15 +40,28 @@
 
   // renderer, scene, camera
   const host = document.getElementById("view");
+  // quality: ?quality=high (antialiasing, shadows) or low; auto (default): low on a software WebGL renderer
+  function webglRenderer() {
+    const gl = document.createElement("canvas").getContext("webgl2");
+    if (!gl) return "";
+    const info = gl.getExtension("WEBGL_debug_renderer_info");
+    const name = String(gl.getParameter(info ? info.UNMASKED_RENDERER_WEBGL : gl.RENDERER));
+    const lose = gl.getExtension("WEBGL_lose_context");
+    if (lose) lose.loseContext();
+    return name;
+  }
+  const asked = new URLSearchParams(window.location.search).get("quality") || "auto";
+  const software = /swiftshader|llvmpipe|software/i.test(webglRenderer());
+  const high = asked === "high" || (asked !== "low" && !software);
   let renderer;
   try {
-    renderer = new T.WebGLRenderer({ antialias: true });
+    renderer = new T.WebGLRenderer({ antialias: high });
   } catch (e) {
     fail("WebGL is not available in this browser: " + e.message);
     return;
   }
   renderer.setPixelRatio(window.devicePixelRatio || 1);
-  renderer.shadowMap.enabled = true;
+  renderer.shadowMap.enabled = high;
   renderer.shadowMap.type = T.PCFShadowMap;
   host.appendChild(renderer.domElement);
   const scene = new T.Scene();
@@ -227,6 +240,14 @@
   note.textContent = "Yellow feet: ground contact. Faint line: root track; solid line and rings: a generated " +
     "walk's path and targets. Drag to orbit, scroll to zoom, right-drag to pan; space plays/pauses.";
   legend.append(note);
+  if (!high) {
+    const q = document.createElement("span");
+    q.className = "note";
+    q.textContent = (software ? "Software WebGL: " : "") + "shadows and antialiasing off (add ?quality=high to the " +
+      "address to turn them on).";
+    legend.append(q);
+  }
+  document.body.dataset.quality = high ? "high" : "low";
 
   // resize and render loop
   function resize() {
@@ -241,7 +262,7 @@
   applyLayout(true);
   let last = performance.now(), fpsFrames = 0, fpsStart = last;
   const api = {
-    skeletons: n, motions: n, totalFrames, displayFps, fps: 0, rendered: 0,
+    skeletons: n, motions: n, totalFrames, displayFps, fps: 0, rendered: 0, quality: high ? "high" : "low",
     frame: () => shownFrame,
     setFrame: (k) => { state.time = Math.max(0, Math.min(totalFrames, k)) / displayFps; },
     play: () => setPlaying(true),
