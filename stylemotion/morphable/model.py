@@ -35,6 +35,7 @@ from stylemotion.morphable.bspline import SplineBasis
 from stylemotion.morphable.channels import Channels
 from stylemotion.morphable.fpca import FunctionalPCA, fit_reduction
 from stylemotion.morphable.gmm import LatentGMM, fit_gmm
+from stylemotion.morphable.tree import TREE_SAMPLES, SpaceTree
 from stylemotion.morphable.warping import canonical_times, dtw_warp, monotone, resample
 from stylemotion.primitives import Clip, canonical_timelines, time_normalize
 from stylemotion.representation import JOINT_DIMS, positions_to_frames
@@ -159,6 +160,7 @@ class MorphableModel:
         length: ``L``, frames of the canonical timeline.
         fps: frames per second of decoded motions.
         meta: plain values (primitive, action, style, settings, fit record).
+        tree: the space-partitioning tree over samples of the mixture (:mod:`.tree`), if built.
     """
 
     channels: Channels
@@ -168,6 +170,7 @@ class MorphableModel:
     length: int
     fps: float
     meta: dict[str, Any] = field(default_factory=dict)
+    tree: SpaceTree | None = None
 
     # -- interfaces shared with the VAEs (MotionGraph, evaluation)
 
@@ -247,7 +250,14 @@ class MorphableModel:
                   "pca_variance": self.reduction.variance, **self.gmm.to_arrays()}
         if self.channels.offsets is not None:
             arrays["offsets"] = self.channels.offsets
+        if self.tree is not None:
+            arrays.update(self.tree.to_arrays())
         return arrays
+
+    def build_tree(self, samples: int = TREE_SAMPLES, split: str = "kmeans", seed: int = 0, **kwargs) -> SpaceTree:
+        """Build (and keep) the space-partitioning tree over ``samples`` codes drawn from the mixture."""
+        self.tree = SpaceTree.build(self.gmm.sample(samples, seed), split=split, seed=seed, **kwargs)
+        return self.tree
 
     def save(self, path: str | Path) -> Path:
         """Write the model to ``path`` (``.npz``) atomically; returns the path."""
@@ -276,9 +286,10 @@ class MorphableModel:
             channels = Channels(meta["representation"], z["offsets"] if "offsets" in z.files else None)
             reduction = FunctionalPCA(z["pca_mean"], z["pca_components"], z["pca_scale"], z["pca_variance"])
             gmm = LatentGMM.from_arrays(z)
+            tree = SpaceTree.from_arrays(z) if "tree_latent" in z.files else None
         meta["path"] = str(path)
         return cls(channels, SplineBasis(int(meta["num_coefficients"])), reduction, gmm, int(meta["length"]),
-                   float(meta["fps"]), meta)
+                   float(meta["fps"]), meta, tree)
 
 
 def concat_samples(parts: Sequence[MotionSamples]) -> MotionSamples:

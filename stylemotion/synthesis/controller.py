@@ -278,7 +278,9 @@ def follow_path(graph: MotionGraph, path: GroundPath, seed: int = 0, settings: F
             previous_pose=None if motion is None else torch.tensor(motion[-1, JOINT_DIMS], dtype=torch.float32),
             previous_speed=None if previous_speed is None else torch.tensor(previous_speed))
         model = graph.models[primitive]
-        z, start_cost, final_cost, terms = _search(model, goal, settings, generator)
+        own_search = getattr(model, "search_step", None)  # e.g. a Morphable Graph primitive's MAP (eq. 4.9)
+        z, start_cost, final_cost, terms = (own_search(goal, settings, generator) if own_search
+                                            else _search(model, goal, settings, generator))
         decoded = model.decode_latent(z[None])
         clip = decoded.frames[0, : int(decoded.num_frames[0])].numpy().astype(np.float64)
         before = 0 if motion is None else len(motion) - 1
