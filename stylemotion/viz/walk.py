@@ -3,7 +3,8 @@
 One oblique view (:func:`stylemotion.viz.animation.oblique`, across the walk and from above)
 holds the whole scene: the requested path on the ground (dashed), the root's track so far (grey),
 the step keyframes (dots) and the stick figure (left limbs blue, right limbs red). Written as a GIF
-with matplotlib's ``PillowWriter``, or as MP4 with ``FFMpegWriter`` when ffmpeg is installed.
+with matplotlib's ``PillowWriter``, or as MP4 (H.264) with ``FFMpegWriter`` running the ffmpeg binary that
+the ``imageio-ffmpeg`` wheel ships (a dependency), so no system ffmpeg is needed.
 Files are written atomically (temporary name, then rename).
 """
 
@@ -12,7 +13,8 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-from matplotlib.animation import FFMpegWriter, PillowWriter, writers
+from matplotlib import rc_context
+from matplotlib.animation import FFMpegWriter, PillowWriter
 from matplotlib.figure import Figure
 
 from stylemotion.skeleton import JOINT_INDEX
@@ -20,9 +22,24 @@ from stylemotion.viz.animation import oblique, pose_at
 from stylemotion.viz.stick import StickFigure, project
 
 
+def ffmpeg_executable() -> str:
+    """Path of the ffmpeg binary of ``imageio-ffmpeg`` (its wheel's, or ``IMAGEIO_FFMPEG_EXE``).
+
+    Raises:
+        RuntimeError: imageio-ffmpeg finds no binary (a platform without a wheel and no system ffmpeg).
+    """
+    import imageio_ffmpeg
+
+    return imageio_ffmpeg.get_ffmpeg_exe()
+
+
 def mp4_available() -> bool:
-    """Whether matplotlib finds ffmpeg (needed for ``.mp4``)."""
-    return writers.is_available("ffmpeg")
+    """Whether an ffmpeg binary is found (needed for ``.mp4``)."""
+    try:
+        ffmpeg_executable()
+    except RuntimeError:
+        return False
+    return True
 
 
 def save_walk_animation(positions: np.ndarray, fps: float, path_xz: np.ndarray, out: str | Path,
@@ -42,14 +59,15 @@ def save_walk_animation(positions: np.ndarray, fps: float, path_xz: np.ndarray, 
             the default looks across a walk along +Z, from its right and above).
 
     Raises:
-        RuntimeError: ``.mp4`` requested without ffmpeg.
+        RuntimeError: ``.mp4`` requested and imageio-ffmpeg finds no ffmpeg binary.
     """
     out = Path(out)
     suffix = out.suffix.lower()
     if suffix not in (".gif", ".mp4"):
         raise ValueError(f"{out}: animation must be .gif or .mp4")
     if suffix == ".mp4" and not mp4_available():
-        raise RuntimeError(f"{out}: writing MP4 needs ffmpeg on PATH (or write a .gif)")
+        raise RuntimeError(f"{out}: writing MP4 needs the ffmpeg binary of imageio-ffmpeg (pip install imageio-ffmpeg, "
+                           f"or set IMAGEIO_FFMPEG_EXE; or write a .gif)")
     world = np.asarray(positions, dtype=np.float64)
     ground_path = np.stack([path_xz[:, 0], np.zeros(len(path_xz)), path_xz[:, 1]], axis=-1)
     root = world[:, JOINT_INDEX["Hips"]].copy()
@@ -78,15 +96,20 @@ def save_walk_animation(positions: np.ndarray, fps: float, path_xz: np.ndarray, 
     total = int(np.ceil((frames - 1) / fps * display_fps)) + 1
     out.parent.mkdir(parents=True, exist_ok=True)
     tmp = out.with_name(f".{out.stem}.tmp{out.suffix}")
-    writer = PillowWriter(fps=display_fps) if suffix == ".gif" else FFMpegWriter(fps=display_fps)
-    with writer.saving(fig, str(tmp), dpi):
-        for k in range(total):
-            index = k * fps / display_fps
-            stick.set_pose(pose_at(scene, frames, index))
-            upto = min(int(index) + 1, frames)
-            track.set_data(root_page[:upto, 0], root_page[:upto, 1])
-            shown = keys[keys < upto]
-            dots.set_data(root_page[shown, 0], root_page[shown, 1])
-            writer.grab_frame()
+    writer = PillowWriter(fps=display_fps) if suffix == ".gif" else FFMpegWriter(fps=display_fps, codec="h264")
+    ffmpeg = {"animation.ffmpeg_path": ffmpeg_executable()} if suffix == ".mp4" else {}
+    try:
+        with rc_context(ffmpeg), writer.saving(fig, str(tmp), dpi):
+            for k in range(total):
+                index = k * fps / display_fps
+                stick.set_pose(pose_at(scene, frames, index))
+                upto = min(int(index) + 1, frames)
+                track.set_data(root_page[:upto, 0], root_page[:upto, 1])
+                shown = keys[keys < upto]
+                dots.set_data(root_page[shown, 0], root_page[shown, 1])
+                writer.grab_frame()
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
     tmp.replace(out)
     return out
