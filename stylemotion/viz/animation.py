@@ -11,13 +11,15 @@ ground are drawn faintly, so the spread of step lengths and turning shows.
   has finished holds its last pose; written with matplotlib's ``PillowWriter``.
 * :func:`save_last_frames`: a PNG of the same line-up at each sample's last frame, plus a small
   side view of every last pose labelled with its duration.
-* :class:`SampleAnimation`: a Lightning callback that writes both for a trained VAE/CVAE.
+* :func:`save_samples_npz`: the samples' positions, which ``stylemotion-view`` shows in the browser.
+* :class:`SampleAnimation`: a Lightning callback that writes all three for a trained VAE/CVAE.
 
 Files are written atomically (temporary name, then rename). No pyplot: a notebook's backend is left alone.
 """
 
 from __future__ import annotations
 
+import io
 import logging
 from pathlib import Path
 
@@ -28,8 +30,9 @@ from matplotlib.animation import PillowWriter
 from matplotlib.figure import Figure
 
 from stylemotion.geometry import rotate_yaw
+from stylemotion.io.atomic import atomic_write_bytes
 from stylemotion.sampling import MotionSamples
-from stylemotion.skeleton import JOINT_INDEX
+from stylemotion.skeleton import CANONICAL_JOINTS, JOINT_INDEX
 from stylemotion.viz.stick import TRUNK_COLOR, StickFigure, draw_pose, project
 
 log = logging.getLogger(__name__)
@@ -190,12 +193,27 @@ def save_last_frames(samples: MotionSamples, path: str | Path, count: int = 16, 
     return _save(fig, path, dpi=90)
 
 
+def save_samples_npz(samples: MotionSamples, path: str | Path, count: int = 16) -> Path:
+    """The first ``count`` samples as an NPZ that ``stylemotion-view`` shows: ``positions`` ``(n, frames, 21, 3)``
+    float32 metres (zero after each sample's end), ``num_frames`` ``(n,)``, ``fps``, ``joint_names``."""
+    path = Path(path)
+    count = min(count, len(samples))
+    buffer = io.BytesIO()
+    np.savez(buffer, positions=samples.positions[:count].numpy().astype(np.float32),
+             num_frames=samples.num_frames[:count].numpy().astype(np.int64), fps=np.float64(samples.fps),
+             joint_names=np.array(CANONICAL_JOINTS))
+    atomic_write_bytes(path, buffer.getvalue())
+    return path
+
+
 def render_samples(samples: MotionSamples, folder: str | Path, stem: str = "samples", title: str = "",
                    count: int = 16) -> tuple[Path, Path]:
-    """Write ``<stem>.gif`` and ``<stem>_last_frames.png`` into ``folder``; returns both paths."""
+    """Write ``<stem>.gif``, ``<stem>_last_frames.png`` and ``<stem>.npz`` (for ``stylemotion-view``) into
+    ``folder``; returns the GIF's and the PNG's paths."""
     folder = Path(folder)
     gif = save_gif(samples, folder / f"{stem}.gif", count=count, title=title)
     png = save_last_frames(samples, folder / f"{stem}_last_frames.png", count=count, title=title)
+    save_samples_npz(samples, folder / f"{stem}.npz", count=count)
     return gif, png
 
 
