@@ -12,6 +12,8 @@ checkpoint or a folder holding another run's results ends in one line naming the
 
 from __future__ import annotations
 
+import importlib
+
 import hydra
 from omegaconf import DictConfig
 
@@ -23,6 +25,9 @@ from stylemotion.training import CheckpointNotFoundError, objective, run
 
 def _main(cfg: DictConfig) -> float | None:
     with reported("stylemotion-train", ConfigError, OutputExistsError, CheckpointNotFoundError):
+        if cfg.get("runner"):  # a model family fitted without Lightning (e.g. experiment=morphable_graph)
+            runner = importlib.import_module(str(cfg.runner))
+            return runner.objective(runner.run(cfg)["metrics"])
         result = run(cfg)
     return objective(result["metrics"], cfg)
 

@@ -39,6 +39,7 @@ from typing import Any
 import numpy as np
 from omegaconf import DictConfig, OmegaConf
 
+from stylemotion.config import ConfigError
 from stylemotion.datasets.loading import ConversionSettings, load_canonical_positions
 from stylemotion.evaluation.sources import NEUTRAL
 from stylemotion.export import write_motion_bvh
@@ -118,8 +119,19 @@ def generate(cfg: DictConfig | Mapping[str, Any], command: str = "") -> dict[str
     out = check_new_output(cfg["out"], force)
     started = time.perf_counter()
     path = path_from_config(cfg.get("path") or {})
-    graph = load_graph(str(cfg["style"]), run=cfg.get("run"), models=cfg.get("models"),
-                       action=str(cfg.get("action", "walk")), neutral_style=str(cfg.get("neutral_style", "normal")))
+    kind = str((cfg.get("model") or {}).get("family", "?"))  # model=morphable; none: the VAEs
+    kind = "vae" if not cfg.get("model") else kind
+    if kind == "morphable":
+        from stylemotion.morphable.synthesis import MapSettings, load_morphable_graph
+
+        graph = load_morphable_graph(cfg.get("models") or {}, action=str(cfg.get("action", "walk")),
+                                     settings=MapSettings(**(cfg.get("morphable") or {})))
+    elif kind == "vae":
+        graph = load_graph(str(cfg["style"]), run=cfg.get("run"), models=cfg.get("models"),
+                           action=str(cfg.get("action", "walk")), neutral_style=str(cfg.get("neutral_style", "normal")))
+    else:
+        raise ConfigError("stylemotion-generate takes model=morphable (the Morphable Graph) or no model= (the VAEs); "
+                          f"the chosen model config has family {kind!r}")
     settings = FollowSettings(**(cfg.get("follow") or {}))
     motion = follow_path(graph, path, seed=int(cfg.get("seed", 0)), settings=settings)
     raw_skating, _ = skating(motion.positions, motion.fps)
@@ -128,13 +140,14 @@ def generate(cfg: DictConfig | Mapping[str, Any], command: str = "") -> dict[str
     summary = walk_figures(motion)
     summary["foot_skating_ratio_before_cleanup"] = raw_skating
     style = graph.style if graph.style != NEUTRAL else str(cfg.get("neutral_style", "normal"))
-    summary["real_foot_skating_ratio"] = real_foot_skating(cfg.get("run"), graph.style)
+    summary["real_foot_skating_ratio"] = real_foot_skating(cfg.get("run") if kind == "vae" else None, graph.style)
     title = (f"{graph.action} · {graph.style} · seed {cfg.get('seed', 0)} · {path.length:.1f} m path · "
              f"{summary['duration_s']:.1f} s")
     with atomic_folder(out, on_exists=lambda: check_new_output(out, force)) as tmp:
         summary.update(write_outputs(motion, tmp, cfg.get("outputs") or {}, title))
         summary["meta"] = {
             "style": graph.style, "data_style": style, "seed": int(cfg.get("seed", 0)), "models": graph.sources,
+            "model": kind,
             "profiles": {k: asdict(v) for k, v in graph.profiles.items()}, "follow": asdict(settings),
             "path": cfg.get("path"), **provenance(command or None), "seconds": time.perf_counter() - started,
         }

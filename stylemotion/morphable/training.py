@@ -1,0 +1,91 @@
+"""``stylemotion-train experiment=morphable_graph``: fit one Morphable Graph primitive into a run folder.
+
+The run folder (``runs/train/morphable_graph/<run id>/``, or each sweep job's) receives
+``config_resolved.yaml``, ``run.json`` (version, commit, command), ``model.npz`` (the model and its
+space-partitioning tree, :meth:`~stylemotion.morphable.model.MorphableModel.save`), ``metrics.json``
+(the fit record, held-out reconstruction error, seconds) and ``samples/samples.gif`` +
+``samples/last_frames.png`` (16 samples, as the VAE runs show them). A folder that already holds a
+``model.npz`` is refused unless ``force=true``. Clips come from the ``clips`` DataModule (the take-based
+split of ``data``), the primitive and style from ``primitive`` and ``style``.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from hydra.utils import instantiate
+from omegaconf import DictConfig, OmegaConf
+
+from stylemotion.config import set_torch_threads
+from stylemotion.io.atomic import atomic_write_bytes
+from stylemotion.io.outputs import OutputExistsError
+from stylemotion.morphable.model import FitSettings, MorphableModel, fit_primitive, reconstruction_error
+from stylemotion.primitives import parse_primitive
+from stylemotion.training import _record_start
+
+log = logging.getLogger(__name__)
+
+MODEL_FILE = "model.npz"
+
+
+def run(cfg: DictConfig) -> dict[str, Any]:
+    """Fit, save and measure one primitive as ``cfg`` says; returns ``{"model", "metrics"}``."""
+    output_dir = Path(cfg.output_dir)
+    model_path = output_dir / MODEL_FILE
+    if model_path.exists() and not cfg.get("force", False):
+        raise OutputExistsError(f"{output_dir} already holds a morphable model ({MODEL_FILE}); pass force=true to "
+                                "replace it or choose another folder (hydra.run.dir=…)")
+    set_torch_threads(cfg.get("threads"))
+    began = time.perf_counter()
+    action, primitive = parse_primitive(str(cfg.primitive))
+    _record_start(output_dir, cfg, None)
+    atomic_write_bytes(output_dir / "config_resolved.yaml", OmegaConf.to_yaml(cfg, resolve=True).encode())
+    styles = None if cfg.get("style") in (None, "all") else [str(cfg.style)]
+    datamodule = instantiate(cfg.datamodule, data=OmegaConf.to_container(cfg.data, resolve=True), action=action,
+                             primitives=[primitive], styles=styles, _convert_="all")
+    datamodule.setup()
+    model_cfg = OmegaConf.to_container(cfg.model, resolve=True)
+    tree_cfg = model_cfg.pop("tree", None) or {}
+    model_cfg.pop("family", None)
+    settings = FitSettings(**model_cfg)
+    model = fit_primitive(datamodule.clips["train"], settings,
+                          meta={"data": str(cfg.data.get("name")), "seed": int(cfg.seed)})
+    if tree_cfg.get("samples", 0):
+        model.build_tree(int(tree_cfg["samples"]), str(tree_cfg.get("split", "kmeans")), int(cfg.seed),
+                         leaf_size=int(tree_cfg.get("leaf_size", 16)))
+    model.save(model_path)
+    metrics: dict[str, Any] = {"fit": model.meta["fit"], "seconds_fit": time.perf_counter() - began,
+                               "clips": {p: len(c) for p, c in datamodule.clips.items()},
+                               "timeline_frames": model.length, "num_coefficients": model.basis.num_coefficients}
+    for part in ("val", "test"):
+        if datamodule.clips.get(part):
+            metrics[f"{part}/joint_rmse_m"] = reconstruction_error(model, datamodule.clips[part])
+    metrics["model_bytes"] = model_path.stat().st_size
+    if cfg.get("samples", True):
+        _write_samples(model, output_dir / "samples", int(cfg.seed), str(cfg.data.get("name")))
+    metrics["seconds"] = time.perf_counter() - began
+    atomic_write_bytes(output_dir / "metrics.json", json.dumps(metrics, indent=1, default=float).encode())
+    log.info("%s_%s: %s written; training joint RMSE %.4f m, test %.4f m", action, primitive, model_path,
+             model.meta["fit"]["joint_rmse_m"], metrics.get("test/joint_rmse_m", float("nan")))
+    return {"model": model, "metrics": metrics}
+
+
+def _write_samples(model: MorphableModel, folder: Path, seed: int, data_name: str) -> None:
+    from stylemotion.viz.animation import save_gif, save_last_frames
+
+    folder.mkdir(parents=True, exist_ok=True)
+    samples = model.sample(16, seed=seed)
+    title = f"{data_name} {model.meta.get('action')}_{model.meta.get('primitive')} · Morphable Graph · seed {seed}"
+    save_gif(samples, folder / "samples.gif", title=title)
+    save_last_frames(samples, folder / "last_frames.png", title=title)
+
+
+def objective(metrics: dict[str, Any]) -> float | None:
+    """What a sweep minimizes: the held-out joint RMSE (test, else val)."""
+    value = metrics.get("test/joint_rmse_m", metrics.get("val/joint_rmse_m"))
+    return None if value is None or not np.isfinite(value) else float(value)
