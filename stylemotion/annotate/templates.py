@@ -17,6 +17,8 @@ from dataclasses import dataclass
 import numpy as np
 from dtaidistance import dtw_ndim
 
+from stylemotion.morphable.warping import resample
+
 #: Quantization threshold δ of the thesis (entries ≤ δ become 0, ≥ 1 − δ become 1, the rest wildcards).
 DELTA = 0.05
 
@@ -59,22 +61,21 @@ class MotionTemplate:
         return q
 
 
-def _resample(x: np.ndarray, length: int) -> np.ndarray:
+def resample_length(x: np.ndarray, length: int) -> np.ndarray:
     """Linear resampling of ``(frames, d)`` to ``(length, d)``."""
-    src = np.linspace(0.0, x.shape[0] - 1.0, length)
-    return np.stack([np.interp(src, np.arange(x.shape[0]), col) for col in x.T], axis=1)
+    return resample(x, np.linspace(0.0, x.shape[0] - 1.0, length))
 
 
 def warp_to(reference: np.ndarray, example: np.ndarray) -> np.ndarray:
-    """``example`` ``(n, d)`` warped onto the timeline of ``reference`` ``(m, d)`` by DTW: frame ``i`` of the
-    result is the mean of the example frames aligned to reference frame ``i``. Returns ``(m, d)`` float64."""
-    path = np.asarray(dtw_ndim.warping_path(np.ascontiguousarray(reference, dtype=np.float64),
-                                            np.ascontiguousarray(example, dtype=np.float64), use_c=True))
+    """``example`` ``(n, d)`` warped onto the timeline of ``reference`` ``(m, d)`` by DTW (dtaidistance's C
+    implementation): frame ``i`` of the result is the mean of the example frames aligned to reference frame
+    ``i`` (for boolean features: the fraction that is on). Returns ``(m, d)`` float64."""
+    reference = np.ascontiguousarray(reference, dtype=np.float64)
+    example = np.ascontiguousarray(example, dtype=np.float64)
+    path = np.asarray(dtw_ndim.warping_path(reference, example, use_c=True))
     sums = np.zeros((reference.shape[0], example.shape[1]))
-    counts = np.zeros(reference.shape[0])
     np.add.at(sums, path[:, 0], example[path[:, 1]])
-    np.add.at(counts, path[:, 0], 1.0)
-    return sums / counts[:, None]
+    return sums / np.bincount(path[:, 0], minlength=reference.shape[0])[:, None]
 
 
 def learn_template(label: str, examples: Sequence[np.ndarray], iterations: int = 4,
@@ -98,7 +99,7 @@ def learn_template(label: str, examples: Sequence[np.ndarray], iterations: int =
                                  f"count, got shapes {[x.shape for x in xs][:5]}")
     length = int(round(np.mean([x.shape[0] for x in xs])))
     start = int(np.argmin([abs(x.shape[0] - length) for x in xs]))
-    template = _resample(xs[start], length)
+    template = resample_length(xs[start], length)
     for _ in range(iterations):
         template = np.mean([warp_to(template, x) for x in xs], axis=0)
     return MotionTemplate(label, np.clip(template, 0.0, 1.0), len(xs), delta)

@@ -31,7 +31,7 @@ import tensorly as tl
 from scipy.optimize import lsq_linear
 from tensorly.tenalg import mode_dot, multi_mode_dot
 
-from stylemotion.annotate.templates import _resample, warp_to
+from stylemotion.annotate.templates import resample_length, warp_to
 from stylemotion.representation import positions_to_frames
 from stylemotion.skeleton import NUM_JOINTS
 
@@ -172,7 +172,7 @@ def build_tensor(label: str, examples: Mapping[str, Sequence[np.ndarray]], fps: 
     coords = {s: [pose_coordinates(m, fps) for m in examples[s][:r]] for s in styles}
     every = [c for s in styles for c in coords[s]]
     length = int(round(np.mean([c.shape[0] for c in every])))
-    reference = _resample(every[int(np.argmin([abs(c.shape[0] - length) for c in every]))], length)
+    reference = resample_length(every[int(np.argmin([abs(c.shape[0] - length) for c in every]))], length)
     theta = np.stack([np.stack([warp_to(reference, c).T for c in coords[s]], axis=-1) for s in styles], axis=2)
     core, factors = n_mode_svd(theta)
     return MotionTensor(label, styles, r, reference, core, factors, fps), theta

@@ -1,0 +1,178 @@
+"""``stylemotion-annotate``: learn class motion templates and tensors, or annotate a document with them.
+
+Learning (no ``document=``): the dataset's train takes (its ``split``), ``per_class`` of each content for the
+templates and up to ``repetitions`` per style for the tensors; ``out`` becomes a templates folder
+(:mod:`stylemotion.annotate.model`).
+
+Annotating (``document=<BVH>``, ``templates=<folder>``): the BVH is converted as datasets are (any skeleton a
+joint map fits) at the model's fps and annotated (:mod:`stylemotion.annotate.annotation`); ``out`` gets
+
+* ``labels.csv``: one row per frame, columns exactly ``frame,label`` (the class, empty where none);
+* ``segments.json``: the settings, and each labelled run ``{label, start, end, cost}`` (frames, ``end``
+  exclusive; ``cost`` the smallest ``Δ`` over it) with ``style``/``style_weights`` where the class has a tensor;
+* ``timeline.png``: the class and sub-class segments over time (Fig. 3.1).
+
+Outputs are written atomically into a new folder; an existing one is refused unless ``force``.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import time
+from collections.abc import Callable, Mapping
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from omegaconf import DictConfig, OmegaConf
+
+from stylemotion.annotate.annotation import AnnotationSettings, AnnotationInputError, annotate_features, segments
+from stylemotion.annotate.features import relational_features
+from stylemotion.annotate.model import AnnotationModel, ModelFolderError, learn_model, load_model, save_model
+from stylemotion.annotate.templates import TemplateInputError
+from stylemotion.config import ConfigError, positive_int
+from stylemotion.datasets import build_dataset
+from stylemotion.datasets.loading import ConversionSettings
+from stylemotion.io.atomic import atomic_folder, atomic_write_bytes
+from stylemotion.io.outputs import check_new_output, inside
+from stylemotion.provenance import provenance
+from stylemotion.style_example.example import StyleExampleError, convert_example, parse_example
+
+Say = Callable[[str], None]
+
+
+class AnnotateInputError(ValueError):
+    """A ``stylemotion-annotate`` input that cannot be used; the message names the key and the value."""
+
+
+def learn(data: Mapping[str, Any], out: str | os.PathLike, *, per_class: int = 9, seed: int = 0,
+          repetitions: int | None = 5, tensors: bool = True, force: bool = False, say: Say = print,
+          command: str = "") -> AnnotationModel:
+    """Learn templates (and tensors) from ``data``'s train split and write the folder ``out``."""
+    out = check_new_output(out, force)
+    per_class = positive_int(per_class, "per_class")
+    if repetitions is not None:
+        repetitions = positive_int(repetitions, "repetitions")
+    try:
+        takeset = build_dataset(data)
+    except (KeyError, ValueError) as exc:
+        message = exc.args[0] if isinstance(exc, KeyError) and exc.args else exc
+        raise AnnotateInputError(f"data={data.get('name')}: {message}") from None
+    split = dict(data.get("split") or {})
+    train = takeset.split(int(split.get("seed", 0)), float(split.get("val_fraction", 0.1)),
+                          float(split.get("test_fraction", 0.1)))["train"]
+    started = time.perf_counter()
+    try:
+        model = learn_model(train, takeset.fps, per_class, seed, repetitions, tensors)
+    except TemplateInputError as exc:
+        raise AnnotateInputError(f"data={data.get('name')}: {exc}") from None
+    extra = {"data": {k: v for k, v in data.items() if k in ("name", "root", "contents", "styles", "split")},
+             "learn_s": round(time.perf_counter() - started, 3), "provenance": provenance(command or None)}
+    with atomic_folder(out, on_exists=lambda: check_new_output(out, force)) as tmp:
+        save_model(model, tmp, extra)
+    say(f"{len(model.templates)} templates ({', '.join(model.classes)}) and {len(model.tensors)} tensors from "
+        f"{takeset.name}'s train takes written to {out}")
+    for label, reason in model.record["tensors_skipped"].items():
+        say(f"no tensor for {label}: {reason}")
+    return model
+
+
+def load_document(document: str, fps: float, conversion: Mapping[str, Any] | None = None) -> tuple[np.ndarray,
+                                                                                                     dict[str, Any]]:
+    """``(frames, 21, 3)`` positions of ``document=`` at ``fps`` and a JSON-ready record of the file."""
+    try:
+        spec = parse_example(document, key="document")
+        if "::" not in spec.path and not Path(spec.path).expanduser().is_file():
+            raise AnnotateInputError(f"document={document}: no such file")
+        settings = ConversionSettings(fps=fps, **{k: v for k, v in (conversion or {}).items() if v is not None})
+        example = convert_example(spec, settings)
+    except StyleExampleError as exc:
+        raise AnnotateInputError(str(exc)) from None
+    record = {"file": example.name, "sha256": example.sha256, "file_fps": example.file_fps,
+              "file_frames": example.file_frames, "file_range": [example.start, example.end],
+              "frames": int(example.positions.shape[0]), "fps": fps}
+    return np.asarray(example.positions, dtype=np.float32), record
+
+
+def annotate_positions(positions: np.ndarray, model: AnnotationModel,
+                       settings: AnnotationSettings = AnnotationSettings()) -> tuple[list[str], list[dict[str, Any]]]:
+    """Frame labels (``""`` where none) and segment records (with sub-class fits where a tensor exists)."""
+    annotation = annotate_features(relational_features(positions, model.fps), model.templates, settings)
+    labels = annotation.label_names()
+    records = []
+    for start, end, label in segments(labels):
+        record: dict[str, Any] = {"label": label, "start": start, "end": end,
+                                  "cost": round(float(np.min(annotation.distance[start:end])), 5)}
+        tensor = model.tensors.get(label)
+        if tensor is not None and end - start >= 2:
+            fit = tensor.parametrize(positions[start:end])
+            record.update(style=fit.style, style_weights=dict(zip(tensor.styles, np.round(fit.style_weights, 4)
+                                                                  .tolist())), fit_rms_m=round(fit.rms, 5))
+        records.append(record)
+    return labels, records
+
+
+def annotate(document: str, templates: str | os.PathLike, out: str | os.PathLike, *,
+             settings: AnnotationSettings = AnnotationSettings(), conversion: Mapping[str, Any] | None = None,
+             force: bool = False, say: Say = print, command: str = "") -> dict[str, Any]:
+    """Annotate ``document`` with the model in ``templates`` and write the folder ``out`` (module docstring)."""
+    started = time.perf_counter()
+    out = check_new_output(out, force)
+    if not (isinstance(settings.tau, (int, float)) and settings.tau > 0):
+        raise AnnotateInputError(f"tau={settings.tau} must be a positive number (the thesis used 0.13)")
+    try:
+        model = load_model(templates)
+    except ModelFolderError as exc:
+        raise AnnotateInputError(str(exc)) from None
+    positions, record = load_document(document, model.fps, conversion)
+    shortest = min(model.templates, key=lambda t: t.num_frames)
+    if positions.shape[0] < shortest.num_frames:
+        raise AnnotateInputError(f"document={document}: {positions.shape[0]} frames at {model.fps:g} fps is shorter "
+                                 f"than every template (the shortest, {shortest.label!r}, has {shortest.num_frames})")
+    try:
+        labels, records = annotate_positions(positions, model, settings)
+    except AnnotationInputError as exc:
+        raise AnnotateInputError(f"document={document}: {exc}") from None
+    report = {"document": {"value": str(document), **record}, "templates": str(templates),
+              "classes": list(model.classes), "tensors": sorted(model.tensors),
+              "settings": {"tau": settings.tau, "keyframes": settings.keyframes,
+                           "keyframe_count": settings.keyframe_count,
+                           "keyframe_tolerance": settings.keyframe_tolerance},
+              "labelled_fraction": round(float(np.mean([lab != "" for lab in labels])), 4),
+              "segments": records, "provenance": provenance(command or None)}
+    with atomic_folder(out, on_exists=lambda: check_new_output(out, force)) as tmp:
+        rows = "".join(f"{i},{lab}\n" for i, lab in enumerate(labels))
+        atomic_write_bytes(inside(tmp, "labels.csv"), ("frame,label\n" + rows).encode())
+        from stylemotion.annotate.figures import plot_timeline
+
+        plot_timeline(records, list(model.classes), len(labels), model.fps, inside(tmp, "timeline.png"),
+                      f"{record['file']}: tau={settings.tau}, key frames {'on' if settings.keyframes else 'off'}")
+        report["timing_s"] = round(time.perf_counter() - started, 3)
+        atomic_write_bytes(inside(tmp, "segments.json"), (json.dumps(report, indent=1) + "\n").encode())
+    say(f"{len(records)} segment(s), {report['labelled_fraction']:.0%} of {len(labels)} frames labelled; "
+        f"written to {out}")
+    return report
+
+
+def annotate_from_config(cfg: DictConfig, say: Say = print, command: str = "") -> Any:
+    """:func:`learn` (no ``document``) or :func:`annotate` with the keys of ``stylemotion/configs/annotate.yaml``."""
+    plain = OmegaConf.to_container(cfg, resolve=True)
+    if not isinstance(plain, dict):
+        raise ConfigError("the annotate config must be a mapping")
+    force = bool(plain.get("force", False))
+    if not plain.get("document"):
+        return learn(plain["data"], plain["out"], per_class=plain.get("per_class", 9), seed=plain.get("seed", 0),
+                     repetitions=plain.get("repetitions", 5), tensors=bool(plain.get("tensors", True)), force=force,
+                     say=say, command=command)
+    if not plain.get("templates"):
+        raise AnnotateInputError("document= needs templates=<folder> (learn one with stylemotion-annotate "
+                                 "data=<dataset> out=<folder>)")
+    keyframes = plain.get("keyframes") or {}
+    settings = AnnotationSettings(tau=plain.get("tau", AnnotationSettings.tau),
+                                  keyframes=bool(keyframes.get("use", True)),
+                                  keyframe_count=positive_int(keyframes.get("count", 3), "keyframes.count"),
+                                  keyframe_tolerance=float(keyframes.get("tolerance", 0.0)))
+    return annotate(str(plain["document"]), plain["templates"], plain["out"], settings=settings,
+                    conversion={key: plain.get(key) for key in ("joint_map", "unit_scale", "up_axis")},
+                    force=force, say=say, command=command)

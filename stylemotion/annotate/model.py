@@ -1,0 +1,151 @@
+"""Learning an annotation model from a labelled dataset, and its folder on disk.
+
+A model is the class motion templates (one per content label) plus, where a class has at least two styles of
+two or more train takes, its class motion tensor. The folder holds ``model.json`` (classes, feature names,
+fps, settings, the takes used, provenance), ``templates.npz`` (``<class>``: ``(frames, features)`` values) and
+``tensors.npz`` (``<class>/core``, ``<class>/U1..U4``, ``<class>/reference``; styles in ``model.json``).
+"""
+
+from __future__ import annotations
+
+import io
+import json
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from stylemotion.annotate.features import FEATURE_NAMES, relational_features
+from stylemotion.annotate.tensors import MotionTensor, TensorInputError, build_tensor
+from stylemotion.annotate.templates import DELTA, MotionTemplate, TemplateInputError, learn_template
+from stylemotion.datasets.base import Take
+from stylemotion.io.atomic import atomic_write_bytes
+from stylemotion.io.outputs import inside
+
+MODEL_FORMAT = 1
+
+
+class ModelFolderError(ValueError):
+    """A templates folder that cannot be read; the message names the file and what is wrong."""
+
+
+@dataclass
+class AnnotationModel:
+    """Templates and tensors of a set of classes at ``fps``; ``record``: what ``model.json`` says besides."""
+
+    templates: list[MotionTemplate]
+    tensors: dict[str, MotionTensor]
+    fps: float
+    record: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def classes(self) -> tuple[str, ...]:
+        return tuple(t.label for t in self.templates)
+
+
+def choose_examples(takes: Sequence[Take], per_class: int, seed: int) -> dict[str, list[Take]]:
+    """Up to ``per_class`` takes of every content, drawn with ``seed`` (sorted by name first)."""
+    rng = np.random.default_rng(seed)
+    by: dict[str, list[Take]] = {}
+    for take in sorted(takes, key=lambda t: t.name):
+        by.setdefault(take.content, []).append(take)
+    chosen = {}
+    for content in sorted(by):
+        group = by[content]
+        order = rng.permutation(len(group))[:per_class]
+        chosen[content] = [group[i] for i in sorted(order)]
+    return chosen
+
+
+def learn_model(train: Sequence[Take], fps: float, per_class: int = 9, seed: int = 0,
+                tensor_repetitions: int | None = 5, tensors: bool = True) -> AnnotationModel:
+    """Templates from ``per_class`` train takes of each content; tensors from all train takes of a content
+    (``tensor_repetitions`` per style; classes whose styles are too few are left without a tensor).
+
+    Raises:
+        TemplateInputError: a content with fewer than two train takes (naming it and the count).
+    """
+    examples = choose_examples(train, per_class, seed)
+    if not examples:
+        raise TemplateInputError("no train takes to learn templates from")
+    templates = [learn_template(c, [relational_features(t.positions, fps) for t in takes])
+                 for c, takes in examples.items()]
+    learned: dict[str, MotionTensor] = {}
+    skipped: dict[str, str] = {}
+    if tensors:
+        for content in examples:
+            by_style: dict[str, list[np.ndarray]] = {}
+            for take in sorted(train, key=lambda t: t.name):
+                if take.content == content:
+                    by_style.setdefault(take.style, []).append(take.positions)
+            usable = {s: v for s, v in by_style.items() if len(v) >= max(2, tensor_repetitions or 2)}
+            try:
+                learned[content] = build_tensor(content, usable, fps, tensor_repetitions)[0]
+            except TensorInputError as exc:
+                skipped[content] = str(exc)
+    record = {"examples": {c: [t.name for t in takes] for c, takes in examples.items()},
+              "tensor_repetitions": tensor_repetitions, "tensors_skipped": skipped, "seed": seed}
+    return AnnotationModel(templates, learned, fps, record)
+
+
+def _npz(arrays: dict[str, np.ndarray]) -> bytes:
+    buffer = io.BytesIO()
+    np.savez_compressed(buffer, **arrays)
+    return buffer.getvalue()
+
+
+def save_model(model: AnnotationModel, folder: Path, extra: dict[str, Any] | None = None) -> None:
+    """Write the three files into ``folder`` (an existing, empty staging folder)."""
+    templates = {t.label: t.values for t in model.templates}
+    tensors: dict[str, np.ndarray] = {}
+    for label, tensor in model.tensors.items():
+        tensors[f"{label}/core"] = tensor.core
+        tensors[f"{label}/reference"] = tensor.reference
+        for n, f in enumerate(tensor.factors, 1):
+            tensors[f"{label}/U{n}"] = f
+    meta = {
+        "format": MODEL_FORMAT, "fps": model.fps, "features": list(FEATURE_NAMES), "delta": DELTA,
+        "classes": [{"label": t.label, "frames": t.num_frames, "examples": t.examples} for t in model.templates],
+        "tensors": {label: {"styles": list(t.styles), "repetitions": t.repetitions, "ranks": list(t.ranks),
+                            "frames": t.frames} for label, t in model.tensors.items()},
+        **model.record, **(extra or {}),
+    }
+    atomic_write_bytes(inside(folder, "templates.npz"), _npz(templates))
+    atomic_write_bytes(inside(folder, "tensors.npz"), _npz(tensors))
+    atomic_write_bytes(inside(folder, "model.json"), (json.dumps(meta, indent=1) + "\n").encode())
+
+
+def load_model(folder: str | Path) -> AnnotationModel:
+    """Read a folder written by :func:`save_model`.
+
+    Raises:
+        ModelFolderError: a missing file, another format or feature set, a class without its arrays.
+    """
+    folder = Path(folder).expanduser()
+    meta_path = folder / "model.json"
+    if not meta_path.is_file():
+        raise ModelFolderError(f"templates={folder}: no model.json there (learn one with "
+                               f"stylemotion-annotate data=<dataset> out={folder})")
+    try:
+        meta = json.loads(meta_path.read_text())
+    except (OSError, json.JSONDecodeError) as exc:
+        raise ModelFolderError(f"{meta_path}: not readable JSON ({exc})") from None
+    if meta.get("format") != MODEL_FORMAT or meta.get("features") != list(FEATURE_NAMES):
+        raise ModelFolderError(f"{meta_path}: format {meta.get('format')!r} with {len(meta.get('features') or [])} "
+                               f"features; this version reads format {MODEL_FORMAT} with {len(FEATURE_NAMES)}")
+    try:
+        with np.load(folder / "templates.npz") as npz:
+            templates = [MotionTemplate(c["label"], np.array(npz[c["label"]]), int(c["examples"]),
+                                        float(meta["delta"])) for c in meta["classes"]]
+        tensors = {}
+        with np.load(folder / "tensors.npz") as npz:
+            for label, info in meta.get("tensors", {}).items():
+                tensors[label] = MotionTensor(label, tuple(info["styles"]), int(info["repetitions"]),
+                                              np.array(npz[f"{label}/reference"]), np.array(npz[f"{label}/core"]),
+                                              tuple(np.array(npz[f"{label}/U{n}"]) for n in range(1, 5)),
+                                              float(meta["fps"]))
+    except (OSError, KeyError, ValueError) as exc:
+        raise ModelFolderError(f"templates={folder}: its arrays do not match model.json ({exc})") from None
+    return AnnotationModel(templates, tensors, float(meta["fps"]), meta)
