@@ -28,6 +28,7 @@ def test_a_take_of_the_synthetic_default_left_out_of_the_database(tmp_path):
         assert npz["positions"].shape == (240, 21, 3) and float(npz["fps"]) == 30.0
         assert list(npz["joint_names"]) == list(CANONICAL_JOINTS)
     assert (tmp_path / "out" / "motion.bvh").read_text().startswith("HIERARCHY")
+    assert (tmp_path / "out" / "motion.gif").read_bytes()[:6] == b"GIF89a"
     written = json.loads((tmp_path / "out" / "summary.json").read_text())
     assert written["markers"]["excluded_take"] == TAKE and written["database"]["takes"] == 27
     assert written["error"]["mean_cm"] < written["error_nearest_neighbour"]["mean_cm"]
@@ -67,7 +68,7 @@ def test_bad_values_are_named_and_nothing_is_written(tmp_path):
 def test_the_console_command_runs_and_refuses_in_one_line(tmp_path):
     env = {**os.environ, "HYDRA_FULL_ERROR": "0", "PYTHONWARNINGS": "ignore"}
     root = Path(__file__).resolve().parents[2]
-    run = [sys.executable, "-m", "stylemotion.cli.reconstruct", f"markers={TAKE}", "data.takes_per_pair=1"]
+    run = [sys.executable, "-m", "stylemotion.cli.reconstruct", f"markers={TAKE}", "data.takes_per_pair=1", "gif=false"]
     done = subprocess.run(run + [f"out={tmp_path / 'o'}", "k=16"], cwd=root, env=env, capture_output=True,
                           text=True, timeout=120)
     assert done.returncode == 0, done.stderr
