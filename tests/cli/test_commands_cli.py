@@ -31,6 +31,7 @@ COMMANDS = {  # module → (console script, a phrase of its description, a key o
                     "markers=<BVH[:start-end]|NPZ|CSV|take>"),
     "texture": ("stylemotion-texture", "complete or texture a motion with a motion database",
                 "motion=<BVH[:start-end]|NPZ|take>"),
+    "keyframes": ("stylemotion-keyframes", "a motion through a few keyframes", "keys=<keys.json>"),
 }
 
 
