@@ -1,6 +1,7 @@
 """The report folder of an evaluation: ``report.md``, ``report.json``, one CSV per table, PNG figures.
 
-The layout of ``report.json`` (Table 5.1 under ``table_5_1.<primitive>``, Tables 5.2/5.3 under
+``report.html`` is the same report as a web page with the figures and samples in the viewer. The layout of
+``report.json`` (Table 5.1 under ``table_5_1.<primitive>``, Tables 5.2/5.3 under
 ``variance``/``variance_ratio``, the extra metrics, ``meta`` with provenance, ``definitions`` of
 every number) is specified in ``docs/report.md``. The folder is built beside its final place and
 renamed into it, so a report is never half written; an existing folder is refused unless
@@ -14,6 +15,7 @@ import io
 import json
 import math
 import os
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
@@ -27,9 +29,12 @@ from stylemotion.io.atomic import atomic_folder
 from stylemotion.io.outputs import check_new_output, inside
 
 
-def write_report(results: dict[str, Any], out: str | os.PathLike, force: bool = False) -> Path:
+def write_report(results: dict[str, Any], out: str | os.PathLike, force: bool = False,
+                 samples: Mapping[str, Any] | None = None) -> Path:
     """Write the report folder of ``results`` (from :func:`stylemotion.evaluation.pipeline.evaluate_models`
-    plus ``meta``) atomically; returns its path."""
+    plus ``meta``) atomically; returns its path. ``report.html`` (:mod:`stylemotion.viewer.report`) shows the
+    tables, the figures and, when ``samples`` maps ``<primitive> <model>`` to its MotionSamples, a few of
+    them in the viewer."""
     out = check_new_output(out, force)
     results = {**results, "definitions": DEFINITIONS}
     # checked again at swap time: the folder may have appeared meanwhile
@@ -37,7 +42,11 @@ def write_report(results: dict[str, Any], out: str | os.PathLike, force: bool = 
         figures = write_figures(results, tmp)
         tables = write_csvs(results, tmp)
         (tmp / "report.json").write_text(json.dumps(_plain(results), indent=1, allow_nan=False))
-        (tmp / "report.md").write_text(format_markdown(results, figures, tables))
+        text = format_markdown(results, figures, tables)
+        (tmp / "report.md").write_text(text)
+        from stylemotion.viewer.report import write_report_html  # the viewer imports this package's markdown
+
+        write_report_html(tmp, text, figures, samples)
     return out
 
 

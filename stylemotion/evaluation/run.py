@@ -33,6 +33,7 @@ from stylemotion.io.outputs import check_new_output
 from stylemotion.models.autoencoder import IncompatibleModelError, MotionAutoencoder
 from stylemotion.models.checkpoints import autoencoder_info, find_checkpoints, load_autoencoder
 from stylemotion.provenance import provenance
+from stylemotion.viewer.report import SAMPLES_PER_MODEL
 
 log = logging.getLogger(__name__)
 
@@ -127,7 +128,8 @@ def run_evaluation(data_cfg: Mapping[str, Any], checkpoints: Sequence[str], eval
         "settings": asdict(settings), **provenance(command or None),
         "seconds": time.perf_counter() - started,
     }
-    write_report(results, out, force)
+    viewer = {f"{m.primitive} {m.name}": m.source.sample(SAMPLES_PER_MODEL, seed=settings.seed) for m in models}
+    write_report(results, out, force, samples=viewer)
     return results
 
 

@@ -20,7 +20,8 @@ it exists, unless ``force=true``; the folder appears complete or not at all):
   ``joint_names``;
 * ``motion.bvh``: the canonical skeleton with rotations fitted to the positions
   (:mod:`stylemotion.export`);
-* ``motion.gif`` (and ``motion.mp4`` with ``outputs.mp4=true``, by imageio-ffmpeg's ffmpeg): the stick figure on the path;
+* ``motion.gif`` (and ``motion.mp4`` with ``outputs.mp4=true``, by imageio-ffmpeg's ffmpeg): the stick figure
+  on the path;
 * ``summary.json``: :func:`stylemotion.synthesis.quality.walk_figures`, the BVH round trip error,
   the real data's foot-skating ratio for the style, the steps, the settings and provenance.
 """

@@ -231,7 +231,8 @@
     swatch.className = "swatch";
     swatch.style.background = "#" + m.color.getHexString();
     const label = document.createElement("span");
-    label.textContent = `${m.name} · ${m.group} · ${m.frames} frames @ ${m.fps} fps`;
+    const named = m.name.startsWith(m.group) ? m.name : `${m.name} · ${m.group}`;
+    label.textContent = `${named} · ${m.frames} frames @ ${m.fps} fps`;
     row.append(swatch, label);
     legend.append(row);
   });
