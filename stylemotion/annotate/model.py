@@ -62,7 +62,8 @@ def choose_examples(takes: Sequence[Take], per_class: int, seed: int) -> dict[st
 def learn_model(train: Sequence[Take], fps: float, per_class: int = 9, seed: int = 0,
                 tensor_repetitions: int | None = 5, tensors: bool = True) -> AnnotationModel:
     """Templates from ``per_class`` train takes of each content; tensors from all train takes of a content
-    (``tensor_repetitions`` per style; classes whose styles are too few are left without a tensor).
+    (``tensor_repetitions`` per style, fewer where every style has fewer; styles with under two train takes
+    are left out, and a class with under two such styles gets no tensor).
 
     Raises:
         TemplateInputError: a content with fewer than two train takes (naming it and the count).
@@ -80,9 +81,11 @@ def learn_model(train: Sequence[Take], fps: float, per_class: int = 9, seed: int
             for take in sorted(train, key=lambda t: t.name):
                 if take.content == content:
                     by_style.setdefault(take.style, []).append(take.positions)
-            usable = {s: v for s, v in by_style.items() if len(v) >= max(2, tensor_repetitions or 2)}
+            usable = {s: v for s, v in by_style.items() if len(v) >= 2}
+            counts = [len(v) for v in usable.values()] or [0]
+            r = min(min(counts), tensor_repetitions or min(counts))
             try:
-                learned[content] = build_tensor(content, usable, fps, tensor_repetitions)[0]
+                learned[content] = build_tensor(content, usable, fps, r)[0]
             except TensorInputError as exc:
                 skipped[content] = str(exc)
     record = {"examples": {c: [t.name for t in takes] for c, takes in examples.items()},
