@@ -24,7 +24,7 @@ import time
 
 import numpy as np
 
-from stylemotion.datasets import TakeSet, load_dataset
+from stylemotion.datasets import TakeSet, load_dataset, spread_over_styles
 from stylemotion.geometry import rotate_yaw
 from stylemotion.reconstruct.keyframes import DynamicMotionGraph, Keyframe, NoConnectionError, keys_from_motion
 from stylemotion.search.database import MotionDatabase
@@ -80,7 +80,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--data", choices=("bandai", "synthetic"), default="bandai")
     parser.add_argument("--root", default=None, help="Bandai folder or data.zip (default: $STYLEMOTION_DATA/...)")
     parser.add_argument("--contents", default="walk,walk-turn-left,walk-turn-right,run")
-    parser.add_argument("--takes", type=int, default=4, help="test takes per content")
+    parser.add_argument("--takes", type=int, default=4, help="test takes per content, taken in turn from each style")
     parser.add_argument("--spacings", default="1,2,4", help="seconds between keys (comma-separated)")
     parser.add_argument("--rotate-take", default="", help="take of the rotation experiment (default: first walk)")
     parser.add_argument("--rotate-step", type=float, default=30.0, help="degrees between turned second keys")
@@ -99,7 +99,7 @@ def main(argv: list[str] | None = None) -> int:
     parts = data.split(args.seed, 0.0, 0.15 if args.data == "synthetic" else 0.1, group_by=group)
     train, test = parts["train"], parts["test"]
     contents = [c for c in args.contents.split(",") if c]
-    queries = [t for c in contents for t in [t for t in test if t.content == c][: args.takes]]
+    queries = spread_over_styles(test, contents, args.takes)
     database = MotionDatabase.from_takeset(TakeSet(data.name, train, data.fps))
     t0 = time.perf_counter()
     graph = DynamicMotionGraph(database)

@@ -24,7 +24,7 @@ import time  # noqa: E402
 
 import numpy as np  # noqa: E402
 
-from stylemotion.datasets import TakeSet, load_dataset  # noqa: E402
+from stylemotion.datasets import TakeSet, load_dataset, spread_over_styles  # noqa: E402
 from stylemotion.reconstruct import (  # noqa: E402
     DEFAULT_MARKERS,
     SparseReconstructor,
@@ -56,7 +56,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--features", default="E15,E30,E39,E15x3,pca16")
     parser.add_argument("--databases", default="HDM,CMU-")
     parser.add_argument("--k", type=int, default=64)
-    parser.add_argument("--takes", type=int, default=3, help="test takes per content")
+    parser.add_argument("--takes", type=int, default=3, help="test takes per content, taken in turn from each style")
     parser.add_argument("--frames", type=int, default=0, help="first frames of each query take (0 = all)")
     parser.add_argument("--noise-mm", type=float, default=1.0)
     parser.add_argument("--seed", type=int, default=0)
@@ -73,7 +73,7 @@ def main(argv: list[str] | None = None) -> int:
     if missing:
         known = sorted({t.content for t in test})
         raise SystemExit(f"--contents: no test take of {missing}; the data's contents: {known}")
-    queries = [t for c in contents for t in [t for t in test if t.content == c][: args.takes]]
+    queries = spread_over_styles(test, contents, args.takes)
     emit({"kind": "setup", "data": data.name, "fps": data.fps, "train_takes": len(train), "test_takes": len(test),
           "queries": [q.name for q in queries], "k": args.k, "noise_mm": args.noise_mm, "markers": DEFAULT_MARKERS})
     rng = np.random.default_rng(args.seed)

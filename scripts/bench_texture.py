@@ -21,7 +21,7 @@ import time
 
 import numpy as np
 
-from stylemotion.datasets import TakeSet, load_dataset
+from stylemotion.datasets import TakeSet, load_dataset, spread_over_styles
 from stylemotion.reconstruct.texture import LEG_JOINTS, MotionTexturer, key_spline
 from stylemotion.search.database import MotionDatabase
 from stylemotion.skeleton import CANONICAL_JOINTS, JOINT_INDEX
@@ -44,7 +44,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--data", choices=("bandai", "synthetic"), default="bandai")
     parser.add_argument("--root", default=None, help="Bandai folder or data.zip (default: $STYLEMOTION_DATA/...)")
     parser.add_argument("--contents", default="walk,run,wave-both-hands,raise-up-both-hands")
-    parser.add_argument("--takes", type=int, default=3, help="test takes per content")
+    parser.add_argument("--takes", type=int, default=3, help="test takes per content, taken in turn from each style")
     parser.add_argument("--frames", type=int, default=0, help="first frames of each query take (0 = all)")
     parser.add_argument("--every", default="3,6,10", help="texturing: frames between keys (comma-separated)")
     parser.add_argument("--seed", type=int, default=0)
@@ -66,7 +66,7 @@ def main(argv: list[str] | None = None) -> int:
     if missing:
         known = sorted({t.content for t in test})
         raise SystemExit(f"--contents: no test take of {missing}; the data's contents: {known}")
-    queries = [t for c in contents for t in [t for t in test if t.content == c][: args.takes]]
+    queries = spread_over_styles(test, contents, args.takes)
     database = MotionDatabase.from_takeset(TakeSet(data.name, train, data.fps))
     started = time.perf_counter()
     texturers = {mode: MotionTexturer(database, mode) for mode in ("complete", "texture")}

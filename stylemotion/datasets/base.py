@@ -7,6 +7,7 @@ whatever else the source knows).
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
 from typing import Any
@@ -135,3 +136,21 @@ def _share(n: int, fraction: float) -> int:
     if fraction <= 0:
         return 0
     return max(1, round(n * fraction)) if n >= 3 else 0
+
+
+def spread_over_styles(takes: Sequence[Take], contents: Sequence[str], per_content: int) -> list[Take]:
+    """``per_content`` takes of each content, taken in turn from each style (sorted by name within a style), so a
+    benchmark's queries cover every style rather than the first one alphabetically."""
+    chosen: list[Take] = []
+    for content in contents:
+        by_style: dict[str, list[Take]] = {}
+        for take in sorted((t for t in takes if t.content == content), key=lambda t: t.name):
+            by_style.setdefault(take.style, []).append(take)
+        queues = [by_style[s] for s in sorted(by_style)]
+        picked: list[Take] = []
+        while len(picked) < per_content and any(queues):
+            for queue in queues:
+                if queue and len(picked) < per_content:
+                    picked.append(queue.pop(0))
+        chosen += picked
+    return chosen
