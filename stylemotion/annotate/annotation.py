@@ -14,7 +14,7 @@ contradicted) in the right order inside the hit's segment.
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -149,13 +149,14 @@ class ClassDistances:
 
 
 def class_distances(document: np.ndarray, templates: Sequence[MotionTemplate],
-                    settings: AnnotationSettings = AnnotationSettings()) -> ClassDistances:
+                    settings: AnnotationSettings | None = None) -> ClassDistances:
     """Subsequence-DTW distance functions of every template over a document's ``(frames, features)`` features.
 
     Raises:
         AnnotationInputError: no template, feature counts that differ, or a document shorter than the
             shortest template's minimum match (half its length).
     """
+    settings = settings or AnnotationSettings()
     doc = np.asarray(document)
     if not templates:
         raise AnnotationInputError("no class templates to annotate with")
@@ -197,8 +198,9 @@ def annotate_distances(distances: ClassDistances, tau: float, keyframes: bool) -
 
 
 def annotate_features(document: np.ndarray, templates: Sequence[MotionTemplate],
-                      settings: AnnotationSettings = AnnotationSettings()) -> Annotation:
+                      settings: AnnotationSettings | None = None) -> Annotation:
     """Annotate a document given as ``(frames, features)`` relational features."""
+    settings = settings or AnnotationSettings()
     return annotate_distances(class_distances(document, templates, settings), settings.tau, settings.keyframes)
 
 

@@ -27,7 +27,7 @@ from typing import Any
 import numpy as np
 from omegaconf import DictConfig, OmegaConf
 
-from stylemotion.annotate.annotation import AnnotationSettings, AnnotationInputError, annotate_features, segments
+from stylemotion.annotate.annotation import AnnotationInputError, AnnotationSettings, annotate_features, segments
 from stylemotion.annotate.features import relational_features
 from stylemotion.annotate.model import AnnotationModel, ModelFolderError, learn_model, load_model, save_model
 from stylemotion.annotate.templates import TemplateInputError
@@ -96,8 +96,9 @@ def load_document(document: str, fps: float, conversion: Mapping[str, Any] | Non
 
 
 def annotate_positions(positions: np.ndarray, model: AnnotationModel,
-                       settings: AnnotationSettings = AnnotationSettings()) -> tuple[list[str], list[dict[str, Any]]]:
+                       settings: AnnotationSettings | None = None) -> tuple[list[str], list[dict[str, Any]]]:
     """Frame labels (``""`` where none) and segment records (with sub-class fits where a tensor exists)."""
+    settings = settings or AnnotationSettings()
     annotation = annotate_features(relational_features(positions, model.fps), model.templates, settings)
     labels = annotation.label_names()
     records = []
@@ -114,10 +115,11 @@ def annotate_positions(positions: np.ndarray, model: AnnotationModel,
 
 
 def annotate(document: str, templates: str | os.PathLike, out: str | os.PathLike, *,
-             settings: AnnotationSettings = AnnotationSettings(), conversion: Mapping[str, Any] | None = None,
+             settings: AnnotationSettings | None = None, conversion: Mapping[str, Any] | None = None,
              force: bool = False, say: Say = print, command: str = "") -> dict[str, Any]:
     """Annotate ``document`` with the model in ``templates`` and write the folder ``out`` (module docstring)."""
     started = time.perf_counter()
+    settings = settings or AnnotationSettings()
     out = check_new_output(out, force)
     if not (isinstance(settings.tau, (int, float)) and settings.tau > 0):
         raise AnnotateInputError(f"tau={settings.tau} must be a positive number (the thesis used 0.13)")

@@ -18,8 +18,8 @@ from typing import Any
 import numpy as np
 
 from stylemotion.annotate.features import FEATURE_NAMES, relational_features
-from stylemotion.annotate.tensors import MotionTensor, TensorInputError, build_tensor
 from stylemotion.annotate.templates import DELTA, MotionTemplate, TemplateInputError, learn_template
+from stylemotion.annotate.tensors import MotionTensor, TensorInputError, build_tensor
 from stylemotion.datasets.base import Take
 from stylemotion.io.atomic import atomic_write_bytes
 from stylemotion.io.outputs import inside
