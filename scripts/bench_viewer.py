@@ -25,11 +25,9 @@ from pathlib import Path
 import numpy as np
 
 from stylemotion.datasets.synthetic import CONTENTS, STYLES, generate_take
+from stylemotion.viewer.browser import CHROMIUM_ARGS, chromium_path
 from stylemotion.viewer.motions import samples_to_motions
 from stylemotion.viewer.page import folder_size, write_viewer
-
-CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-                 "--disable-background-networking", "--disable-component-update", "--disable-sync"]
 
 
 def motions(count: int, frames: int):
@@ -48,7 +46,7 @@ def main() -> int:
     parser.add_argument("--frames", type=int, default=300)
     parser.add_argument("--loads", type=int, default=3)
     parser.add_argument("--seconds", type=float, default=5.0)
-    parser.add_argument("--chromium", default=os.environ.get("STYLEMOTION_CHROMIUM", "/usr/bin/chromium"))
+    parser.add_argument("--chromium", default=chromium_path())
     parser.add_argument("--screenshot", default=None, help="also save a screenshot of the page (PNG)")
     args = parser.parse_args()
     from playwright.sync_api import sync_playwright
@@ -61,7 +59,7 @@ def main() -> int:
         size = folder_size(index.parent)
         data_size = (index.parent / "data.js").stat().st_size
         with sync_playwright() as p:
-            browser = p.chromium.launch(executable_path=args.chromium, args=CHROMIUM_ARGS)
+            browser = p.chromium.launch(executable_path=args.chromium, args=list(CHROMIUM_ARGS))
             loads, errors = [], []
             for _ in range(args.loads):
                 page = browser.new_page(viewport={"width": 1280, "height": 720})

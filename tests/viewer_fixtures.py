@@ -15,10 +15,7 @@ import numpy as np
 import pytest
 
 from stylemotion.datasets.synthetic import generate_take
-
-CHROMIUM = os.environ.get("STYLEMOTION_CHROMIUM", "/usr/bin/chromium")
-CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-                 "--disable-background-networking", "--disable-component-update", "--disable-sync"]
+from stylemotion.viewer.browser import CHROMIUM_ARGS, chromium_path
 
 
 def write_take_npz(path: Path, style: str, seconds: float = 3.0, walk: bool = False) -> Path:
@@ -50,14 +47,15 @@ def chromium_executable() -> str:
         import playwright.sync_api  # noqa: F401
     except ImportError:
         missing.append("the Python package playwright (pip install -e '.[dev]')")
-    if not (Path(CHROMIUM).is_file() or shutil.which(CHROMIUM)):
-        missing.append(f"{CHROMIUM} (apt-get install chromium; or set STYLEMOTION_CHROMIUM)")
+    chromium = chromium_path()
+    if not (Path(chromium).is_file() or shutil.which(chromium)):
+        missing.append(f"{chromium} (apt-get install chromium; or set STYLEMOTION_CHROMIUM)")
     if missing:
         message = "browser test needs " + " and ".join(missing)
         if running_in_ci():
             pytest.fail(message + " (CI=true: not skipped)")
         pytest.skip(message)
-    return CHROMIUM
+    return chromium
 
 
 @pytest.fixture(scope="module")
@@ -67,6 +65,6 @@ def browser():
     from playwright.sync_api import sync_playwright
 
     with sync_playwright() as p:
-        b = p.chromium.launch(executable_path=executable, args=CHROMIUM_ARGS)
+        b = p.chromium.launch(executable_path=executable, args=list(CHROMIUM_ARGS))
         yield b
         b.close()
