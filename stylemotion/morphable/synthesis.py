@@ -73,6 +73,8 @@ class ConstrainedResult:
         latent: ``(d,)``.
         errors_m: each constraint's error (metres; orientations scaled) after the solve.
         start_errors_m: the same for the tree's candidate.
+        cost, start_cost: the MAP objective ``½‖r‖²`` (module doc) of the result and of the tree's candidate
+            (the result is the better of LM's end point and the candidate).
         neg_log_prior: ``−ln p(s)`` of the result.
         evaluations: tree evaluations + LM function evaluations.
         unreachable: messages naming the constraints missed by more than the tolerance.
@@ -81,6 +83,8 @@ class ConstrainedResult:
     latent: np.ndarray
     errors_m: list[float]
     start_errors_m: list[float]
+    cost: float
+    start_cost: float
     neg_log_prior: float
     evaluations: int
     unreachable: list[str] = field(default_factory=list)
@@ -145,15 +149,17 @@ def solve_constraints(model: MorphableModel, constraints: Sequence[KeyframeConst
         return np.concatenate([constraint_residuals(model, s, constraints, settings.constraint_scale_m), prior(s)])
 
     fit = least_squares(residuals, found.latent, method="lm", max_nfev=settings.max_evaluations)
-    final = errors(fit.x[None])[0]
+    start_cost = 0.5 * float((residuals(found.latent) ** 2).sum())
+    best, cost = (fit.x, float(fit.cost)) if fit.cost <= start_cost else (found.latent, start_cost)
+    final = errors(best[None])[0]
     start = errors(found.latent[None])[0]
     missed = [f"{c.kind} constraint on {c.joint or 'the pose'} at frame {c.frame:g}: residual {e:.3f} m "
               f"(tolerance {settings.tolerance_m} m; the tree's candidate missed it by {s:.3f} m)"
               for c, e, s in zip(constraints, final, start) if e > settings.tolerance_m]
     for message in missed:
         warnings.warn(f"unreachable keyframe: {message}", UnreachableConstraintWarning, stacklevel=2)
-    return ConstrainedResult(fit.x, [float(e) for e in final], [float(e) for e in start],
-                             float(-model.gmm.log_prob(fit.x)), found.evaluations + int(fit.nfev), missed)
+    return ConstrainedResult(best, [float(e) for e in final], [float(e) for e in start], cost, start_cost,
+                             float(-model.gmm.log_prob(best)), found.evaluations + int(fit.nfev), missed)
 
 
 # ---------------------------------------------------------------------------------------------

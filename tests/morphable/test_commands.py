@@ -1,0 +1,52 @@
+"""``stylemotion-train experiment=morphable_graph`` and ``stylemotion-generate model=morphable`` as console
+commands on the synthetic default."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from stylemotion.morphable import MorphableModel
+
+SMALL = ["data.takes_per_pair=3", "data.duration_s=5.0", "model.latent_dim=5", "model.reduction=fpca",
+         "model.num_coefficients=6", "model.tree.samples=500", "samples=false", "threads=1"]
+
+
+def _run(args: list[str], cwd: Path) -> subprocess.CompletedProcess:
+    env = {**os.environ, "OMP_NUM_THREADS": "1"}
+    return subprocess.run([sys.executable, "-m", *args], cwd=cwd, env=env, capture_output=True, text=True, timeout=300)
+
+
+@pytest.mark.slow  # four console commands: ~45 s on a loaded 2-core machine
+def test_train_then_generate(tmp_path):
+    runs = {}
+    for primitive in ("walk_leftStance", "walk_rightStance"):
+        out = tmp_path / primitive
+        done = _run(["stylemotion.cli.train", "experiment=morphable_graph", f"primitive={primitive}",
+                     f"hydra.run.dir={out}", *SMALL], tmp_path)
+        assert done.returncode == 0, done.stderr[-2000:]
+        metrics = json.loads((out / "metrics.json").read_text())
+        assert metrics["fit"]["clips"] > 5 and 0 < metrics["test/joint_rmse_m"] < 0.1
+        assert {"run.json", "config_resolved.yaml", "model.npz"} <= {p.name for p in out.iterdir()}
+        model = MorphableModel.load(out)
+        assert model.meta["primitive"] == primitive.split("_")[1] and model.tree is not None
+        runs[primitive] = out
+    again = _run(["stylemotion.cli.train", "experiment=morphable_graph", f"hydra.run.dir={runs['walk_leftStance']}",
+                  *SMALL], tmp_path)
+    assert again.returncode != 0 and "already holds a morphable model" in again.stderr + again.stdout
+    walk = tmp_path / "walk"
+    done = _run(["stylemotion.cli.generate", "model=morphable", f"+models.walk_leftStance={runs['walk_leftStance']}",
+                 f"+models.walk_rightStance={runs['walk_rightStance'] / 'model.npz'}", f"out={walk}",
+                 "path.s_curve.length_m=3.0", "path.s_curve.amplitude_m=0.2", "outputs.gif=false"], tmp_path)
+    assert done.returncode == 0, done.stderr[-2000:]
+    summary = json.loads((walk / "summary.json").read_text())
+    assert summary["meta"]["model"] == "morphable" and summary["deviation"]["mean_m"] < 0.15
+    with np.load(walk / "motion.npz", allow_pickle=False) as z:
+        assert z["positions"].shape[1:] == (21, 3)
+    assert (walk / "motion.bvh").is_file()
