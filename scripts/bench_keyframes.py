@@ -18,14 +18,14 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
 import sys
 import time
 
 import numpy as np
 
-from stylemotion.datasets import TakeSet, load_dataset, spread_over_styles
+from stylemotion.datasets import TakeSet
 from stylemotion.geometry import rotate_yaw
+from stylemotion.reconstruct.benchmark import benchmark_queries, benchmark_split
 from stylemotion.reconstruct.keyframes import DynamicMotionGraph, Keyframe, NoConnectionError, keys_from_motion
 from stylemotion.search.database import MotionDatabase
 from stylemotion.skeleton import JOINT_INDEX
@@ -89,17 +89,11 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     if args.tiny:
         args.data, args.contents, args.takes, args.spacings, args.rotate_step = "synthetic", "walk", 1, "2", 180.0
-    if args.data == "synthetic":
-        data = load_dataset("synthetic", takes_per_pair=1)
-    else:
-        root = args.root or os.path.join(os.environ.get("STYLEMOTION_DATA", "../shared/data"),
-                                         "bandai-namco-motion-2", "data.zip")
-        data = load_dataset("bandai", root=root)
-    group = ("content",) if args.data == "synthetic" else ("content", "style")
-    parts = data.split(args.seed, 0.0, 0.15 if args.data == "synthetic" else 0.1, group_by=group)
-    train, test = parts["train"], parts["test"]
-    contents = [c for c in args.contents.split(",") if c]
-    queries = spread_over_styles(test, contents, args.takes)
+    try:
+        data, train, test = benchmark_split(args.data, args.root, args.seed)
+        queries = benchmark_queries(test, args.contents, args.takes)
+    except ValueError as exc:
+        raise SystemExit(str(exc)) from None
     database = MotionDatabase.from_takeset(TakeSet(data.name, train, data.fps))
     t0 = time.perf_counter()
     graph = DynamicMotionGraph(database)

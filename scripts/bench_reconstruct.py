@@ -24,22 +24,15 @@ import time  # noqa: E402
 
 import numpy as np  # noqa: E402
 
-from stylemotion.datasets import TakeSet, load_dataset, spread_over_styles  # noqa: E402
+from stylemotion.datasets import TakeSet  # noqa: E402
 from stylemotion.reconstruct import (  # noqa: E402
     DEFAULT_MARKERS,
     SparseReconstructor,
     joint_errors_cm,
     tracks_from_positions,
 )
+from stylemotion.reconstruct.benchmark import benchmark_queries, benchmark_split  # noqa: E402
 from stylemotion.search.database import MotionDatabase  # noqa: E402
-
-
-def load(args: argparse.Namespace) -> TakeSet:
-    if args.data == "synthetic":
-        return load_dataset("synthetic", takes_per_pair=1)
-    root = args.root or os.path.join(os.environ.get("STYLEMOTION_DATA", "../shared/data"), "bandai-namco-motion-2",
-                                     "data.zip")
-    return load_dataset("bandai", root=root, workers=args.workers)
 
 
 def emit(record: dict) -> None:
@@ -64,16 +57,11 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     if args.tiny:
         args.data, args.contents, args.takes, args.frames = "synthetic", "walk,run", 1, 20
-    data = load(args)
-    group = ("content",) if args.data == "synthetic" else ("content", "style")
-    parts = data.split(args.seed, 0.0, 0.15 if args.data == "synthetic" else 0.1, group_by=group)
-    train, test = parts["train"], parts["test"]
-    contents = [c for c in args.contents.split(",") if c]
-    missing = sorted(set(contents) - {t.content for t in test})
-    if missing:
-        known = sorted({t.content for t in test})
-        raise SystemExit(f"--contents: no test take of {missing}; the data's contents: {known}")
-    queries = spread_over_styles(test, contents, args.takes)
+    try:
+        data, train, test = benchmark_split(args.data, args.root, args.seed, args.workers)
+        queries = benchmark_queries(test, args.contents, args.takes)
+    except ValueError as exc:
+        raise SystemExit(str(exc)) from None
     emit({"kind": "setup", "data": data.name, "fps": data.fps, "train_takes": len(train), "test_takes": len(test),
           "queries": [q.name for q in queries], "k": args.k, "noise_mm": args.noise_mm, "markers": DEFAULT_MARKERS})
     rng = np.random.default_rng(args.seed)

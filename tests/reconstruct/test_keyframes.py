@@ -5,8 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from reconstruct_fixtures import synthetic_split
 
-from stylemotion.datasets.base import TakeSet
 from stylemotion.datasets.registry import load_dataset
 from stylemotion.reconstruct.keyframes import (
     DynamicMotionGraph,
@@ -19,7 +19,6 @@ from stylemotion.reconstruct.keyframes import (
     resample,
 )
 from stylemotion.reconstruct.texture import MotionTexturer, TextureInputError
-from stylemotion.search.database import MotionDatabase
 from stylemotion.synthesis.quality import skating
 
 FPS = 30.0
@@ -27,9 +26,7 @@ FPS = 30.0
 
 @pytest.fixture(scope="module")
 def split():
-    ts = load_dataset("synthetic", takes_per_pair=1)
-    parts = ts.split(0, 0.0, 0.15, group_by=("content",))
-    return MotionDatabase.from_takeset(TakeSet("synthetic", parts["train"], ts.fps)), parts["train"], parts["test"]
+    return synthetic_split()
 
 
 @pytest.fixture(scope="module")

@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from conftest import BANDAI_ZIP, shared_data_dir
+from reconstruct_fixtures import synthetic_split
 
 from stylemotion.datasets.base import TakeSet
 from stylemotion.datasets.registry import load_dataset
@@ -23,9 +24,7 @@ from stylemotion.search.database import MotionDatabase
 
 @pytest.fixture(scope="module")
 def split():
-    ts = load_dataset("synthetic", takes_per_pair=1)
-    parts = ts.split(0, 0.0, 0.15, group_by=("content",))
-    return MotionDatabase.from_takeset(TakeSet("synthetic", parts["train"], ts.fps)), parts["train"], parts["test"]
+    return synthetic_split()
 
 
 @pytest.fixture(scope="module")

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from reconstruct_fixtures import synthetic_split
 
 from stylemotion.datasets.base import TakeSet
 from stylemotion.datasets.registry import load_dataset
@@ -22,9 +23,7 @@ def _cm(a: np.ndarray, b: np.ndarray, joints: list[int]) -> float:
 
 @pytest.fixture(scope="module")
 def split():
-    ts = load_dataset("synthetic", takes_per_pair=1)
-    parts = ts.split(0, 0.0, 0.15, group_by=("content",))
-    return MotionDatabase.from_takeset(TakeSet("synthetic", parts["train"], ts.fps)), parts["train"], parts["test"]
+    return synthetic_split()
 
 
 @pytest.fixture(scope="module")
