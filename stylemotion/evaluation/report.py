@@ -1,6 +1,7 @@
 """The report folder of an evaluation: ``report.md``, ``report.json``, one CSV per table, PNG figures.
 
-``report.html`` is the same report as a web page with the figures and samples in the viewer. The layout of
+``report.html`` is the same report as a web page with the figures and samples in the viewer; ``tensorboard/``
+holds the figures, settings and headline numbers as TensorBoard events. The layout of
 ``report.json`` (Table 5.1 under ``table_5_1.<primitive>``, Tables 5.2/5.3 under
 ``variance``/``variance_ratio``, the extra metrics, ``meta`` with provenance, ``definitions`` of
 every number) is specified in ``docs/report.md``. The folder is built beside its final place and
@@ -27,6 +28,7 @@ from stylemotion.evaluation.pipeline import VARIATION_KEYS
 from stylemotion.evaluation.tables import VARIANCE_KEYS
 from stylemotion.io.atomic import atomic_folder
 from stylemotion.io.outputs import check_new_output, inside
+from stylemotion.viz.tensorboard import write_report_events
 
 
 def write_report(results: dict[str, Any], out: str | os.PathLike, force: bool = False,
@@ -40,6 +42,7 @@ def write_report(results: dict[str, Any], out: str | os.PathLike, force: bool = 
     # checked again at swap time: the folder may have appeared meanwhile
     with atomic_folder(out, on_exists=lambda: check_new_output(out, force)) as tmp:
         figures = write_figures(results, tmp)
+        write_report_events(tmp, results, figures)
         tables = write_csvs(results, tmp)
         (tmp / "report.json").write_text(json.dumps(_plain(results), indent=1, allow_nan=False))
         text = format_markdown(results, figures, tables)

@@ -12,7 +12,8 @@ ground are drawn faintly, so the spread of step lengths and turning shows.
 * :func:`save_last_frames`: a PNG of the same line-up at each sample's last frame, plus a small
   side view of every last pose labelled with its duration.
 * :func:`save_samples_npz`: the samples' positions, which ``stylemotion-view`` shows in the browser.
-* :class:`SampleAnimation`: a Lightning callback that writes all three for a trained VAE/CVAE.
+* :class:`SampleAnimation`: a Lightning callback that writes all three for a trained VAE/CVAE and shows the
+  contact sheet and frames of the GIF in TensorBoard (when the run logs there).
 
 Files are written atomically (temporary name, then rename). No pyplot: a notebook's backend is left alone.
 """
@@ -25,6 +26,7 @@ from pathlib import Path
 
 import lightning.pytorch as pl
 import numpy as np
+from lightning.pytorch.loggers import TensorBoardLogger
 from lightning.pytorch.utilities import rank_zero_only
 from matplotlib.animation import PillowWriter
 from matplotlib.figure import Figure
@@ -34,6 +36,7 @@ from stylemotion.io.atomic import atomic_write_bytes
 from stylemotion.sampling import MotionSamples
 from stylemotion.skeleton import CANONICAL_JOINTS, JOINT_INDEX
 from stylemotion.viz.stick import TRUNK_COLOR, StickFigure, draw_pose, project
+from stylemotion.viz.tensorboard import log_sample_images
 
 log = logging.getLogger(__name__)
 
@@ -247,4 +250,7 @@ class SampleAnimation(pl.Callback):
                  + f" · data={self.data_name or model.spec.get('dataset')} · {self.num_samples} samples, "
                  f"seed {self.seed} · checkpoint {best or 'final weights (no best checkpoint)'}")
         self.paths = render_samples(samples, self.dirpath, title=title, count=self.num_samples)
+        for logger in trainer.loggers:
+            if isinstance(logger, TensorBoardLogger):
+                log_sample_images(logger.experiment, *self.paths, step=trainer.global_step)
         log.info("samples written to %s", self.dirpath)
