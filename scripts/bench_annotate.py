@@ -39,7 +39,7 @@ from stylemotion.morphable.warping import resample
 from stylemotion.representation import positions_to_frames
 from stylemotion.skeleton import CANONICAL_PARENTS
 
-TAUS = (0.005, 0.01, 0.02, 0.03, 0.05, 0.08, 0.13)
+TAUS = (0.005, 0.01, 0.02, 0.03, 0.04, 0.05, 0.08, 0.13)
 
 
 def load(data: str):
@@ -71,14 +71,15 @@ def table_32(documents, model, settings):
     distances = [class_distances(f, model.templates, settings) for f in features]
     distance_s = time.perf_counter() - started
     rows = []
-    for keyframes in (False, True):
-        for tau in TAUS:
-            t0 = time.perf_counter()
-            annotations = [annotate_distances(d, tau, keyframes) for d in distances]
-            label_s = time.perf_counter() - t0
-            scores = pooled([(doc.labels, a.label_names()) for doc, a in zip(documents, annotations)])
-            rows.append({"keyframes": keyframes, "tau": tau, **{k: round(v, 4) for k, v in scores.items()},
-                         "label_s": round(label_s, 3)})
+    for min_run in (0, settings.min_run):
+        for keyframes in (False, True):
+            for tau in TAUS:
+                t0 = time.perf_counter()
+                annotations = [annotate_distances(d, tau, keyframes, min_run) for d in distances]
+                label_s = time.perf_counter() - t0
+                scores = pooled([(doc.labels, a.label_names()) for doc, a in zip(documents, annotations)])
+                rows.append({"min_run": min_run, "keyframes": keyframes, "tau": tau,
+                             **{k: round(v, 4) for k, v in scores.items()}, "label_s": round(label_s, 3)})
     frames = sum(len(d.labels) for d in documents)
     timing = {"frames": frames, "features_s": round(feature_s, 2), "distances_s": round(distance_s, 2),
               "per_hour_s": round((feature_s + distance_s) * 108000 / frames, 1)}
@@ -115,7 +116,7 @@ def subclass(split, repetitions, documents, distances, settings, model_classes):
     walk = model_classes.index("walk")
     seg_right = seg_total = 0
     for doc, dist in zip(documents, distances):
-        a = annotate_distances(dist, settings.tau, True)
+        a = annotate_distances(dist, settings.tau, True, settings.min_run)
         labels = a.labels
         edges = np.flatnonzero(np.diff(np.r_[-2, labels, -2]) != 0)
         for s, e in zip(edges[:-1], edges[1:]):
@@ -206,10 +207,10 @@ def main() -> None:
                "timing": timing, "subclass": sub, "truncation": trunc, "decomposition": decomposition}
     out.mkdir(parents=True, exist_ok=True)
     atomic_write_bytes(out / "results.json", (json.dumps(results, indent=1) + "\n").encode())
-    print("| key frames | τ | P1 | R1 | F1 | P2 | R2 | F2 |\n|---|---|---|---|---|---|---|---|")
+    print("| min_run | key frames | τ | P1 | R1 | F1 | P2 | R2 | F2 |\n|---|---|---|---|---|---|---|---|---|")
     for r in rows:
-        print(f"| {'with' if r['keyframes'] else 'no'} | {r['tau']} | {r['P1']:.3f} | {r['R1']:.3f} | {r['F1']:.3f} | "
-              f"{r['P2']:.3f} | {r['R2']:.3f} | {r['F2']:.3f} |")
+        scores = " | ".join(f"{r[k]:.3f}" for k in ("P1", "R1", "F1", "P2", "R2", "F2"))
+        print(f"| {r['min_run']} | {'with' if r['keyframes'] else 'no'} | {r['tau']} | {scores} |")
     print(json.dumps({k: v for k, v in results.items() if k not in ("table_3_2", "truncation")}, indent=1))
     print("| ranks (DOF, frames, style, rep) | KiB | error cm | error deg |\n|---|---|---|---|")
     for r in trunc:

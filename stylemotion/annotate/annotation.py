@@ -6,6 +6,8 @@ smallest ``Δ_p(ℓ*) < τ``, mark its segment ``[start(ℓ*), ℓ*]`` (the fram
 ``Δ_p(ℓ*)``), forbid every later hit whose segment overlaps a marked one, repeat until no value is below ``τ``.
 Each frame then gets the class of the smallest ``Δ̄_p^τ`` (eqs. 3.1–3.2), or none where all are ``inf``.
 
+Beyond the thesis, labelled runs shorter than ``min_run`` frames are left unlabelled afterwards.
+
 Key-frame preselection: a class's key frames are a few columns of its quantized template (spread over its
 length, each the column with most consistent entries in its neighbourhood). A hit survives only when the
 document has frames matching its key frames (at most ``keyframe_tolerance`` of their consistent entries
@@ -130,12 +132,15 @@ def class_hits(delta: np.ndarray, start: np.ndarray, tau: float, label: str,
 class AnnotationSettings:
     """``tau``: matching threshold; ``keyframes``: use key-frame preselection; ``keyframe_count`` key frames
     per class; ``keyframe_tolerance``: fraction of a key frame's consistent entries a matching frame may
-    contradict."""
+    contradict; ``min_run``: shortest labelled run kept, frames (shorter slivers, where one class's hit
+    overlays another's, are left unlabelled; 30 = 1 s at 30 fps, below the shortest Bandai template's
+    minimum match of 35 frames; 0 disables it)."""
 
     tau: float = DEFAULT_TAU
     keyframes: bool = True
     keyframe_count: int = 3
-    keyframe_tolerance: float = 0.0
+    keyframe_tolerance: float = 0.1
+    min_run: int = 30
 
 
 @dataclass(frozen=True)
@@ -182,8 +187,9 @@ def class_distances(document: np.ndarray, templates: Sequence[MotionTemplate],
     return ClassDistances(tuple(t.label for t in templates), np.stack(deltas), np.stack(starts), np.stack(keeps))
 
 
-def annotate_distances(distances: ClassDistances, tau: float, keyframes: bool) -> Annotation:
-    """Frame labels from precomputed class distances at threshold ``tau`` (eqs. 3.1–3.2)."""
+def annotate_distances(distances: ClassDistances, tau: float, keyframes: bool, min_run: int = 0) -> Annotation:
+    """Frame labels from precomputed class distances at threshold ``tau`` (eqs. 3.1–3.2); runs of one label
+    shorter than ``min_run`` frames are then left unlabelled (0: the thesis' procedure as is)."""
     bars, hits = [], []
     for p, label in enumerate(distances.classes):
         h, bar = class_hits(distances.delta[p], distances.start[p], tau, label,
@@ -194,6 +200,12 @@ def annotate_distances(distances: ClassDistances, tau: float, keyframes: bool) -
     best = np.argmin(bar, axis=0)
     minimum = bar[best, np.arange(bar.shape[1])]
     labels = np.where(np.isfinite(minimum), best, -1)
+    if min_run > 1:
+        edges = np.flatnonzero(np.diff(np.r_[-2, labels, -2]) != 0)
+        for a, b in zip(edges[:-1], edges[1:]):
+            if labels[a] >= 0 and b - a < min_run:
+                labels[a:b] = -1
+                minimum[a:b] = np.inf
     return Annotation(labels, minimum, distances.classes, tuple(sorted(hits, key=lambda h: (h.start, h.label))))
 
 
@@ -201,7 +213,8 @@ def annotate_features(document: np.ndarray, templates: Sequence[MotionTemplate],
                       settings: AnnotationSettings | None = None) -> Annotation:
     """Annotate a document given as ``(frames, features)`` relational features."""
     settings = settings or AnnotationSettings()
-    return annotate_distances(class_distances(document, templates, settings), settings.tau, settings.keyframes)
+    return annotate_distances(class_distances(document, templates, settings), settings.tau, settings.keyframes,
+                              settings.min_run)
 
 
 def segments(labels: Sequence[str] | np.ndarray) -> list[tuple[int, int, str]]:

@@ -140,7 +140,7 @@ def annotate(document: str, templates: str | os.PathLike, out: str | os.PathLike
               "classes": list(model.classes), "tensors": sorted(model.tensors),
               "settings": {"tau": settings.tau, "keyframes": settings.keyframes,
                            "keyframe_count": settings.keyframe_count,
-                           "keyframe_tolerance": settings.keyframe_tolerance},
+                           "keyframe_tolerance": settings.keyframe_tolerance, "min_run": settings.min_run},
               "labelled_fraction": round(float(np.mean([lab != "" for lab in labels])), 4),
               "segments": records, "provenance": provenance(command or None)}
     with atomic_folder(out, on_exists=lambda: check_new_output(out, force)) as tmp:
@@ -174,7 +174,8 @@ def annotate_from_config(cfg: DictConfig, say: Say = print, command: str = "") -
     settings = AnnotationSettings(tau=plain.get("tau", AnnotationSettings.tau),
                                   keyframes=bool(keyframes.get("use", True)),
                                   keyframe_count=positive_int(keyframes.get("count", 3), "keyframes.count"),
-                                  keyframe_tolerance=float(keyframes.get("tolerance", 0.0)))
+                                  keyframe_tolerance=float(keyframes.get("tolerance", 0.1)),
+                                  min_run=int(plain.get("min_run", 30)))
     return annotate(str(plain["document"]), plain["templates"], plain["out"], settings=settings,
                     conversion={key: plain.get(key) for key in ("joint_map", "unit_scale", "up_axis")},
                     force=force, say=say, command=command)
