@@ -90,3 +90,11 @@ def test_other_files_and_empty_run_folders(tmp_path):
         read_inputs([tmp_path / "empty_run"])
     with pytest.raises(MotionDataError, match="no such file"):
         read_inputs([tmp_path / "missing.bvh"])
+
+
+def test_malformed_bvh_names_file_and_line(tmp_path):
+    bad = tmp_path / "bad.bvh"
+    bad.write_text("HIERARCHY\nROOT Hips\n{\n  OFFSET 0 0\n}\n")
+    with pytest.raises(MotionDataError) as info:
+        read_inputs([bad])
+    assert str(info.value).startswith(f"{bad}:")
