@@ -15,7 +15,33 @@ import numpy as np
 import pytest
 
 from stylemotion.datasets.synthetic import generate_take
+from stylemotion.sampling import MotionSamples
 from stylemotion.viewer.browser import CHROMIUM_ARGS, chromium_path
+
+
+def synthetic_samples(styles: tuple[str, ...] = ("normal", "elderly"), seconds: float = 1.0,
+                      lengths: list[int] | None = None) -> MotionSamples:
+    """MotionSamples of synthetic walks (one per style), as a sampler returns them (padded to one length)."""
+    import torch
+
+    pos = np.stack([generate_take("walk", s, 0, duration_s=seconds).positions for s in styles])
+    n, frames = pos.shape[:2]
+    lengths = torch.tensor(lengths or [frames] * n)
+    return MotionSamples(torch.from_numpy(pos), torch.zeros(n, frames, 66), lengths, (lengths - 1) / 30.0,
+                         torch.zeros(n, 1, 1), torch.zeros(n, 1, 66), 30.0)
+
+
+def tiny_results(columns_on_diagonal: tuple[str, ...] = ("neutral", "elderly")) -> dict:
+    """Evaluation results with one 2 × 2 Table 5.1 (rows neutral, elderly), as ``evaluate_models`` + meta."""
+    styles = ["neutral", "elderly"]
+    return {
+        "meta": {"data_name": "synthetic", "seed": 3, "samples": {"table_5_1": 4}},
+        "table_5_1": {"walk_leftStance": {
+            "models": styles, "examples": styles, "distance": [[0.1, 0.7], [0.9, 0.2]], "samples": 4,
+            "diagonal": {"rows": styles, "columns": list(columns_on_diagonal), "row_argmin": {},
+                         "all_rows": True, "all_columns": len(columns_on_diagonal) == 2},
+            "example_clips": {"neutral": "mean motion", "elderly": "take 3"}}},
+    }
 
 
 def write_take_npz(path: Path, style: str, seconds: float = 3.0, walk: bool = False) -> Path:

@@ -6,7 +6,7 @@ import json
 
 import numpy as np
 import pytest
-from viewer_fixtures import write_take_npz
+from viewer_fixtures import synthetic_samples, write_take_npz
 
 from stylemotion.contacts import foot_contacts
 from stylemotion.io.errors import MotionDataError
@@ -44,20 +44,14 @@ def test_reconstruction_folder_and_generated_walk_folder(tmp_path):
 
 
 def test_samples_folder_written_by_the_sample_callback(tmp_path):
-    import torch
-
-    from stylemotion.sampling import MotionSamples
     from stylemotion.viz.animation import save_samples_npz
 
-    pos = np.stack([np.load(write_take_npz(tmp_path / f"{s}.npz", s))["positions"] for s in ("normal", "active")])
-    n, frames = pos.shape[:2]
-    samples = MotionSamples(torch.from_numpy(pos), torch.zeros(n, frames, 66), torch.tensor([90, 50]),
-                            torch.tensor([89 / 30, 49 / 30]), torch.zeros(n, 1, 1), torch.zeros(n, 1, 66), 30.0)
+    samples = synthetic_samples(("normal", "active"), 3.0, lengths=[90, 50])
     save_samples_npz(samples, tmp_path / "run" / "cvae" / "walk_left_active" / "samples" / "samples.npz")
     motions = read_inputs([tmp_path / "run"])
     assert [m.frames for m in motions] == [90, 50]
     assert {m.group for m in motions} == {"walk_left_active"}
-    np.testing.assert_array_equal(motions[1].positions, pos[1, :50])
+    np.testing.assert_array_equal(motions[1].positions, samples.positions[1, :50].numpy())
 
 
 @pytest.mark.parametrize("content, match", [

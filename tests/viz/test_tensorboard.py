@@ -3,13 +3,11 @@
 from __future__ import annotations
 
 import numpy as np
-import torch
 from tensorboard.backend.event_processing.event_accumulator import EventAccumulator
 from torch.utils.tensorboard import SummaryWriter
+from viewer_fixtures import synthetic_samples, tiny_results
 
-from stylemotion.datasets.synthetic import generate_take
 from stylemotion.evaluation.report import write_report
-from stylemotion.sampling import MotionSamples
 from stylemotion.viz.animation import render_samples
 from stylemotion.viz.tensorboard import log_sample_images
 
@@ -21,10 +19,7 @@ def _events(folder) -> EventAccumulator:
 
 
 def test_sample_images(tmp_path):
-    pos = np.stack([generate_take("walk", s, 0, duration_s=1.0).positions for s in ("normal", "elderly")])
-    n, frames = pos.shape[:2]
-    samples = MotionSamples(torch.from_numpy(pos), torch.zeros(n, frames, 66), torch.full((n,), frames),
-                            torch.full((n,), (frames - 1) / 30), torch.zeros(n, 1, 1), torch.zeros(n, 1, 66), 30.0)
+    samples = synthetic_samples()
     gif, png = render_samples(samples, tmp_path / "samples", count=2)
     writer = SummaryWriter(str(tmp_path / "tb"))
     log_sample_images(writer, gif, png, step=7)
@@ -38,15 +33,7 @@ def test_sample_images(tmp_path):
 
 
 def test_report_figures_and_numbers(tmp_path):
-    styles = ["neutral", "elderly"]
-    results = {
-        "meta": {"data_name": "synthetic", "seed": 3, "samples": {"table_5_1": 4}},
-        "table_5_1": {"walk_leftStance": {
-            "models": styles, "examples": styles, "distance": [[0.1, 0.7], [0.9, 0.2]], "samples": 4,
-            "diagonal": {"rows": styles, "columns": ["neutral"], "row_argmin": {}, "all_rows": True,
-                         "all_columns": False},
-            "example_clips": {"neutral": "mean motion", "elderly": "take 3"}}},
-    }
+    results = tiny_results(columns_on_diagonal=("neutral",))
     out = write_report(results, tmp_path / "report")
     acc = _events(out / "tensorboard")
     assert acc.Tags()["images"] == ["report/table_5_1_walk_leftStance"]
