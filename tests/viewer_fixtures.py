@@ -7,12 +7,12 @@ download is never used). When it is missing the browser tests are skipped on a w
 
 from __future__ import annotations
 
-import os
 import shutil
 from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import running_in_ci
 
 from stylemotion.datasets.synthetic import generate_take
 from stylemotion.sampling import MotionSamples
@@ -59,11 +59,6 @@ def motion_files(tmp_path: Path) -> list[Path]:
     """Three motion NPZ files of three styles; the first is a walk with a path and targets."""
     return [write_take_npz(tmp_path / f"{s}.npz", s, walk=(i == 0))
             for i, s in enumerate(("normal", "elderly", "active"))]
-
-
-def running_in_ci() -> bool:
-    """As tests/conftest.py decides it (not imported: tests/viewer/conftest.py shadows that module name here)."""
-    return os.environ.get("CI", "").strip().lower() in ("1", "true", "yes", "on")
 
 
 def chromium_executable() -> str:
