@@ -95,10 +95,14 @@ def objective(model, constraints: Sequence[KeyframeConstraint]):
     if not constraints:
         raise ValueError("no constraint given")
     need_rot = any(c.kind == "orientation" for c in constraints)
+    frames = sorted({int(round(c.frame * (model.length - 1))) for c in constraints})
+    # evaluate only the constrained frames: re-express each constraint's frame as its index among them
+    local = [KeyframeConstraint(c.kind, c.target, c.joint, frames.index(int(round(c.frame * (model.length - 1))))
+                                / max(len(frames) - 1, 1), c.orientation_scale_m) for c in constraints]
 
     def cost(latent: np.ndarray) -> np.ndarray:
-        out = model.canonical_positions(latent, rotations=need_rot)
+        out = model.poses_at(latent, frames, rotations=need_rot)
         pos, rot = out if need_rot else (out, None)
-        return constraint_errors(pos, rot, constraints, model.length).sum(-1)
+        return constraint_errors(pos, rot, local, len(frames)).sum(-1)
 
     return cost

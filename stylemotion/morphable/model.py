@@ -208,6 +208,18 @@ class MorphableModel:
         rate = (self.length - 1) * self.fps / self.warps(warp)[:, -1]
         return self.channels.positions(channels, rate, rotations=rotations)
 
+    def poses_at(self, latent: np.ndarray, frames: Sequence[int], rotations: bool = False):
+        """``(n, len(frames), 21, 3)`` positions at canonical ``frames`` only (and global rotations with
+        ``rotations``): for the quaternion representation just those frames are evaluated (what constraint
+        searches over thousands of codes need); the ``frames`` representation integrates the whole clip."""
+        frames = list(frames)
+        if self.channels.kind != "quaternion":
+            out = self.canonical_positions(latent, rotations=rotations)
+            return (out[0][:, frames], out[1][:, frames]) if rotations else out[:, frames]
+        spatial, _ = self.coefficients(latent)
+        times = np.asarray(frames, dtype=np.float64) / (self.length - 1)
+        return self.channels.positions(self.basis.evaluate(spatial, times), rotations=rotations)
+
     def decode_latent(self, latent: np.ndarray | torch.Tensor) -> MotionSamples:
         """Motions of ``(n, d)`` codes, at :attr:`fps` with their own durations (see the module doc)."""
         latent = np.atleast_2d(latent.detach().cpu().numpy() if isinstance(latent, torch.Tensor) else latent)

@@ -33,7 +33,7 @@ from scipy.optimize import least_squares
 from scipy.spatial.transform import Rotation
 
 from stylemotion.geometry import rotate_yaw, rotate_yaw_xz, wrap_angle
-from stylemotion.morphable.constraints import KeyframeConstraint, constraint_errors
+from stylemotion.morphable.constraints import KeyframeConstraint, constraint_errors, objective
 from stylemotion.morphable.model import MorphableModel
 from stylemotion.morphable.tree import SpaceTree
 from stylemotion.representation import ROOT_JOINT, facing_yaw
@@ -141,8 +141,7 @@ def solve_constraints(model: MorphableModel, constraints: Sequence[KeyframeConst
         pos, rot = out if need_rot else (out, None)
         return constraint_errors(pos, rot, constraints, model.length)
 
-    tree = _tree(model)
-    found = tree.search(lambda s: errors(s).sum(-1), settings.candidates)
+    found = _tree(model).search(objective(model, constraints), settings.candidates)
     prior = _prior_residual(model, found.latent, settings.prior_weight)
 
     def residuals(s: np.ndarray) -> np.ndarray:
