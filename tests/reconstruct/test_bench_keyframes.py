@@ -1,4 +1,4 @@
-"""scripts/bench_keyframes.py and scripts/bench_texture.py --tiny: their JSON lines on synthetic data."""
+"""The reconstruction benchmark scripts (keyframes, texture, style transfer) on synthetic data: their JSON lines."""
 
 from __future__ import annotations
 
@@ -37,3 +37,11 @@ def test_texture_tiny_run_writes_completion_and_texturing_lines(capsys):
     assert set(summaries) == {"complete", "texture@3", "texture@10"}
     assert summaries["complete"]["upper_cm"] > 0 and summaries["complete"]["nn_upper_cm"] > 0
     assert summaries["texture@10"]["spline_cm"] > summaries["texture@3"]["spline_cm"]
+
+
+def test_style_transfer_script_completes_from_both_databases(capsys):
+    assert _load("bench_style_transfer").main(["--data", "synthetic"]) == 0
+    rows = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
+    assert [r["kind"] for r in rows] == ["real", "real", "completed", "completed"]
+    assert [r["database"] for r in rows[2:]] == ["walk normal", "walk elderly"]
+    assert all(r["db_takes"] >= 1 and r["upper_cm_to_take"] > 0 for r in rows[2:])
