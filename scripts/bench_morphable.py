@@ -1,0 +1,234 @@
+"""Benchmark of the Morphable Graph (issue 14) on Bandai (or the synthetic default), as JSON lines.
+
+    python scripts/bench_morphable.py --parts k,dims,tree,path,tables --out runs/bench_morphable [--data bandai]
+
+Parts (each prints JSON lines, also appended to ``<out>/morphable.jsonl``):
+
+* ``k`` (Fig. 3.9): joint-space RMSE of the spline fit against the number of coefficients ``K`` for the
+  walk and run stance primitives (training clips of the neutral style);
+* ``dims`` (Fig. 3.10): reconstruction error in feature space (unexplained share of the coefficients'
+  variance) and in joint space (RMSE, m) against latent dimensions, FPCA / normalized FPCA / SFPCA, on
+  walk_leftStance's training clips;
+* ``tree`` (Fig. 4.12): ``--constraints`` random position, orientation and pose constraints at the last
+  keyframe (targets from fresh mixture samples): median error and evaluations of the k-means, GMM and
+  median trees, the best of 100 random samples, and brute force over the tree's 10,000 codes;
+* ``path``: the 10 m S-curve of ``stylemotion-generate`` with the two stance models (seeds 0 1 2);
+* ``tables`` (Tables 5.2/5.3): pose_SD, V_SD, step_SD of 10,000 samples per stance model against the
+  training clips, and the model size against the training data's.
+
+Models are fitted once into ``<out>/models/<primitive>/model.npz`` (default settings, the neutral style)
+and reused by later runs.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import time
+import warnings
+from pathlib import Path
+
+import numpy as np
+from omegaconf import OmegaConf
+
+from stylemotion.config import CONFIG_DIR
+from stylemotion.datamodules.clips import ClipDataModule
+from stylemotion.evaluation.tables import variance_stats
+from stylemotion.morphable import FitSettings, MorphableModel, fit_primitive
+from stylemotion.morphable.bspline import SplineBasis
+from stylemotion.morphable.constraints import KeyframeConstraint, objective
+from stylemotion.morphable.fpca import METHODS, fit_reduction
+from stylemotion.morphable.model import coefficient_vectors, functional_data, joint_error_function, spline_rmse
+from stylemotion.morphable.tree import SpaceTree, brute_force
+from stylemotion.primitives import parse_primitive, time_normalize
+from stylemotion.sampling import pad_motions
+from stylemotion.skeleton import CANONICAL_JOINTS
+from stylemotion.synthesis.controller import SharpTurnWarning
+from stylemotion.synthesis.generate import generate
+
+STANCES = ("walk_leftStance", "walk_rightStance")
+DIMS = (1, 2, 3, 5, 8, 10, 15, 20, 30, 40)
+CONSTRAINED_JOINTS = ("Hand_L", "Hand_R", "Foot_L", "Foot_R", "Head")
+
+
+class Bench:
+    def __init__(self, data: str, out: Path, style: str):
+        self.data_name, self.out, self.style = data, out, style
+        self.data = OmegaConf.to_container(OmegaConf.load(CONFIG_DIR / "data" / f"{data}.yaml"), resolve=True)
+        out.mkdir(parents=True, exist_ok=True)
+        self.log = out / "morphable.jsonl"
+
+    def emit(self, record: dict) -> None:
+        line = json.dumps({"data": self.data_name, **record}, default=float)
+        print(line, flush=True)
+        with self.log.open("a") as fh:
+            fh.write(line + "\n")
+
+    def clips(self, primitive: str) -> dict[str, list]:
+        action, name = parse_primitive(primitive)
+        dm = ClipDataModule(data=self.data, action=action, primitives=[name], styles=[self.style])
+        dm.setup()
+        return dm.clips
+
+    def model(self, primitive: str) -> MorphableModel:
+        path = self.out / "models" / primitive / "model.npz"
+        if path.is_file():
+            return MorphableModel.load(path)
+        began = time.perf_counter()
+        model = fit_primitive(self.clips(primitive)["train"], FitSettings(), meta={"data": self.data_name})
+        fitted = time.perf_counter() - began
+        model.build_tree()
+        model.save(path)
+        self.emit({"part": "fit", "primitive": primitive, "seconds_fit": fitted,
+                   "seconds_with_tree": time.perf_counter() - began, **{k: model.meta["fit"][k] for k in
+                                                                       ("clips", "joint_rmse_m", "gmm_components")},
+                   "num_coefficients": model.basis.num_coefficients, "timeline": model.length})
+        return model
+
+
+def part_k(b: Bench) -> None:
+    for primitive in STANCES + ("run_leftStance", "run_rightStance"):
+        data = functional_data(b.clips(primitive)["train"])
+        for k in range(4, data.length + 1):
+            b.emit({"part": "k", "primitive": primitive, "K": k, "clips": len(data.aligned), "timeline": data.length,
+                    "joint_rmse_m": spline_rmse(data, k)})
+
+
+def part_dims(b: Bench, k: int | None, iterations: int) -> None:
+    clips = b.clips("walk_leftStance")["train"]
+    data = functional_data(clips)
+    k = k or b.model("walk_leftStance").basis.num_coefficients
+    basis = SplineBasis(k)
+    vectors, groups, _ = coefficient_vectors(data, basis)
+    error = joint_error_function(data, basis, vectors)
+    total = ((vectors - vectors.mean(0)) ** 2).sum()
+    for dims in DIMS:
+        if dims >= len(vectors):
+            continue
+        for method in METHODS:
+            began = time.perf_counter()
+            pca, record = fit_reduction(vectors, groups, dims, method, error, iterations)
+            rebuilt = pca.reconstruct(pca.project(vectors))
+            b.emit({"part": "dims", "primitive": "walk_leftStance", "K": k, "dims": dims, "method": method,
+                    "feature_unexplained": float(((rebuilt - vectors) ** 2).sum() / total),
+                    "joint_rmse_m": float(np.sqrt(error(rebuilt))), "seconds": time.perf_counter() - began,
+                    "sfpca_start": record.get("start")})
+
+
+def _constraint(kind: str, rng: np.random.Generator, model: MorphableModel) -> KeyframeConstraint:
+    code = model.gmm.sample(1, rng)
+    pos, rot = model.poses_at(code, [model.length - 1], rotations=True)
+    joint = CONSTRAINED_JOINTS[rng.integers(len(CONSTRAINED_JOINTS))]
+    j = CANONICAL_JOINTS.index(joint)
+    if kind == "position":
+        return KeyframeConstraint("position", pos[0, 0, j], joint=joint)
+    if kind == "orientation":
+        return KeyframeConstraint("orientation", rot[0, 0, j], joint=joint)
+    return KeyframeConstraint("pose", pos[0, 0])
+
+
+def part_tree(b: Bench, count: int, candidates: list[int]) -> None:
+    for primitive in STANCES:
+        model = b.model(primitive)
+        trees = {"kmeans": model.tree}
+        for split in ("gmm", "median"):
+            began = time.perf_counter()
+            trees[split] = SpaceTree.build(model.tree.latent, split=split, seed=0)
+            b.emit({"part": "tree_build", "primitive": primitive, "split": split,
+                    "seconds": time.perf_counter() - began, "depth": trees[split].depth})
+        rng = np.random.default_rng(1)
+        for kind in ("position", "orientation", "pose"):
+            rows: dict[str, list[tuple[float, int]]] = {}
+            for _ in range(count):
+                cost = objective(model, [_constraint(kind, rng, model)])
+                exact = brute_force(model.tree.latent, cost)
+                rows.setdefault("brute_force", []).append((exact.cost, exact.evaluations))
+                random = model.gmm.sample(100, rng)
+                rows.setdefault("random_100", []).append((float(cost(random).min()), 100))
+                for split, tree in trees.items():
+                    for c in candidates:
+                        found = tree.search(cost, c)
+                        rows.setdefault(f"{split}_c{c}", []).append((found.cost, found.evaluations))
+            brute = np.median([e for e, _ in rows["brute_force"]])
+            for method, values in rows.items():
+                err = np.array([e for e, _ in values])
+                b.emit({"part": "tree", "primitive": primitive, "kind": kind, "method": method, "constraints": count,
+                        "median_error": float(np.median(err)), "median_vs_brute": float(np.median(err) / brute),
+                        "median_evaluations": float(np.median([n for _, n in values])),
+                        "max_evaluations": int(max(n for _, n in values))})
+
+
+def part_path(b: Bench, seeds: list[int]) -> None:
+    models = {p: str(b.out / "models" / p / "model.npz") for p in STANCES}
+    for p in STANCES:
+        b.model(p)
+    for seed in seeds:
+        out = b.out / "generate" / f"seed{seed}"
+        cfg = {"model": {"family": "morphable"}, "models": models, "style": "neutral", "seed": seed, "out": str(out),
+               "force": True, "outputs": {"bvh": True, "gif": seed == seeds[0]}}
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", SharpTurnWarning)
+            s = generate(cfg)
+        b.emit({"part": "path", "seed": seed, **{f"deviation_{k}": s["deviation"][k] for k in ("mean_m", "max_m",
+                                                                                               "final_m")},
+                "duration_s": s["duration_s"], "steps": s["steps"], "mean_speed_mps": s["mean_speed_mps"],
+                "skating": s["foot_skating_ratio"], "skating_raw": s["foot_skating_ratio_before_cleanup"],
+                "transition_speed_ratio": s["transitions"]["ratio"], "bvh_mpjpe_m": s.get("bvh_reimport_mpjpe_m"),
+                "synthesis_s": s["synthesis_seconds"], "sharp_turn_warnings": len(caught),
+                "load": os.getloadavg()[0]})
+
+
+def part_tables(b: Bench, samples: int) -> None:
+    for primitive in STANCES:
+        model, clips = b.model(primitive), b.clips(primitive)["train"]
+        frames, n = pad_motions([c.frames for c in clips])
+        positions, _ = pad_motions([c.positions for c in clips])
+        normalized = np.stack([time_normalize(c.frames, model.length) for c in clips])
+        real = variance_stats(frames.numpy(), positions.numpy(), n.numpy(), normalized)
+        began = time.perf_counter()
+        s = model.sample(samples, seed=0)
+        seconds = time.perf_counter() - began
+        fake = variance_stats(s.frames.numpy(), s.positions.numpy(), s.num_frames.numpy(), s.normalized_frames.numpy())
+        data_bytes = sum(c.positions.astype(np.float32).nbytes for c in clips)
+        model_bytes = (b.out / "models" / primitive / "model.npz").stat().st_size
+        b.emit({"part": "tables", "primitive": primitive, "samples": samples, "sample_seconds": seconds,
+                "training": real, "morphable": fake,
+                "ratio": {k: fake[k] / real[k] for k in ("pose_sd", "v_sd", "step_sd", "pose_across_sd")},
+                "model_bytes": model_bytes, "model_bytes_without_tree": model_bytes - model.tree.latent.nbytes // 2
+                - model.tree.centroid.nbytes - model.tree.children.nbytes, "training_positions_bytes": data_bytes})
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--data", default="bandai")
+    parser.add_argument("--style", default="normal")
+    parser.add_argument("--out", default="runs/bench_morphable")
+    parser.add_argument("--parts", default="k,dims,tree,path,tables")
+    parser.add_argument("--K", type=int, help="coefficients for dims (default: the fitted model's)")
+    parser.add_argument("--sfpca-iterations", type=int, default=15)
+    parser.add_argument("--constraints", type=int, default=200, help="per kind and primitive")
+    parser.add_argument("--candidates", type=int, nargs="*", default=[1, 2, 4])
+    parser.add_argument("--seeds", type=int, nargs="*", default=[0, 1, 2])
+    parser.add_argument("--samples", type=int, default=10_000)
+    args = parser.parse_args(argv)
+    b = Bench(args.data, Path(args.out), args.style)
+    parts = args.parts.split(",")
+    unknown = set(parts) - {"k", "dims", "tree", "path", "tables"}
+    if unknown:
+        parser.error(f"unknown parts {sorted(unknown)}")
+    if "k" in parts:
+        part_k(b)
+    if "dims" in parts:
+        part_dims(b, args.K, args.sfpca_iterations)
+    if "tree" in parts:
+        part_tree(b, args.constraints, args.candidates)
+    if "path" in parts:
+        part_path(b, args.seeds)
+    if "tables" in parts:
+        part_tables(b, args.samples)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
