@@ -38,17 +38,24 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--data", choices=("bandai", "synthetic"), default="bandai")
     parser.add_argument("--style", default="elderly")
     parser.add_argument("--content", default="walk")
+    parser.add_argument("--synthetic-takes", type=int, default=3, help="takes per content and style (synthetic)")
     args = parser.parse_args(argv)
-    data, train, test = benchmark_split(args.data)
-    take = next(t for t in test if t.content == args.content and t.style == "normal")
-    real = next(t for t in test if t.content == args.content and t.style == args.style)
+    data, train, test = benchmark_split(args.data, synthetic_takes=args.synthetic_takes)
+    def pick(style: str):  # a test take, else (small data sets) a train take, which then leaves the databases
+        found = [t for t in test if t.content == args.content and t.style == style]
+        found += [t for t in train if t.content == args.content and t.style == style]
+        if not found:
+            raise SystemExit(f"no {args.content} take of style {style} in {data.name}")
+        return found[0]
+
+    take, real = pick("normal"), pick(args.style)
     truth = np.asarray(take.positions, dtype=np.float64)
     legs = truth.copy()
     legs[:, UPPER] = np.nan
     rows = [{"kind": "real", "take": take.name, **posture(truth, data.fps)},
             {"kind": "real", "take": real.name, **posture(np.asarray(real.positions, np.float64), data.fps)}]
     for style in ("normal", args.style):
-        takes = [t for t in train if t.content == args.content and t.style == style]
+        takes = [t for t in train if t.content == args.content and t.style == style and t.name != take.name]
         database = MotionDatabase.from_takeset(TakeSet(data.name, takes, data.fps))
         done = MotionTexturer(database, "complete").apply(legs).positions
         rows.append({"kind": "completed", "take": take.name, "database": f"{args.content} {style}",

@@ -9,13 +9,13 @@ from collections.abc import Sequence
 from stylemotion.datasets import Take, TakeSet, load_dataset, spread_over_styles
 
 
-def benchmark_split(data: str, root: str | None = None, seed: int = 0,
-                    workers: int = 1) -> tuple[TakeSet, list[Take], list[Take]]:
+def benchmark_split(data: str, root: str | None = None, seed: int = 0, workers: int = 1,
+                    synthetic_takes: int = 1) -> tuple[TakeSet, list[Take], list[Take]]:
     """``(dataset, train takes, test takes)``: ``data="bandai"`` (``root`` or ``$STYLEMOTION_DATA``/
-    ``../shared/data``, 10 % test per content and style) or ``"synthetic"`` (one take per content and style,
-    15 % test per content)."""
+    ``../shared/data``, 10 % test per content and style) or ``"synthetic"`` (``synthetic_takes`` takes per content
+    and style, 15 % test per content)."""
     if data == "synthetic":
-        takeset = load_dataset("synthetic", takes_per_pair=1)
+        takeset = load_dataset("synthetic", takes_per_pair=synthetic_takes)
         parts = takeset.split(seed, 0.0, 0.15, group_by=("content",))
     elif data == "bandai":
         root = root or os.path.join(os.environ.get("STYLEMOTION_DATA", "../shared/data"), "bandai-namco-motion-2",
