@@ -5,7 +5,8 @@ parametrization, tensor truncation (Tables 4.1/4.4 analogues) and annotation spe
 
 Documents: ``--seconds`` long, test-split takes of random contents joined by ``--blend`` unlabelled frames
 (stylemotion.annotate.documents). Templates: ``--per-class`` train takes per content. Sub-class: the walk
-tensor (``--repetitions`` train takes per style) fits every test and validation walk take, and every walk
+tensor (``--repetitions`` train takes per style; accuracy also for 3, 5, 8, 12)
+fits every test and validation walk take, and every walk
 segment the annotation finds in the documents; the evaluation package's StyleClassifier, fitted on the same
 train walk takes, is the comparison. Prints markdown tables and writes ``results.json`` into ``--out``.
 """
@@ -39,6 +40,7 @@ from stylemotion.morphable.warping import resample
 from stylemotion.representation import positions_to_frames
 from stylemotion.skeleton import CANONICAL_PARENTS
 
+REPETITION_SWEEP = (3, 5, 8, 12)
 TAUS = (0.005, 0.01, 0.02, 0.03, 0.04, 0.05, 0.08, 0.13)
 
 
@@ -129,7 +131,13 @@ def subclass(split, repetitions, documents, distances, settings, model_classes):
             seg_total += 1
             seg_right += tensor.parametrize(doc.positions[s:e]).style == max(overlap)[1]
     counts = {s: int((truth == s).sum()) for s in tensor.styles}
-    return {"styles": list(tensor.styles), "repetitions": tensor.repetitions, "held_out_takes": len(held),
+    sweep = {}
+    for r in REPETITION_SWEEP:
+        if r <= min(len(v) for v in train.values()):
+            other = build_tensor("walk", train, 30.0, r)[0]
+            sweep[r] = round(float(np.mean([other.parametrize(t.positions).style == t.style for t in held])), 4)
+    return {"repetition_sweep": sweep, "styles": list(tensor.styles), "repetitions": tensor.repetitions,
+            "held_out_takes": len(held),
             "per_style": counts, "tensor_accuracy": round(tensor_acc, 4),
             "classifier_accuracy": round(report.accuracy, 4), "chance": round(1 / len(tensor.styles), 4),
             "majority": round(max(counts.values()) / len(held), 4), "fit_s_per_take": round(fit_s, 3),
@@ -180,7 +188,7 @@ def main() -> None:
     parser.add_argument("--seconds", type=float, default=40.0)
     parser.add_argument("--blend", type=int, default=8)
     parser.add_argument("--per-class", type=int, default=9)
-    parser.add_argument("--repetitions", type=int, default=5)
+    parser.add_argument("--repetitions", type=int, default=12)
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--out", default="runs/bench_annotate")
     args = parser.parse_args()

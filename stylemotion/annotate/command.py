@@ -47,7 +47,7 @@ class AnnotateInputError(ValueError):
 
 
 def learn(data: Mapping[str, Any], out: str | os.PathLike, *, per_class: int = 9, seed: int = 0,
-          repetitions: int | None = 5, tensors: bool = True, force: bool = False, say: Say = print,
+          repetitions: int | None = None, tensors: bool = True, force: bool = False, say: Say = print,
           command: str = "") -> AnnotationModel:
     """Learn templates (and tensors) from ``data``'s train split and write the folder ``out``."""
     out = check_new_output(out, force)
@@ -165,7 +165,7 @@ def annotate_from_config(cfg: DictConfig, say: Say = print, command: str = "") -
     force = bool(plain.get("force", False))
     if not plain.get("document"):
         return learn(plain["data"], plain["out"], per_class=plain.get("per_class", 9), seed=plain.get("seed", 0),
-                     repetitions=plain.get("repetitions", 5), tensors=bool(plain.get("tensors", True)), force=force,
+                     repetitions=plain.get("repetitions"), tensors=bool(plain.get("tensors", True)), force=force,
                      say=say, command=command)
     if not plain.get("templates"):
         raise AnnotateInputError("document= needs templates=<folder> (learn one with stylemotion-annotate "

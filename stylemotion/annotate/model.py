@@ -60,9 +60,9 @@ def choose_examples(takes: Sequence[Take], per_class: int, seed: int) -> dict[st
 
 
 def learn_model(train: Sequence[Take], fps: float, per_class: int = 9, seed: int = 0,
-                tensor_repetitions: int | None = 5, tensors: bool = True) -> AnnotationModel:
+                tensor_repetitions: int | None = None, tensors: bool = True) -> AnnotationModel:
     """Templates from ``per_class`` train takes of each content; tensors from all train takes of a content
-    (``tensor_repetitions`` per style, fewer where every style has fewer; styles with under two train takes
+    (``tensor_repetitions`` per style, None: as many as every style has; styles with under two train takes
     are left out, and a class with under two such styles gets no tensor).
 
     Raises:
