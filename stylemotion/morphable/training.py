@@ -21,7 +21,7 @@ import numpy as np
 from hydra.utils import instantiate
 from omegaconf import DictConfig, OmegaConf
 
-from stylemotion.config import set_torch_threads
+from stylemotion.config import ConfigError, set_torch_threads
 from stylemotion.io.atomic import atomic_write_bytes
 from stylemotion.io.outputs import OutputExistsError
 from stylemotion.morphable.model import FitSettings, MorphableModel, fit_primitive, reconstruction_error
@@ -52,9 +52,12 @@ def run(cfg: DictConfig) -> dict[str, Any]:
     model_cfg = OmegaConf.to_container(cfg.model, resolve=True)
     tree_cfg = model_cfg.pop("tree", None) or {}
     model_cfg.pop("family", None)
-    settings = FitSettings(**model_cfg)
-    model = fit_primitive(datamodule.clips["train"], settings,
-                          meta={"data": str(cfg.data.get("name")), "seed": int(cfg.seed)})
+    try:
+        settings = FitSettings(**model_cfg)
+        model = fit_primitive(datamodule.clips["train"], settings,
+                              meta={"data": str(cfg.data.get("name")), "seed": int(cfg.seed)})
+    except (TypeError, ValueError) as err:  # a bad model.* value, too few clips, a mixture that cannot be fitted
+        raise ConfigError(f"experiment=morphable_graph, {action}_{primitive}: {err}") from err
     if tree_cfg.get("samples", 0):
         model.build_tree(int(tree_cfg["samples"]), str(tree_cfg.get("split", "kmeans")), int(cfg.seed),
                          leaf_size=int(tree_cfg.get("leaf_size", 16)))

@@ -55,3 +55,17 @@ def test_held_out_clips_reconstruct(left_model, left_clips):
     train = reconstruction_error(left_model, left_clips["train"])
     test = reconstruction_error(left_model, left_clips["test"])
     assert 0 < train < 0.05 and 0 < test < 0.08
+
+
+def test_the_frames_representation_samples_too(left_clips):
+    from stylemotion.morphable import FitSettings, fit_primitive
+
+    model = fit_primitive(left_clips["train"], FitSettings(representation="frames", latent_dim=4,
+                                                           reduction="normalized", num_coefficients=6))
+    s = model.sample(5, seed=0)
+    assert s.frames.shape[-1] == 66 and torch.isfinite(s.positions).all()
+    # frames are the channels themselves: the positions are their integration
+    first = s.motion(0).numpy()
+    assert np.linalg.norm(first[-1, 0, [0, 2]] - first[0, 0, [0, 2]]) > 0.3  # it walks forward a step
+    with pytest.raises(ValueError, match="orientations need the quaternion representation"):
+        model.canonical_positions(s.latent.numpy(), rotations=True)
