@@ -14,7 +14,10 @@ Parts (each prints JSON lines, also appended to ``<out>/morphable.jsonl``):
   median trees, the best of 100 random samples, and brute force over the tree's 10,000 codes;
 * ``path``: the 10 m S-curve of ``stylemotion-generate`` with the two stance models (seeds 0 1 2);
 * ``tables`` (Tables 5.2/5.3): pose_SD, V_SD, step_SD of 10,000 samples per stance model against the
-  training clips, and the model size against the training data's.
+  training clips, and the model size against the training data's;
+* ``density`` (Fig. 4.9): the left foot at the last frame, mocap against 60,000 samples (``density_foot_l.png``);
+* ``latent`` (Fig. 3.11): t-SNE of the training clips' 20-dimensional codes per method, coloured by content,
+  and how often a code's 5 nearest neighbours share its content (``latent_tsne.png``).
 
 Models are fitted once into ``<out>/models/<primitive>/model.npz`` (default settings, the neutral style)
 and reused by later runs.
@@ -199,6 +202,75 @@ def part_tables(b: Bench, samples: int) -> None:
                 - model.tree.centroid.nbytes - model.tree.children.nbytes, "training_positions_bytes": data_bytes})
 
 
+def part_density(b: Bench, samples: int) -> None:
+    """Fig. 4.9: the left foot at the last frame of walk_leftStance, mocap against ``samples`` model samples."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    model, clips = b.model("walk_leftStance"), b.clips("walk_leftStance")["train"]
+    foot = CANONICAL_JOINTS.index("Foot_L")
+    real = np.stack([c.positions[-1, foot] for c in clips])
+    fake = model.poses_at(model.gmm.sample(samples, 0), [model.length - 1])[:, 0, foot]
+    fig, axes = plt.subplots(2, 2, figsize=(8, 7))
+    for row, (points, name) in enumerate(((real, f"motion capture ({len(real)} clips)"),
+                                          (fake, f"Morphable Graph ({samples:,} samples)"))):
+        for col, (i, j, label) in enumerate(((0, 2, "x (left) / z (forward), m"), (0, 1, "x / y (up), m"))):
+            axes[row, col].hexbin(points[:, i], points[:, j], gridsize=40, cmap="viridis", mincnt=1,
+                                  extent=(real[:, i].min() - 0.1, real[:, i].max() + 0.1,
+                                          real[:, j].min() - 0.1, real[:, j].max() + 0.1))
+            axes[row, col].set_title(f"{name}: {label}", fontsize=8)
+    fig.suptitle(f"{b.data_name} walk_leftStance: Foot_L at the last frame (Fig. 4.9)", fontsize=9)
+    fig.tight_layout()
+    path = b.out / "density_foot_l.png"
+    fig.savefig(path, dpi=80)
+    plt.close(fig)
+    inside = np.mean([(fake[:, k] >= np.quantile(real[:, k], 0.005)) & (fake[:, k] <= np.quantile(real[:, k], 0.995))
+                      for k in range(3)], axis=0).mean()
+    b.emit({"part": "density", "samples": samples, "figure": str(path), "real_mean_m": real.mean(0).tolist(),
+            "samples_mean_m": fake.mean(0).tolist(), "real_sd_m": real.std(0).tolist(),
+            "samples_sd_m": fake.std(0).tolist(),
+            "samples_inside_real_range": float(inside)})
+
+
+def part_latent(b: Bench, k: int | None, iterations: int, dims: int = 20) -> None:
+    """Fig. 3.11: 2-D t-SNE of the latent codes of walk_leftStance's training clips by method, coloured by content
+    (walk / walk-turn-left / walk-turn-right); the agreement of each code's 5 nearest neighbours' content."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from sklearn.manifold import TSNE
+    from sklearn.model_selection import cross_val_score
+    from sklearn.neighbors import KNeighborsClassifier
+
+    clips = b.clips("walk_leftStance")["train"]
+    data = functional_data(clips)
+    basis = SplineBasis(k or b.model("walk_leftStance").basis.num_coefficients)
+    vectors, groups, _ = coefficient_vectors(data, basis)
+    error = joint_error_function(data, basis, vectors)
+    labels = np.array([c.content for c in clips])
+    names = sorted(set(labels))
+    fig, axes = plt.subplots(1, len(METHODS), figsize=(4 * len(METHODS), 4))
+    for ax, method in zip(axes, METHODS):
+        pca, _ = fit_reduction(vectors, groups, dims, method, error, iterations)
+        codes = pca.project(vectors)
+        codes = codes / codes.std()
+        knn = float(cross_val_score(KNeighborsClassifier(5), codes, labels, cv=5).mean())
+        xy = TSNE(2, random_state=0, init="pca", perplexity=30).fit_transform(codes)
+        for name in names:
+            ax.scatter(*xy[labels == name].T, s=6, label=name)
+        ax.set_title(f"{method}: 5-NN content accuracy {knn:.2f}", fontsize=9)
+        b.emit({"part": "latent", "method": method, "dims": dims, "knn5_content_accuracy": knn,
+                "contents": {n: int((labels == n).sum()) for n in names}})
+    axes[0].legend(fontsize=7)
+    fig.suptitle(f"{b.data_name} walk_leftStance latent codes ({dims} dims), t-SNE (Fig. 3.11)", fontsize=9)
+    fig.tight_layout()
+    fig.savefig(b.out / "latent_tsne.png", dpi=80)
+    plt.close(fig)
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--data", default="bandai")
@@ -214,7 +286,7 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     b = Bench(args.data, Path(args.out), args.style)
     parts = args.parts.split(",")
-    unknown = set(parts) - {"k", "dims", "tree", "path", "tables"}
+    unknown = set(parts) - {"k", "dims", "tree", "path", "tables", "density", "latent"}
     if unknown:
         parser.error(f"unknown parts {sorted(unknown)}")
     if "k" in parts:
@@ -227,6 +299,10 @@ def main(argv: list[str] | None = None) -> int:
         part_path(b, args.seeds)
     if "tables" in parts:
         part_tables(b, args.samples)
+    if "density" in parts:
+        part_density(b, 60_000)
+    if "latent" in parts:
+        part_latent(b, args.K, args.sfpca_iterations)
     return 0
 
 
