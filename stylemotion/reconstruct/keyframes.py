@@ -12,17 +12,20 @@ Between every two consecutive keys ``k_i → k_{i+1}`` (docs/reconstruct.md, "Dy
    feet's contact state changes (at least ``min_segment_frames``, at most ``max_segment_s``); the segment is an
    edge, its last (O) / first (I) frame a new node. Each iteration expands the ``b`` best unexpanded nodes of
    each tree by ``D_node`` (eq. 4.12: the distance of hands, feet and head, summed, to the nearest node of the
-   other tree, eq. 4.13), so the trees grow towards each other; nothing is discarded.
+   other tree, eq. 4.13, plus ``facing_weight_m`` × their facing difference — our addition), so the trees grow
+   towards each other; nothing is discarded.
 3. **Connections.** The Hips of every incoming frame go into a spatial hash of ``voxel_m`` voxels; every
    outgoing frame looks in its 27 neighbouring voxels. A pair connects when the Hips are within ``voxel_m``,
    the facings within ``max_turn_deg``, the body-frame hands/feet/head within ``max_pose_m`` (mean) and the
    body-frame root velocities within ``max_velocity_m_s`` (our additions: the thesis blends any close frames).
-   The search stops in the first iteration that finds connections (or fails after ``max_iterations``).
+   The search stops ``extra_iterations`` after the first iteration that finds connections (the thesis: at once)
+   or fails after ``max_iterations``.
 4. **Path.** Each connection closes one path key → O-edges → blend → I-edges → key (the graph of the two trees
    and the connecting edges is a DAG and each connection is its own path through it): the cheapest by
-   ``C_edge`` (eq. 4.14: the speed of every joint summed over the frames, in metres) plus ``duration_weight``
-   × the frames missing or too many against the keys' time difference, each frame priced at the database's
-   median ``C_edge`` per frame (our addition: the thesis has no timing term).
+   ``C_edge`` (eq. 4.14: the speed of every joint summed over the frames, in metres) plus — our additions —
+   ``duration_weight`` × the frames missing or too many against the keys' time difference, each frame priced at
+   the database's median ``C_edge`` per frame, and ``key_weight`` × the distance (summed over joints, metres) of
+   the path's first and last database poses to the keys.
 5. **Blend.** ``blend_frames`` frames around the connection: placement (ground point, yaw) and body-frame pose
    blended with smoothstep weights between the outgoing segment (continued in its database take) and the
    incoming one (started earlier in its take).
