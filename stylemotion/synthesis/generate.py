@@ -70,12 +70,31 @@ def path_from_config(node: Mapping[str, Any]) -> GroundPath:
                    float(curve.get("waves", 1.0)))
 
 
-def bvh_round_trip_error(bvh: Path, positions: np.ndarray, fps: float) -> float:
-    """MPJPE (m) between ``positions`` and the BVH file read back by the project's own loader."""
+def bvh_round_trip_error(bvh: Path, positions: np.ndarray, fps: float) -> tuple[float, float]:
+    """Mean and largest joint distance (m) between ``positions`` and the BVH file read back by the project's own
+    loader."""
     back = load_canonical_positions(FileSource(str(bvh)), ConversionSettings(fps=fps))
     if back.shape != positions.shape:
         raise RuntimeError(f"{bvh} reads back as {back.shape}, expected {positions.shape}")
-    return float(np.linalg.norm(back - positions, axis=-1).mean())
+    distance = np.linalg.norm(back - positions, axis=-1)
+    return float(distance.mean()), float(distance.max())
+
+
+def rigid_bones(positions: np.ndarray) -> tuple[np.ndarray, dict[str, float]]:
+    """``positions`` ``(frames, 21, 3)`` with every bone at its median length (directions kept, placed from the
+    root outwards: :func:`stylemotion.retarget.retarget_positions`), and what that changed: the largest relative
+    spread of a bone's length before (``(max − min) / median``) and the mean and largest joint shift (m). The
+    decoder's positions stretch bones from frame to frame, which no skeleton of a BVH file can follow."""
+    from stylemotion.retarget import BONE_JOINTS, median_bone_lengths, retarget_positions
+    from stylemotion.skeleton import bone_lengths
+
+    lengths = bone_lengths(np.asarray(positions, dtype=np.float64))[:, list(BONE_JOINTS)]
+    median = median_bone_lengths(positions)
+    spread = float(((lengths.max(0) - lengths.min(0)) / np.maximum(median, 1e-9)).max())
+    fixed = retarget_positions(positions, median)
+    shift = np.linalg.norm(fixed - positions, axis=-1)
+    return fixed, {"bone_length_spread_before": spread, "mean_shift_m": float(shift.mean()),
+                   "max_shift_m": float(shift.max())}
 
 
 def real_foot_skating(run: str | Path | None, style: str) -> float | None:
@@ -104,7 +123,8 @@ def write_outputs(motion: SynthesizedMotion, folder: Path, outputs: Mapping[str,
     figures: dict[str, Any] = {}
     if outputs.get("bvh", True):
         write_motion_bvh(motion.positions, folder / "motion.bvh", motion.fps)
-        figures["bvh_reimport_mpjpe_m"] = bvh_round_trip_error(folder / "motion.bvh", motion.positions, motion.fps)
+        mean, largest = bvh_round_trip_error(folder / "motion.bvh", motion.positions, motion.fps)
+        figures["bvh_reimport_mpjpe_m"], figures["bvh_reimport_max_m"] = mean, largest
     keys = [s.start_frame for s in motion.steps[1:]]
     if outputs.get("gif", True):
         save_walk_animation(motion.positions, motion.fps, motion.path.points, folder / "motion.gif", keys, title)
@@ -135,11 +155,16 @@ def generate(cfg: DictConfig | Mapping[str, Any], command: str = "") -> dict[str
                           f"the chosen model config has family {kind!r}")
     settings = FollowSettings(**(cfg.get("follow") or {}))
     motion = follow_path(graph, path, seed=int(cfg.get("seed", 0)), settings=settings)
+    rigid = None
+    if cfg.get("rigid_bones", True):
+        positions, rigid = rigid_bones(motion.positions)
+        motion = replace(motion, positions=positions.astype(np.float32))
     raw_skating, _ = skating(motion.positions, motion.fps)
     if cfg.get("clean_feet", True):
         motion = replace(motion, positions=clean_foot_skating(motion.positions, motion.fps).astype(np.float32))
     summary = walk_figures(motion)
     summary["foot_skating_ratio_before_cleanup"] = raw_skating
+    summary["rigid_bones"] = rigid
     style = graph.style if graph.style != NEUTRAL else str(cfg.get("neutral_style", "normal"))
     summary["real_foot_skating_ratio"] = real_foot_skating(cfg.get("run") if kind == "vae" else None, graph.style)
     title = (f"{graph.action} · {graph.style} · seed {cfg.get('seed', 0)} · {path.length:.1f} m path · "

@@ -16,6 +16,7 @@ from vae_fixtures import feature_module, fit, tiny_autoencoder_ckpt
 from stylemotion.io.outputs import OutputExistsError
 from stylemotion.models.vae import PrimitiveVAE
 from stylemotion.representation import frames_to_positions, positions_to_frames
+from stylemotion.skeleton import bone_lengths
 from stylemotion.synthesis import (
     FollowSettings,
     GroundPath,
@@ -262,6 +263,11 @@ def test_generate_writes_motion_bvh_gif_and_summary(tmp_path: Path, tiny_models)
                 "bvh_reimport_mpjpe_m", "synthesis_seconds", "meta", "steps_detail"):
         assert key in on_disk, key
     assert summary["bvh_reimport_mpjpe_m"] < 0.02
+    # rigid bones: every bone of motion.npz keeps one length, so the BVH reads back with every joint within 1 cm
+    assert summary["bvh_reimport_max_m"] < 0.01 and summary["rigid_bones"]["bone_length_spread_before"] > 0
+    with np.load(out / "motion.npz") as npz:
+        lengths = bone_lengths(npz["positions"].astype(np.float64))[:, 1:]
+    assert float((lengths.max(0) - lengths.min(0)).max()) < 1e-4
     assert (out / "motion.gif").stat().st_size > 10_000 and (out / "motion.bvh").is_file()
     with pytest.raises(OutputExistsError, match="exists"):
         generate(cfg)
