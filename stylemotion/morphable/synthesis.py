@@ -32,6 +32,7 @@ import torch
 from scipy.optimize import least_squares
 from scipy.spatial.transform import Rotation
 
+from stylemotion.config import ConfigError
 from stylemotion.geometry import rotate_yaw, rotate_yaw_xz, wrap_angle
 from stylemotion.morphable.constraints import KeyframeConstraint, constraint_errors, objective
 from stylemotion.morphable.model import MorphableModel
@@ -251,15 +252,18 @@ def load_morphable_graph(models: Mapping[str, str | Path], action: str = "walk",
     from stylemotion.synthesis.graph import MotionGraph, _short
 
     if not models:
-        raise ValueError("model=morphable needs models={walk_leftStance: <run folder or model.npz>, "
-                         "walk_rightStance: …}")
+        raise ConfigError("model=morphable needs +models.walk_leftStance=<run folder or model.npz> "
+                          "+models.walk_rightStance=<…>")
     loaded, sources = {}, {}
     for key, path in sorted(models.items()):
         primitive = _short(str(key), action)
-        model = MorphableModel.load(path)
+        try:
+            model = MorphableModel.load(path)
+        except (OSError, ValueError, KeyError) as err:
+            raise ConfigError(f"models.{key}={path}: {err}") from err
         have = f"{model.meta.get('action')}_{model.meta.get('primitive')}"
         if have != f"{action}_{primitive}":
-            raise ValueError(f"models.{key}={path} holds a {have} model, not {action}_{primitive}")
+            raise ConfigError(f"models.{key}={path} holds a {have} model, not {action}_{primitive}")
         loaded[primitive], sources[primitive] = MorphablePrimitive(model, settings), str(model.meta["path"])
     styles = {m.model.meta.get("style") for m in loaded.values()}
     return MotionGraph(action=action, style="/".join(sorted(str(s) for s in styles)), models=loaded, sources=sources)

@@ -75,6 +75,8 @@ def test_path_following_through_the_controller(left_model, right_model, tmp_path
     saved = json.loads((tmp_path / "g" / "summary.json").read_text())
     assert saved["meta"]["model"] == "morphable" and saved["deviation"]["mean_m"] == summary["deviation"]["mean_m"]
     assert summary["deviation"]["mean_m"] < 0.15  # the end may be up to half a step short (the controller's rule)
+    with pytest.raises(ValueError, match="no morphable model at"):
+        generate({**cfg, "out": str(tmp_path / "h"), "models": {**paths, "walk_rightStance": str(tmp_path / "none")}})
     with pytest.raises(ValueError, match="holds a walk_leftStance model, not walk_rightStance"):
         generate({**cfg, "out": str(tmp_path / "h"), "models": {"walk_rightStance": paths["walk_leftStance"],
                                                                  "walk_leftStance": paths["walk_leftStance"]}})
