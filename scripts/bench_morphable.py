@@ -16,6 +16,11 @@ Parts (each prints JSON lines, also appended to ``<out>/morphable.jsonl``):
 * ``tables`` (Tables 5.2/5.3): pose_SD, V_SD, step_SD of 10,000 samples per stance model against the
   training clips, and the model size against the training data's;
 * ``density`` (Fig. 4.9): the left foot at the last frame, mocap against 60,000 samples (``density_foot_l.png``);
+* ``vae`` (Fig. 3.10's fourth curve, with ``--vae-run``): the walk_leftStance VAE of a finished
+  ``stylemotion-reproduce`` run on the same training clips: posterior mean → decoder → autoencoder →
+  positions against the recorded clips (joint-space RMSE, m) and against the autoencoder's own
+  reconstruction (the VAE's compression alone), the unexplained share of its input's variance, and the
+  three FPCA variants at the VAE's latent size for comparison;
 * ``latent`` (Fig. 3.11): t-SNE of the training clips' 20-dimensional codes per method, coloured by content,
   and how often a code's 5 nearest neighbours share its content (``latent_tsne.png``).
 
@@ -234,6 +239,65 @@ def part_density(b: Bench, samples: int) -> None:
             "samples_inside_real_range": float(inside)})
 
 
+def part_vae(b: Bench, run_folder: Path, k: int | None, iterations: int) -> None:
+    """Fig. 3.10's fourth curve: the run's walk_leftStance VAE on the training clips of the FPCA curves."""
+    import torch
+
+    from stylemotion.datamodules.features import encode_frames
+    from stylemotion.finished_run import FinishedRun, read_json_object
+    from stylemotion.models.checkpoints import load_generative
+    from stylemotion.sampling import decode_features
+
+    primitive = "walk_leftStance"
+    run = FinishedRun(run_folder, read_json_object(run_folder / "reproduce.json", "reproduce.json"), {})
+    stages = [s for s in run.stages("vae") if (s.get("values") or {}).get("primitive") == primitive]
+    if not stages:
+        raise SystemExit(f"--vae-run {run_folder}: its reproduce.json has no vae stage of {primitive}")
+    ckpt = run.located(stages[0]["checkpoint"])
+    vae = load_generative(ckpt)
+    clips = b.clips(primitive)["train"]
+    spec = vae.spec
+    if spec["clips"]["train"] != len(clips) or spec["content_styles"] != [b.style]:
+        raise SystemExit(f"--vae-run {run_folder}: {ckpt} was trained on {spec['clips']['train']} clips of "
+                         f"{spec['content_styles']}, these are {len(clips)} of [{b.style!r}]")
+    length, fps = vae.timeline_frames, vae.fps
+    began = time.perf_counter()
+    features = encode_frames(vae.autoencoder, np.stack([time_normalize(c.frames, length) for c in clips]))
+    duration = torch.tensor([c.duration_s for c in clips], dtype=torch.float32)
+    recon = vae.reconstruct(features, duration)
+    floor = decode_features(vae.autoencoder, features, duration, length, fps)
+    seconds = time.perf_counter() - began
+    recorded, _ = pad_motions([c.positions for c in clips])
+    if recon.positions.shape != recorded.shape or not torch.equal(recon.num_frames, floor.num_frames):
+        raise SystemExit(f"reconstructions {tuple(recon.positions.shape)} do not match the clips "
+                         f"{tuple(recorded.shape)}: durations changed the frame counts")
+    valid = (torch.arange(recorded.shape[1])[None] < recon.num_frames[:, None]).numpy()
+
+    def rmse(a: torch.Tensor, ref: torch.Tensor) -> float:
+        return float(np.sqrt((((a - ref) ** 2).sum(-1).mean(-1)).numpy()[valid].mean()))
+
+    with torch.no_grad():
+        y = vae.normalize(features, duration)
+        rebuilt = vae.net.decode(vae.net.encode(y)[0])
+    unexplained = float(((rebuilt - y) ** 2).sum() / ((y - y.mean(0)) ** 2).sum())
+    b.emit({"part": "vae", "primitive": primitive, "checkpoint": str(ckpt), "dims": vae.hparams.latent_dim,
+            "clips": len(clips), "feature_unexplained": unexplained,
+            "joint_rmse_m": rmse(recon.positions, recorded), "joint_rmse_vs_autoencoder_m": rmse(recon.positions,
+                                                                                                 floor.positions),
+            "autoencoder_rmse_m": rmse(floor.positions, recorded), "seconds": seconds, "load": os.getloadavg()[0]})
+    data = functional_data(clips)
+    basis = SplineBasis(k or b.model(primitive).basis.num_coefficients)
+    vectors, groups, _ = coefficient_vectors(data, basis)
+    error = joint_error_function(data, basis, vectors)
+    total = ((vectors - vectors.mean(0)) ** 2).sum()
+    for method in METHODS:
+        pca, record = fit_reduction(vectors, groups, vae.hparams.latent_dim, method, error, iterations)
+        back = pca.reconstruct(pca.project(vectors))
+        b.emit({"part": "dims", "primitive": primitive, "K": basis.num_coefficients, "dims": vae.hparams.latent_dim,
+                "method": method, "feature_unexplained": float(((back - vectors) ** 2).sum() / total),
+                "joint_rmse_m": float(np.sqrt(error(back))), "sfpca_start": record.get("start")})
+
+
 def part_latent(b: Bench, k: int | None, iterations: int, dims: int = 20) -> None:
     """Fig. 3.11: 2-D t-SNE of the latent codes of walk_leftStance's training clips by method, coloured by content
     (walk / walk-turn-left / walk-turn-right); the agreement of each code's 5 nearest neighbours' content."""
@@ -283,10 +347,11 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--candidates", type=int, nargs="*", default=[1, 2, 4])
     parser.add_argument("--seeds", type=int, nargs="*", default=[0, 1, 2])
     parser.add_argument("--samples", type=int, default=10_000)
+    parser.add_argument("--vae-run", type=Path, help="a finished stylemotion-reproduce run folder (part vae)")
     args = parser.parse_args(argv)
     b = Bench(args.data, Path(args.out), args.style)
     parts = args.parts.split(",")
-    unknown = set(parts) - {"k", "dims", "tree", "path", "tables", "density", "latent"}
+    unknown = set(parts) - {"k", "dims", "tree", "path", "tables", "density", "latent", "vae"}
     if unknown:
         parser.error(f"unknown parts {sorted(unknown)}")
     if "k" in parts:
@@ -303,6 +368,10 @@ def main(argv: list[str] | None = None) -> int:
         part_density(b, 60_000)
     if "latent" in parts:
         part_latent(b, args.K, args.sfpca_iterations)
+    if "vae" in parts:
+        if args.vae_run is None:
+            parser.error("part vae needs --vae-run <finished stylemotion-reproduce run folder>")
+        part_vae(b, args.vae_run, args.K, args.sfpca_iterations)
     return 0
 
 
