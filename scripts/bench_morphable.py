@@ -21,6 +21,11 @@ Parts (each prints JSON lines, also appended to ``<out>/morphable.jsonl``):
   positions against the recorded clips (joint-space RMSE, m) and against the autoencoder's own
   reconstruction (the VAE's compression alone), the unexplained share of its input's variance, and the
   three FPCA variants at the VAE's latent size for comparison;
+* ``arm`` (Fig. 3.9/3.10 for an arm primitive, and a keyframe constraint): ``raise`` clips of the
+  ``--arm-content`` takes (:mod:`stylemotion.morphable.arm`), spline RMSE against ``K``, the three reductions
+  against latent dimensions, a model fitted with the default settings, and the hand reaching targets at the
+  primitive's last frame (the held-out clips' own end positions, and random points of the box the training
+  clips' end positions span): error of the mean motion, of the tree's candidate and after the MAP solve;
 * ``latent`` (Fig. 3.11): t-SNE of the training clips' 20-dimensional codes per method, coloured by content,
   and how often a code's 5 nearest neighbours share its content (``latent_tsne.png``).
 
@@ -47,7 +52,13 @@ from stylemotion.morphable import FitSettings, MorphableModel, fit_primitive
 from stylemotion.morphable.bspline import SplineBasis
 from stylemotion.morphable.constraints import KeyframeConstraint, objective
 from stylemotion.morphable.fpca import METHODS, fit_reduction
-from stylemotion.morphable.model import coefficient_vectors, functional_data, joint_error_function, spline_rmse
+from stylemotion.morphable.model import (
+    coefficient_vectors,
+    functional_data,
+    joint_error_function,
+    reconstruction_error,
+    spline_rmse,
+)
 from stylemotion.morphable.tree import SpaceTree, brute_force
 from stylemotion.primitives import parse_primitive, time_normalize
 from stylemotion.sampling import pad_motions
@@ -103,10 +114,11 @@ def part_k(b: Bench) -> None:
                     "joint_rmse_m": spline_rmse(data, k)})
 
 
-def part_dims(b: Bench, k: int | None, iterations: int) -> None:
-    clips = b.clips("walk_leftStance")["train"]
+def part_dims(b: Bench, k: int | None, iterations: int, primitive: str = "walk_leftStance",
+              clips: list | None = None) -> None:
+    clips = b.clips(primitive)["train"] if clips is None else clips
     data = functional_data(clips)
-    k = k or b.model("walk_leftStance").basis.num_coefficients
+    k = k or b.model(primitive).basis.num_coefficients
     basis = SplineBasis(k)
     vectors, groups, _ = coefficient_vectors(data, basis)
     error = joint_error_function(data, basis, vectors)
@@ -118,7 +130,7 @@ def part_dims(b: Bench, k: int | None, iterations: int) -> None:
             began = time.perf_counter()
             pca, record = fit_reduction(vectors, groups, dims, method, error, iterations)
             rebuilt = pca.reconstruct(pca.project(vectors))
-            b.emit({"part": "dims", "primitive": "walk_leftStance", "K": k, "dims": dims, "method": method,
+            b.emit({"part": "dims", "primitive": primitive, "K": k, "dims": dims, "method": method,
                     "feature_unexplained": float(((rebuilt - vectors) ** 2).sum() / total),
                     "joint_rmse_m": float(np.sqrt(error(rebuilt))), "seconds": time.perf_counter() - began,
                     "sfpca_start": record.get("start")})
@@ -298,6 +310,67 @@ def part_vae(b: Bench, run_folder: Path, k: int | None, iterations: int) -> None
                 "joint_rmse_m": float(np.sqrt(error(back))), "sfpca_start": record.get("start")})
 
 
+def part_arm(b: Bench, content: str, iterations: int, targets: int = 50) -> None:
+    """An arm primitive (``content``'s ``raise`` clips): Fig. 3.9, Fig. 3.10, a model, and hand keyframes."""
+    from stylemotion.datasets.registry import build_dataset
+    from stylemotion.morphable.arm import arm_clips
+    from stylemotion.morphable.synthesis import MapSettings, UnreachableConstraintWarning, solve_constraints
+
+    takes = build_dataset(b.data).split(**b.data.get("split", {}))
+    clips, rejected = {}, {}
+    for part in ("train", "test"):
+        clips[part], rejected[part] = arm_clips([t for t in takes[part] if t.style == b.style], content, "raise")
+    name = f"{content}_raise"
+    data = functional_data(clips["train"])
+    b.emit({"part": "arm_clips", "primitive": name, "clips": {p: len(c) for p, c in clips.items()},
+            "rejected": rejected, "timeline": data.length,
+            "frames": [int(min(c.num_frames for c in clips["train"])), int(max(c.num_frames for c in clips["train"]))]})
+    for k in range(4, data.length + 1):
+        b.emit({"part": "k", "primitive": name, "K": k, "clips": len(data.aligned), "timeline": data.length,
+                "joint_rmse_m": spline_rmse(data, k)})
+    path = b.out / "models" / name / "model.npz"
+    if path.is_file():
+        model = MorphableModel.load(path)
+    else:
+        began = time.perf_counter()
+        model = fit_primitive(clips["train"], FitSettings(), meta={"data": b.data_name, "action": content,
+                                                                   "primitive": "raise"})
+        model.build_tree()
+        model.save(path)
+        b.emit({"part": "fit", "primitive": name, "seconds_with_tree": time.perf_counter() - began,
+                **{k: model.meta["fit"][k] for k in ("clips", "joint_rmse_m", "gmm_components")},
+                "num_coefficients": model.basis.num_coefficients, "timeline": model.length,
+                "test_joint_rmse_m": reconstruction_error(model, clips["test"]), "load": os.getloadavg()[0]})
+    part_dims(b, model.basis.num_coefficients, iterations, name, clips["train"])
+    hand = "Hand_L" if "left" in content else "Hand_R"
+    j = CANONICAL_JOINTS.index(hand)
+    ends = np.stack([c.positions[-1, j] for c in clips["train"]])
+    rng = np.random.default_rng(0)
+    goals = {"held-out clip": [c.positions[-1, j] for c in clips["test"]],
+             "box of training ends": list(rng.uniform(ends.min(0), ends.max(0), (targets, 3)))}
+    mean_code = (model.gmm.weights[:, None] * model.gmm.means).sum(0)
+    mean_hand = model.poses_at(mean_code[None], [model.length - 1])[0, 0, j]
+    for scale in (0.02, 0.005):
+        for kind, points in goals.items():
+            rows = []
+            for target in points:
+                with warnings.catch_warnings():
+                    warnings.simplefilter("ignore", UnreachableConstraintWarning)
+                    began = time.perf_counter()
+                    result = solve_constraints(model, [KeyframeConstraint("position", target, joint=hand)],
+                                               MapSettings(constraint_scale_m=scale))
+                rows.append((float(np.linalg.norm(mean_hand - target)), result.start_errors_m[0], result.errors_m[0],
+                             result.evaluations, time.perf_counter() - began,
+                             result.neg_log_prior))
+            r = np.array(rows)
+            b.emit({"part": "arm_keyframe", "primitive": name, "joint": hand, "targets": kind, "count": len(rows),
+                    "constraint_scale_m": scale, "median_mean_motion_m": float(np.median(r[:, 0])),
+                    "median_tree_m": float(np.median(r[:, 1])), "median_map_m": float(np.median(r[:, 2])),
+                    "max_map_m": float(r[:, 2].max()), "share_within_2cm": float((r[:, 2] <= 0.02).mean()),
+                    "median_evaluations": float(np.median(r[:, 3])), "median_seconds": float(np.median(r[:, 4])),
+                    "median_neg_log_prior": float(np.median(r[:, 5])), "load": os.getloadavg()[0]})
+
+
 def part_latent(b: Bench, k: int | None, iterations: int, dims: int = 20) -> None:
     """Fig. 3.11: 2-D t-SNE of the latent codes of walk_leftStance's training clips by method, coloured by content
     (walk / walk-turn-left / walk-turn-right); the agreement of each code's 5 nearest neighbours' content."""
@@ -347,11 +420,12 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--candidates", type=int, nargs="*", default=[1, 2, 4])
     parser.add_argument("--seeds", type=int, nargs="*", default=[0, 1, 2])
     parser.add_argument("--samples", type=int, default=10_000)
+    parser.add_argument("--arm-content", default="raise-up-left-hand", help="arm takes of part arm")
     parser.add_argument("--vae-run", type=Path, help="a finished stylemotion-reproduce run folder (part vae)")
     args = parser.parse_args(argv)
     b = Bench(args.data, Path(args.out), args.style)
     parts = args.parts.split(",")
-    unknown = set(parts) - {"k", "dims", "tree", "path", "tables", "density", "latent", "vae"}
+    unknown = set(parts) - {"k", "dims", "tree", "path", "tables", "density", "latent", "vae", "arm"}
     if unknown:
         parser.error(f"unknown parts {sorted(unknown)}")
     if "k" in parts:
@@ -368,6 +442,8 @@ def main(argv: list[str] | None = None) -> int:
         part_density(b, 60_000)
     if "latent" in parts:
         part_latent(b, args.K, args.sfpca_iterations)
+    if "arm" in parts:
+        part_arm(b, args.arm_content, args.sfpca_iterations)
     if "vae" in parts:
         if args.vae_run is None:
             parser.error("part vae needs --vae-run <finished stylemotion-reproduce run folder>")
