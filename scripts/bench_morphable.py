@@ -26,6 +26,8 @@ Parts (each prints JSON lines, also appended to ``<out>/morphable.jsonl``):
   against latent dimensions, a model fitted with the default settings, and the hand reaching targets at the
   primitive's last frame (the held-out clips' own end positions, and random points of the box the training
   clips' end positions span): error of the mean motion, of the tree's candidate and after the MAP solve;
+* ``rows`` (Tables 5.1–5.3, with ``--vae-run``): the run's evaluation (its VAEs and CVAEs, its settings) with the
+  two stance models as ``morphable`` extra rows (:mod:`stylemotion.morphable.rows`), report in ``<out>/report``;
 * ``latent`` (Fig. 3.11): t-SNE of the training clips' 20-dimensional codes per method, coloured by content,
   and how often a code's 5 nearest neighbours share its content (``latent_tsne.png``).
 
@@ -115,7 +117,7 @@ def part_k(b: Bench) -> None:
 
 
 def part_dims(b: Bench, k: int | None, iterations: int, primitive: str = "walk_leftStance",
-              clips: list | None = None) -> None:
+              clips: list | None = None, counts: tuple[int, ...] = DIMS) -> None:
     clips = b.clips(primitive)["train"] if clips is None else clips
     data = functional_data(clips)
     k = k or b.model(primitive).basis.num_coefficients
@@ -123,7 +125,7 @@ def part_dims(b: Bench, k: int | None, iterations: int, primitive: str = "walk_l
     vectors, groups, _ = coefficient_vectors(data, basis)
     error = joint_error_function(data, basis, vectors)
     total = ((vectors - vectors.mean(0)) ** 2).sum()
-    for dims in DIMS:
+    for dims in counts:
         if dims >= len(vectors):
             continue
         for method in METHODS:
@@ -297,17 +299,7 @@ def part_vae(b: Bench, run_folder: Path, k: int | None, iterations: int) -> None
             "joint_rmse_m": rmse(recon.positions, recorded), "joint_rmse_vs_autoencoder_m": rmse(recon.positions,
                                                                                                  floor.positions),
             "autoencoder_rmse_m": rmse(floor.positions, recorded), "seconds": seconds, "load": os.getloadavg()[0]})
-    data = functional_data(clips)
-    basis = SplineBasis(k or b.model(primitive).basis.num_coefficients)
-    vectors, groups, _ = coefficient_vectors(data, basis)
-    error = joint_error_function(data, basis, vectors)
-    total = ((vectors - vectors.mean(0)) ** 2).sum()
-    for method in METHODS:
-        pca, record = fit_reduction(vectors, groups, vae.hparams.latent_dim, method, error, iterations)
-        back = pca.reconstruct(pca.project(vectors))
-        b.emit({"part": "dims", "primitive": primitive, "K": basis.num_coefficients, "dims": vae.hparams.latent_dim,
-                "method": method, "feature_unexplained": float(((back - vectors) ** 2).sum() / total),
-                "joint_rmse_m": float(np.sqrt(error(back))), "sfpca_start": record.get("start")})
+    part_dims(b, k, iterations, primitive, clips, (int(vae.hparams.latent_dim),))
 
 
 def part_arm(b: Bench, content: str, iterations: int, targets: int = 50) -> None:
@@ -371,6 +363,30 @@ def part_arm(b: Bench, content: str, iterations: int, targets: int = 50) -> None
                     "median_neg_log_prior": float(np.median(r[:, 5])), "load": os.getloadavg()[0]})
 
 
+def part_rows(b: Bench, run_folder: Path) -> None:
+    """Tables 5.1–5.3 of a finished run's models with the Morphable Graph's stance models as extra rows."""
+    from stylemotion.evaluation.run import run_evaluation
+    from stylemotion.finished_run import FinishedRun, read_json_object
+    from stylemotion.morphable.rows import ROW
+
+    run = FinishedRun(run_folder, read_json_object(run_folder / "reproduce.json", "reproduce.json"),
+                      read_json_object(run_folder / "report" / "report.json", "report"))
+    checkpoints = [str(run.located(s["checkpoint"])) for kind in ("vae", "cvae") for s in run.stages(kind)]
+    settings = {k: v for k, v in run.meta["settings"].items() if k != "seed"}
+    began = time.perf_counter()
+    results = run_evaluation(run.data_cfg, checkpoints, settings, b.out / "report", run.seed,
+                             autoencoder_ckpt=str(run.autoencoder_ckpt),
+                             command="scripts/bench_morphable.py --parts rows",
+                             extra_rows={p: {ROW: b.model(p)} for p in STANCES})
+    for p in STANCES:
+        t = results["table_5_1"][p]
+        b.emit({"part": "rows", "primitive": p, "run": str(run_folder), "seconds": time.perf_counter() - began,
+                "variance": {r: results["variance"][p][r] for r in ("training_data", "neutral", ROW)},
+                "variance_ratio": {r: results["variance_ratio"][p][r] for r in ("neutral", ROW)},
+                "table_5_1_examples": t["examples"], "table_5_1_neutral": t["distance"][t["models"].index("neutral")],
+                "table_5_1_morphable": t["extra_rows"][ROW], "load": os.getloadavg()[0]})
+
+
 def part_latent(b: Bench, k: int | None, iterations: int, dims: int = 20) -> None:
     """Fig. 3.11: 2-D t-SNE of the latent codes of walk_leftStance's training clips by method, coloured by content
     (walk / walk-turn-left / walk-turn-right); the agreement of each code's 5 nearest neighbours' content."""
@@ -425,7 +441,7 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     b = Bench(args.data, Path(args.out), args.style)
     parts = args.parts.split(",")
-    unknown = set(parts) - {"k", "dims", "tree", "path", "tables", "density", "latent", "vae", "arm"}
+    unknown = set(parts) - {"k", "dims", "tree", "path", "tables", "density", "latent", "vae", "arm", "rows"}
     if unknown:
         parser.error(f"unknown parts {sorted(unknown)}")
     if "k" in parts:
@@ -444,10 +460,12 @@ def main(argv: list[str] | None = None) -> int:
         part_latent(b, args.K, args.sfpca_iterations)
     if "arm" in parts:
         part_arm(b, args.arm_content, args.sfpca_iterations)
+    if ("vae" in parts or "rows" in parts) and args.vae_run is None:
+        parser.error("parts vae and rows need --vae-run <finished stylemotion-reproduce run folder>")
     if "vae" in parts:
-        if args.vae_run is None:
-            parser.error("part vae needs --vae-run <finished stylemotion-reproduce run folder>")
         part_vae(b, args.vae_run, args.K, args.sfpca_iterations)
+    if "rows" in parts:
+        part_rows(b, args.vae_run)
     return 0
 
 

@@ -12,7 +12,9 @@ Stages, each in its own folder under ``out`` (default ``runs/reproduce/<data nam
    ``experiment=autoencoder``) on all takes of the data;
 3. ``vae/<primitive>``: the neutral PrimitiveVAE of each primitive (``experiment=primitive_vae``);
 4. ``cvae/<primitive>_<style>``: a StyleCVAE per primitive and style (``experiment=style_cvae``);
-5. ``report``: ``stylemotion-eval`` of all of them (:mod:`stylemotion.evaluation.run`).
+5. ``report``: ``stylemotion-eval`` of all of them (:mod:`stylemotion.evaluation.run`); with
+   ``morphable=true`` also the Morphable Graph's neutral models (fitted into ``morphable/<primitive>/``,
+   :mod:`stylemotion.morphable.rows`) as extra rows of Tables 5.1–5.3.
 
 Each training stage composes the ``train`` config with its overrides, takes this command's ``data``
 node, and runs :func:`stylemotion.training.run`: the autoencoder in this process, then the VAEs and
@@ -291,8 +293,10 @@ class Reproduction:
         """Evaluate every trained model into ``<out>/report`` (or reuse the report of the same stages)."""
         report, record = self.out / "report", self.out / "evaluation.json"
         step = self.total_steps()
+        morphable = bool(self.cfg.get("morphable", False))
         settings_hash = _hash({"stages": [s.settings_hash for s in self.stages], "seed": int(self.cfg.seed),
-                               "evaluation": OmegaConf.to_container(self.cfg.evaluation, resolve=True)})
+                               "evaluation": OmegaConf.to_container(self.cfg.evaluation, resolve=True),
+                               **({"morphable": True} if morphable else {})})  # off: the hash of earlier runs
         if report.exists():
             recorded = json.loads(record.read_text()).get("settings_hash") if record.is_file() else None
             if recorded != settings_hash or not (report / "report.json").is_file():
@@ -305,11 +309,21 @@ class Reproduction:
         models = [s.checkpoint for s in self.stages if s.kind in ("vae", "cvae")]
         ae = next(s.checkpoint for s in self.stages if s.kind == "autoencoder")
         command = "stylemotion-reproduce " + " ".join(sys.argv[1:])
+        extra = self.morphable_rows() if morphable else None
         results = run_evaluation(self.cfg.data, models, self.cfg.evaluation, report, int(self.cfg.seed),
                                  autoencoder_ckpt=ae, command=command, progress=lambda text: self.say("    " + text),
-                                 root=self.out)
+                                 root=self.out, extra_rows=extra)
         _write_json(record, {"settings_hash": settings_hash, "report": self.recorded(report)})
         return results
+
+    def morphable_rows(self) -> dict[str, dict[str, Any]]:
+        """``{primitive: {"morphable": model}}``: the Morphable Graph's neutral models of this run's data."""
+        from stylemotion.morphable.rows import ROW, neutral_models
+
+        models = neutral_models(self.data_cfg, self.primitives, str(self.cfg.evaluation.neutral_style),
+                                self.out / "morphable", dict(self.cfg.evaluation.get("segment") or {}),
+                                int(self.cfg.seed), say=self.say)
+        return {p: {ROW: m} for p, m in models.items()}
 
     def recorded(self, path: str | Path | None) -> str | None:
         """``path`` as this run's records hold it: relative to ``out`` when inside it, else absolute."""

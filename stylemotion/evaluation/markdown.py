@@ -137,7 +137,8 @@ def _thesis_section(results: dict[str, Any]) -> list[str]:
                      f"{len(d['columns'])} / {len(t['models'])}", THESIS["table_5_1_columns"] + " (left stance)"])
     for p, ratios in results.get("variance_ratio", {}).items():
         thesis = thesis_ratios(p)
-        styles = [r for r in ratios if r not in ("training_data", "neutral")]
+        extra = results.get("extra_rows", {}).get(p, [])
+        styles = [r for r in ratios if r not in ("training_data", "neutral", *extra)]
         thesis_styles = [r for r in thesis if r not in ("training_data", "neutral")]
         for k in VARIANCE_KEYS:
             if "neutral" in ratios:
@@ -162,6 +163,8 @@ def _table_5_1_section(results: dict[str, Any]) -> list[str]:
         matrix = np.asarray(t["distance"])
         rows = [[f"**{m}**"] + [f"**{fmt(v)}**" if j == matrix[i].argmin() else fmt(v) for j, v in enumerate(matrix[i])]
                 for i, m in enumerate(t["models"])]
+        rows += [[f"*{name}* (extra row)"] + [fmt(v) for v in values]
+                 for name, values in t.get("extra_rows", {}).items()]
         d = t["diagonal"]
         out += [f"### {p} ({fmt(t['samples'])} samples per model)", "",
                 _md_table(["model \\ example"] + t["examples"], rows), "",

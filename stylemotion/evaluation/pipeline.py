@@ -13,7 +13,10 @@ trained on and the autoencoder they share, and computes per primitive:
   ``samples.metrics`` samples per model (:mod:`.metrics`), each against the model's ground truth
   (:meth:`.reference.PrimitiveData.ground_truth`);
 
-and, once, the autoencoder's reconstruction error on the data's test split. Every model is sampled
+and, once, the autoencoder's reconstruction error on the data's test split. ``extra_rows`` adds row-only
+sources (e.g. the Morphable Graph's neutral models): sampled like the models, they get rows in Tables
+5.2/5.3 and a row of distances to the models' examples in Table 5.1 (``table_5_1.<p>.extra_rows``), no column
+and no other metric. Every model is sampled
 once, with the same seed, and that draw serves every metric. Per primitive the data is segmented
 and split once (:func:`real_side`: clips, classifier, ground truths), then each metric family is
 one function returning a small dataclass (:func:`real_variance`, :func:`recognition`,
@@ -27,7 +30,7 @@ import logging
 import time
 from collections import defaultdict
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, field
 from typing import Any
 
 import numpy as np
@@ -58,7 +61,7 @@ from stylemotion.evaluation.sources import (
 from stylemotion.evaluation.tables import diagonal_minima, distance_table, example_gram, mean_motion, variance_stats
 from stylemotion.models.autoencoder import local_mpjpe, mpjpe
 from stylemotion.models.style import mean_gram
-from stylemotion.primitives import Segmentation, parse_primitive, segment_action
+from stylemotion.primitives import Segmentation, parse_primitive, segment_action, time_normalize
 from stylemotion.sampling import MotionSamples
 
 log = logging.getLogger(__name__)
@@ -70,7 +73,8 @@ GRAM_TOLERANCE = 1e-3
 
 def evaluate_models(models: Sequence[EvalModel], takeset: TakeSet, autoencoder, settings: EvalSettings | None = None,
                     split: Mapping[str, Any] | None = None, autoencoder_info: Mapping[str, Any] | None = None,
-                    progress: Callable[[str], None] | None = None) -> dict[str, Any]:
+                    progress: Callable[[str], None] | None = None,
+                    extra_rows: Mapping[str, Mapping[str, Any]] | None = None) -> dict[str, Any]:
     """Evaluate models against real data (see the module doc).
 
     Args:
@@ -81,6 +85,7 @@ def evaluate_models(models: Sequence[EvalModel], takeset: TakeSet, autoencoder, 
         split: the data's split settings (as for training).
         autoencoder_info: ``path``/``fingerprint`` of the autoencoder (checked against the models).
         progress: called with a line of text as each step starts.
+        extra_rows: ``{primitive: {row name: SampleSource}}`` rows of Tables 5.1–5.3 only (module doc).
 
     Returns:
         The results (JSON-able), without ``meta``.
@@ -104,6 +109,12 @@ def evaluate_models(models: Sequence[EvalModel], takeset: TakeSet, autoencoder, 
         if m.dataset is not None and m.dataset != takeset.name:
             raise ValueError(f"{m.checkpoint or m.label} was trained on dataset {m.dataset!r}, not {takeset.name!r}")
         by_primitive[m.primitive].append(m)
+    extra_rows = {p: dict(rows) for p, rows in (extra_rows or {}).items() if rows}
+    for p, rows in extra_rows.items():
+        clash = sorted(set(rows) & ({m.name for m in by_primitive.get(p, [])} | {"training_data"}))
+        if p not in by_primitive or clash:
+            raise ValueError(f"extra rows {sorted(rows)} of {p}: " + (f"names {clash} are taken" if clash else
+                                                                     "no model of that primitive is evaluated"))
     results: dict[str, Any] = {key: {} for key in (
         "table_5_1", "variance", "variance_ratio", "variance_real", "variation_vs_style", "frechet",
         "frechet_reference", "diversity", "foot_skating_detail", "nearest_training")}
@@ -122,7 +133,7 @@ def evaluate_models(models: Sequence[EvalModel], takeset: TakeSet, autoencoder, 
         if action not in segmentations:
             segmentations[action] = segment_action(takeset.takes, action, settings.segment)
         out = _evaluate_primitive(primitive, by_primitive[primitive], takeset, autoencoder, settings, split, say,
-                                  segmentations[action])
+                                  segmentations[action], extra_rows.get(primitive))
         for key in results:
             if key in out:
                 results[key][primitive] = out[key]
@@ -142,6 +153,8 @@ def evaluate_models(models: Sequence[EvalModel], takeset: TakeSet, autoencoder, 
     results["foot_skating"] = {n: pooled_skating(v).ratio for n, v in skating.items()}
     results["foot_skating_real"] = {n: pooled_skating(v).ratio for n, v in skating_real.items()}
     results["primitives"] = sorted(by_primitive)
+    if extra_rows:
+        results["extra_rows"] = {p: sorted(rows) for p, rows in extra_rows.items()}
     results["models"] = [{"name": m.name, "primitive": m.primitive, "style": m.style, "checkpoint": m.checkpoint,
                           "examples": m.examples} for p in sorted(by_primitive) for m in by_primitive[p]]
     return results
@@ -415,20 +428,28 @@ class StyleTable:
     distance: np.ndarray
     samples: int
     example_clips: dict[str, Any]
+    extra_rows: dict[str, list[float]] = field(default_factory=dict)
 
     def as_dict(self) -> dict[str, Any]:
-        return {"models": self.models, "examples": self.models, "distance": self.distance.tolist(),
-                "diagonal": diagonal_minima(self.distance, self.models), "samples": self.samples,
-                "example_clips": self.example_clips}
+        out = {"models": self.models, "examples": self.models, "distance": self.distance.tolist(),
+               "diagonal": diagonal_minima(self.distance, self.models), "samples": self.samples,
+               "example_clips": self.example_clips}
+        if self.extra_rows:
+            out["extra_rows"] = self.extra_rows
+        return out
 
 
-def style_table(real: RealSide, autoencoder, model_frames: Sequence[np.ndarray], settings: EvalSettings) -> StyleTable:
-    """Table 5.1 from each model's first ``samples.table_5_1`` normalized sample frames (in ``real.models`` order)."""
+def style_table(real: RealSide, autoencoder, model_frames: Sequence[np.ndarray], settings: EvalSettings,
+                extra_frames: Mapping[str, np.ndarray] | None = None) -> StyleTable:
+    """Table 5.1 from each model's first ``samples.table_5_1`` normalized sample frames (in ``real.models`` order);
+    ``extra_frames`` (row name → frames) give rows against the same examples."""
     grams = torch.stack([example_column_gram(autoencoder, real, m) for m in real.models])
     table = distance_table(autoencoder, model_frames, grams, settings.gram_chunk)
+    extra = {name: distance_table(autoencoder, [f], grams, settings.gram_chunk)[0].tolist()
+             for name, f in (extra_frames or {}).items()}
     clips = {m.name: ("mean motion of the neutral training clips" if m.name == NEUTRAL
                       else [c.describe() for c in real.examples[m.name]]) for m in real.models}
-    return StyleTable([m.name for m in real.models], table, settings.samples.table_5_1, clips)
+    return StyleTable([m.name for m in real.models], table, settings.samples.table_5_1, clips, extra)
 
 
 def example_column_gram(autoencoder, real: RealSide, model: EvalModel) -> torch.Tensor:
@@ -456,7 +477,8 @@ def example_column_gram(autoencoder, real: RealSide, model: EvalModel) -> torch.
 
 def _evaluate_primitive(primitive: str, models: list[EvalModel], takeset: TakeSet, autoencoder,
                         settings: EvalSettings, split: Mapping[str, Any] | None,
-                        say: Callable[[str], None], segmentation: Segmentation | None = None) -> dict[str, Any]:
+                        say: Callable[[str], None], segmentation: Segmentation | None = None,
+                        extra_rows: Mapping[str, Any] | None = None) -> dict[str, Any]:
     real = real_side(primitive, models, takeset, settings, split, say, segmentation)
     variance = real_variance(real)
     train_poses = pose_sequences(real.training.normalized_frames.numpy())
@@ -489,8 +511,16 @@ def _evaluate_primitive(primitive: str, models: list[EvalModel], takeset: TakeSe
                                                    real.heldout_neutral, real.length)
         log.debug("%s/%s evaluated in %.1f s", primitive, m.name, time.perf_counter() - t0)
     n_models, n_table = len(real.models), settings.samples.table_5_1
+    extra_frames = {}
+    for name, source in (extra_rows or {}).items():
+        say(f"{primitive}: {name} (Tables 5.1–5.3 row): {max(n_table, settings.samples.variance)} samples")
+        samples = source.sample(max(n_table, settings.samples.variance), seed=settings.seed)
+        variance.rows[name] = _variance(samples.subset(slice(0, settings.samples.variance)))
+        frames = samples.normalized_frames[:n_table].numpy()
+        extra_frames[name] = (frames if frames.shape[1] == real.length
+                              else np.stack([time_normalize(f, real.length) for f in frames]))
     say(f"{primitive}: Table 5.1 ({n_models} × {n_models}, {n_table} samples per model)")
-    out["table_5_1"] = style_table(real, autoencoder, table_frames, settings).as_dict()
+    out["table_5_1"] = style_table(real, autoencoder, table_frames, settings, extra_frames).as_dict()
     out["variance"] = variance.rows
     out["variance_real"] = variance.real
     out["variance_ratio"] = variance.ratio

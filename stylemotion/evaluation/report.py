@@ -88,7 +88,8 @@ def write_csvs(results: dict[str, Any], folder: Path) -> list[str]:
 
     for p, t in results.get("table_5_1", {}).items():
         put(f"table_5_1_{p}.csv", ["model \\ example"] + t["examples"],
-            [[m] + row for m, row in zip(t["models"], t["distance"])])
+            [[m] + row for m, row in zip(t["models"], t["distance"])]
+            + [[m] + row for m, row in t.get("extra_rows", {}).items()])
     for p, rows in results.get("variance", {}).items():
         ratio = results["variance_ratio"][p]
         body = [["model", r] + [s[k] for k in VARIANCE_KEYS] + [ratio[r][k] for k in VARIANCE_KEYS]

@@ -79,14 +79,16 @@ def models_autoencoder(model: EvalModel) -> tuple[MotionAutoencoder, str | None]
 def run_evaluation(data_cfg: Mapping[str, Any], checkpoints: Sequence[str], evaluation: Mapping[str, Any],
                    out: str | os.PathLike, seed: int = 0, autoencoder_ckpt: str | None = None, force: bool = False,
                    command: str = "", progress: Callable[[str], None] | None = None,
-                   root: str | os.PathLike | None = None) -> dict[str, Any]:
+                   root: str | os.PathLike | None = None,
+                   extra_rows: Mapping[str, Mapping[str, Any]] | None = None) -> dict[str, Any]:
     """Load the models and their autoencoder, evaluate them on ``data_cfg``'s data, write the report.
 
     The autoencoder is ``autoencoder_ckpt`` if given, else the models' own (embedded in their
     checkpoints; see :func:`stylemotion.models.checkpoints.resolve_autoencoder`). Checkpoint and
     autoencoder paths inside ``root`` (default ``out``; a ``stylemotion-reproduce`` run passes its
     run folder) are recorded relative to it, and ``meta.paths_relative_to`` says where ``root`` is
-    from ``out``, so a moved folder still describes itself.
+    from ``out``, so a moved folder still describes itself. ``extra_rows`` (``{primitive: {row: SampleSource}}``)
+    are rows of Tables 5.1–5.3 only (:func:`~stylemotion.evaluation.pipeline.evaluate_models`).
 
     Returns:
         The results as written to ``report.json`` (with ``meta``).
@@ -115,7 +117,7 @@ def run_evaluation(data_cfg: Mapping[str, Any], checkpoints: Sequence[str], eval
     info = {**info, "path": recorded_path(info["path"], base)}
     takeset = build_dataset(data_cfg)
     results = evaluate_models(models, takeset, autoencoder, settings, split=data_cfg.get("split"),
-                              autoencoder_info=info, progress=progress)
+                              autoencoder_info=info, progress=progress, extra_rows=extra_rows)
     for entry in results.get("models", []):
         entry["checkpoint"] = recorded_path(entry.get("checkpoint"), base)
     results["meta"] = {
