@@ -76,7 +76,6 @@ def test_rejections_name_the_reason() -> None:
 
 
 @pytest.mark.realdata
-@pytest.mark.slow
 def test_bandai_raise_primitive_reaches_held_out_hand_targets(bandai_zip_path: Path) -> None:
     takes = load_dataset("bandai", root=bandai_zip_path, contents=["raise-up-left-hand"], styles=["normal"])
     split = takes.split(seed=0, val_fraction=0.1, test_fraction=0.1)
