@@ -25,7 +25,8 @@ Parts (each prints JSON lines, also appended to ``<out>/morphable.jsonl``):
   ``--arm-content`` takes (:mod:`stylemotion.morphable.arm`), spline RMSE against ``K``, the three reductions
   against latent dimensions, a model fitted with the default settings, and the hand reaching targets at the
   primitive's last frame (the held-out clips' own end positions, and random points of the box the training
-  clips' end positions span): error of the mean motion, of the tree's candidate and after the MAP solve;
+  clips' end positions span): error of the mean motion, of the tree's candidate and after the MAP solve; and
+  Fig. 4.9 for the hand (``density_hand_l.png``);
 * ``rows`` (Tables 5.1–5.3, with ``--vae-run``): the run's evaluation (its VAEs and CVAEs, its settings) with the
   two stance models as ``morphable`` extra rows (:mod:`stylemotion.morphable.rows`), report in ``<out>/report``;
 * ``latent`` (Fig. 3.11): t-SNE of the training clips' 20-dimensional codes per method, coloured by content,
@@ -221,35 +222,38 @@ def part_tables(b: Bench, samples: int) -> None:
                 - model.tree.centroid.nbytes - model.tree.children.nbytes, "training_positions_bytes": data_bytes})
 
 
-def part_density(b: Bench, samples: int) -> None:
-    """Fig. 4.9: the left foot at the last frame of walk_leftStance, mocap against ``samples`` model samples."""
+def part_density(b: Bench, samples: int, model: MorphableModel | None = None, clips: list | None = None,
+                 joint: str = "Foot_L", name: str = "walk_leftStance") -> None:
+    """Fig. 4.9: ``joint`` at the last frame of a primitive (default the left foot of walk_leftStance), mocap
+    against ``samples`` model samples (``density_<joint>.png``)."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    model, clips = b.model("walk_leftStance"), b.clips("walk_leftStance")["train"]
-    foot = CANONICAL_JOINTS.index("Foot_L")
-    real = np.stack([c.positions[-1, foot] for c in clips])
-    fake = model.poses_at(model.gmm.sample(samples, 0), [model.length - 1])[:, 0, foot]
+    if model is None:
+        model, clips = b.model("walk_leftStance"), b.clips("walk_leftStance")["train"]
+    j = CANONICAL_JOINTS.index(joint)
+    real = np.stack([c.positions[-1, j] for c in clips])
+    fake = model.poses_at(model.gmm.sample(samples, 0), [model.length - 1])[:, 0, j]
     fig, axes = plt.subplots(2, 2, figsize=(8, 7))
-    for row, (points, name) in enumerate(((real, f"motion capture ({len(real)} clips)"),
-                                          (fake, f"Morphable Graph ({samples:,} samples)"))):
-        for col, (i, j, label) in enumerate(((0, 2, "x (left) / z (forward), m"), (0, 1, "x / y (up), m"))):
-            axes[row, col].hexbin(points[:, i], points[:, j], gridsize=40, cmap="viridis", mincnt=1,
+    for row, (points, label_) in enumerate(((real, f"motion capture ({len(real)} clips)"),
+                                            (fake, f"Morphable Graph ({samples:,} samples)"))):
+        for col, (i, k, label) in enumerate(((0, 2, "x (left) / z (forward), m"), (0, 1, "x / y (up), m"))):
+            axes[row, col].hexbin(points[:, i], points[:, k], gridsize=40, cmap="viridis", mincnt=1,
                                   extent=(real[:, i].min() - 0.1, real[:, i].max() + 0.1,
-                                          real[:, j].min() - 0.1, real[:, j].max() + 0.1))
-            axes[row, col].set_title(f"{name}: {label}", fontsize=8)
-    fig.suptitle(f"{b.data_name} walk_leftStance: Foot_L at the last frame (Fig. 4.9)", fontsize=9)
+                                          real[:, k].min() - 0.1, real[:, k].max() + 0.1))
+            axes[row, col].set_title(f"{label_}: {label}", fontsize=8)
+    fig.suptitle(f"{b.data_name} {name}: {joint} at the last frame (Fig. 4.9)", fontsize=9)
     fig.tight_layout()
-    path = b.out / "density_foot_l.png"
+    path = b.out / f"density_{joint.lower()}.png"
     fig.savefig(path, dpi=80)
     plt.close(fig)
     inside = np.mean([(fake[:, k] >= np.quantile(real[:, k], 0.005)) & (fake[:, k] <= np.quantile(real[:, k], 0.995))
                       for k in range(3)], axis=0).mean()
-    b.emit({"part": "density", "samples": samples, "figure": str(path), "real_mean_m": real.mean(0).tolist(),
-            "samples_mean_m": fake.mean(0).tolist(), "real_sd_m": real.std(0).tolist(),
-            "samples_sd_m": fake.std(0).tolist(),
+    b.emit({"part": "density", "primitive": name, "joint": joint, "samples": samples, "figure": str(path),
+            "real_mean_m": real.mean(0).tolist(), "samples_mean_m": fake.mean(0).tolist(),
+            "real_sd_m": real.std(0).tolist(), "samples_sd_m": fake.std(0).tolist(),
             "samples_inside_real_range": float(inside)})
 
 
@@ -302,8 +306,9 @@ def part_vae(b: Bench, run_folder: Path, k: int | None, iterations: int) -> None
     part_dims(b, k, iterations, primitive, clips, (int(vae.hparams.latent_dim),))
 
 
-def part_arm(b: Bench, content: str, iterations: int, targets: int = 50) -> None:
-    """An arm primitive (``content``'s ``raise`` clips): Fig. 3.9, Fig. 3.10, a model, and hand keyframes."""
+def part_arm(b: Bench, content: str, iterations: int, k: int | None = None, targets: int = 50) -> None:
+    """An arm primitive (``content``'s ``raise`` clips): Fig. 3.9, Fig. 3.10, a model (``k`` coefficients, default
+    by the RMSE cut-off), hand keyframes and Fig. 4.9 for the hand."""
     from stylemotion.datasets.registry import build_dataset
     from stylemotion.morphable.arm import arm_clips
     from stylemotion.morphable.synthesis import MapSettings, UnreachableConstraintWarning, solve_constraints
@@ -317,24 +322,25 @@ def part_arm(b: Bench, content: str, iterations: int, targets: int = 50) -> None
     b.emit({"part": "arm_clips", "primitive": name, "clips": {p: len(c) for p, c in clips.items()},
             "rejected": rejected, "timeline": data.length,
             "frames": [int(min(c.num_frames for c in clips["train"])), int(max(c.num_frames for c in clips["train"]))]})
-    for k in range(4, data.length + 1):
-        b.emit({"part": "k", "primitive": name, "K": k, "clips": len(data.aligned), "timeline": data.length,
-                "joint_rmse_m": spline_rmse(data, k)})
-    path = b.out / "models" / name / "model.npz"
+    for count in range(4, data.length + 1):
+        b.emit({"part": "k", "primitive": name, "K": count, "clips": len(data.aligned), "timeline": data.length,
+                "joint_rmse_m": spline_rmse(data, count)})
+    path = b.out / "models" / (name if k is None else f"{name}_K{k}") / "model.npz"
     if path.is_file():
         model = MorphableModel.load(path)
     else:
         began = time.perf_counter()
-        model = fit_primitive(clips["train"], FitSettings(), meta={"data": b.data_name, "action": content,
-                                                                   "primitive": "raise"})
+        model = fit_primitive(clips["train"], FitSettings(num_coefficients=k),
+                              meta={"data": b.data_name, "action": content, "primitive": "raise"})
         model.build_tree()
         model.save(path)
-        b.emit({"part": "fit", "primitive": name, "seconds_with_tree": time.perf_counter() - began,
+        b.emit({"part": "fit", "primitive": name, "K_given": k, "seconds_with_tree": time.perf_counter() - began,
                 **{k: model.meta["fit"][k] for k in ("clips", "joint_rmse_m", "gmm_components")},
                 "num_coefficients": model.basis.num_coefficients, "timeline": model.length,
                 "test_joint_rmse_m": reconstruction_error(model, clips["test"]), "load": os.getloadavg()[0]})
     part_dims(b, model.basis.num_coefficients, iterations, name, clips["train"])
     hand = "Hand_L" if "left" in content else "Hand_R"
+    part_density(b, 60_000, model, clips["train"], hand, name)
     j = CANONICAL_JOINTS.index(hand)
     ends = np.stack([c.positions[-1, j] for c in clips["train"]])
     rng = np.random.default_rng(0)
@@ -430,7 +436,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--style", default="normal")
     parser.add_argument("--out", default="runs/bench_morphable")
     parser.add_argument("--parts", default="k,dims,tree,path,tables")
-    parser.add_argument("--K", type=int, help="coefficients for dims (default: the fitted model's)")
+    parser.add_argument("--K", type=int, help="coefficients for dims and the arm model (default: the fitted model's)")
     parser.add_argument("--sfpca-iterations", type=int, default=15)
     parser.add_argument("--constraints", type=int, default=200, help="per kind and primitive")
     parser.add_argument("--candidates", type=int, nargs="*", default=[1, 2, 4])
@@ -459,7 +465,7 @@ def main(argv: list[str] | None = None) -> int:
     if "latent" in parts:
         part_latent(b, args.K, args.sfpca_iterations)
     if "arm" in parts:
-        part_arm(b, args.arm_content, args.sfpca_iterations)
+        part_arm(b, args.arm_content, args.sfpca_iterations, args.K)
     if ("vae" in parts or "rows" in parts) and args.vae_run is None:
         parser.error("parts vae and rows need --vae-run <finished stylemotion-reproduce run folder>")
     if "vae" in parts:
