@@ -32,7 +32,7 @@ def dtw_warp(reference: np.ndarray, clip: np.ndarray) -> np.ndarray:
     """``(L,)`` warping function aligning ``clip`` ``(n, d)`` to ``reference`` ``(L, d)`` (features such as
     root-local joint positions): each reference frame gets the mean clip frame the DTW path matches to it."""
     reference, clip = np.ascontiguousarray(reference, dtype=np.double), np.ascontiguousarray(clip, dtype=np.double)
-    path = np.asarray(dtw_ndim.warping_path(reference, clip))
+    path = np.asarray(dtw_ndim.warping_path(reference, clip, use_c=True))  # the C path: ~50× faster, same path
     sums = np.bincount(path[:, 0], weights=path[:, 1], minlength=len(reference))
     counts = np.bincount(path[:, 0], minlength=len(reference))
     return monotone(sums / np.maximum(counts, 1), last=len(clip) - 1)
