@@ -24,6 +24,7 @@ from omegaconf import DictConfig, OmegaConf
 from stylemotion.config import ConfigError, set_torch_threads
 from stylemotion.io.atomic import atomic_write_bytes
 from stylemotion.io.outputs import OutputExistsError
+from stylemotion.morphable.arm import ARM_PRIMITIVES, arm_clips, is_arm_content
 from stylemotion.morphable.model import FitSettings, MorphableModel, fit_primitive, reconstruction_error
 from stylemotion.primitives import parse_primitive
 from stylemotion.training import _record_start
@@ -42,13 +43,16 @@ def run(cfg: DictConfig) -> dict[str, Any]:
                                 "replace it or choose another folder (hydra.run.dir=…)")
     set_torch_threads(cfg.get("threads"))
     began = time.perf_counter()
-    action, primitive = parse_primitive(str(cfg.primitive))
+    action, primitive = _parse(str(cfg.primitive))
     _record_start(output_dir, cfg, None)
     atomic_write_bytes(output_dir / "config_resolved.yaml", OmegaConf.to_yaml(cfg, resolve=True).encode())
     styles = None if cfg.get("style") in (None, "all") else [str(cfg.style)]
-    datamodule = instantiate(cfg.datamodule, data=OmegaConf.to_container(cfg.data, resolve=True), action=action,
-                             primitives=[primitive], styles=styles, _convert_="all")
-    datamodule.setup()
+    if primitive in ARM_PRIMITIVES:
+        datamodule = _ArmClips(cfg, action, primitive, styles)
+    else:
+        datamodule = instantiate(cfg.datamodule, data=OmegaConf.to_container(cfg.data, resolve=True), action=action,
+                                 primitives=[primitive], styles=styles, _convert_="all")
+        datamodule.setup()
     model_cfg = OmegaConf.to_container(cfg.model, resolve=True)
     tree_cfg = model_cfg.pop("tree", None) or {}
     model_cfg.pop("family", None)
@@ -76,6 +80,37 @@ def run(cfg: DictConfig) -> dict[str, Any]:
     log.info("%s_%s: %s written; training joint RMSE %.4f m, test %.4f m", action, primitive, model_path,
              model.meta["fit"]["joint_rmse_m"], metrics.get("test/joint_rmse_m", float("nan")))
     return {"model": model, "metrics": metrics}
+
+
+def _parse(name: str) -> tuple[str, str]:
+    """``walk_leftStance`` → ``("walk", "leftStance")``; an arm primitive ``<arm content>_<raise|lower>`` (e.g.
+    ``raise-up-left-hand_raise``) → ``(content, primitive)``; ConfigError listing both kinds otherwise."""
+    content, _, primitive = name.rpartition("_")
+    if primitive in ARM_PRIMITIVES and is_arm_content(content):
+        return content, primitive
+    try:
+        return parse_primitive(name)
+    except ValueError as err:
+        raise ConfigError(f"{err}, or an arm primitive <raise-up-…|wave-…>_<{'|'.join(ARM_PRIMITIVES)}> "
+                          "(e.g. raise-up-left-hand_raise)") from None
+
+
+class _ArmClips:
+    """The clips of one arm primitive in the data's seeded split (what :class:`ClipDataModule` gives for walks)."""
+
+    def __init__(self, cfg: DictConfig, content: str, primitive: str, styles: list[str] | None):
+        from stylemotion.datasets import build_dataset
+
+        data = OmegaConf.to_container(cfg.data, resolve=True)
+        takeset = build_dataset(data)
+        split = dict(data.get("split") or {})
+        self.clips: dict[str, list] = {}
+        for part, takes in takeset.split(**split).items():
+            takes = [t for t in takes if styles is None or t.style in styles]
+            self.clips[part], _ = arm_clips(takes, content, primitive)
+        if not self.clips.get("train"):
+            raise ConfigError(f"experiment=morphable_graph, {content}_{primitive}: no {primitive} clip in the train "
+                              f"takes of {content} (style {styles or 'any'}) of dataset {takeset.name!r}")
 
 
 def _write_samples(model: MorphableModel, folder: Path, seed: int, data_name: str) -> None:
