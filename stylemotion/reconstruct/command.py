@@ -33,9 +33,10 @@ import numpy as np
 from omegaconf import DictConfig, OmegaConf
 
 from stylemotion.config import ConfigError, positive_int
-from stylemotion.datasets import TakeSet, build_dataset
+from stylemotion.datasets import TakeSet
 from stylemotion.io.outputs import check_new_output
 from stylemotion.provenance import provenance
+from stylemotion.reconstruct.inputs import command_takeset, database_without
 from stylemotion.reconstruct.markers import (
     DEFAULT_MARKERS,
     MarkerGapWarning,
@@ -46,7 +47,6 @@ from stylemotion.reconstruct.markers import (
 )
 from stylemotion.reconstruct.output import write_motion_folder
 from stylemotion.reconstruct.sparse import RECONSTRUCT_FEATURE_SETS, SparseReconstructor, joint_errors_cm
-from stylemotion.search.database import MotionDatabase
 
 Say = Callable[[str], None]
 
@@ -91,10 +91,7 @@ def reconstruct_command(data: Mapping[str, Any], markers: str, out: str | os.Pat
         raise ConfigError(f"features={features} cannot be used; valid: {list(RECONSTRUCT_FEATURE_SETS)}")
     k = positive_int(k, "k")
     noise_mm = _number(noise_mm, "noise_mm")
-    try:
-        takeset = build_dataset(data)
-    except (KeyError, ValueError) as exc:
-        raise ConfigError(f"data={data.get('name')}: {exc}") from None
+    takeset = command_takeset(data)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", MarkerGapWarning)
         tracks, take = load_tracks(str(markers or "").strip(), takeset, joints, conversion)
@@ -103,8 +100,7 @@ def reconstruct_command(data: Mapping[str, Any], markers: str, out: str | os.Pat
     if abs(tracks.fps - takeset.fps) > 1e-6:
         raise MarkerInputError(f"markers={markers}: {tracks.fps:g} fps, the dataset {takeset.fps:g} fps; give the "
                                f"CSV's fps as '# fps: {takeset.fps:g}' tracks or resample them")
-    kept = [t for t in takeset.takes if not (exclude_markers_take and t.name == take)]
-    database = MotionDatabase.from_takeset(TakeSet(takeset.name, kept, takeset.fps, retarget=takeset.retarget))
+    database = database_without(takeset, {take} if exclude_markers_take and take else set(), f"markers={markers}")
     if not 2 <= k <= database.num_frames:
         raise ConfigError(f"k={k} must be from 2 to the database's {database.num_frames} frames")
     say(f"database {database.name}: {database.num_takes} takes, {database.num_frames} frames; markers "

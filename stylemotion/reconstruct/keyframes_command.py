@@ -37,9 +37,10 @@ import numpy as np
 from omegaconf import DictConfig, OmegaConf
 
 from stylemotion.config import ConfigError
-from stylemotion.datasets import TakeSet, build_dataset
+from stylemotion.datasets import TakeSet
 from stylemotion.io.outputs import check_new_output
 from stylemotion.provenance import provenance
+from stylemotion.reconstruct.inputs import command_takeset, database_without
 from stylemotion.reconstruct.keyframes import (
     DynamicMotionGraph,
     FarKeyframeWarning,
@@ -51,7 +52,6 @@ from stylemotion.reconstruct.keyframes import (
 )
 from stylemotion.reconstruct.markers import read_markers
 from stylemotion.reconstruct.output import write_motion_folder
-from stylemotion.search.database import MotionDatabase
 from stylemotion.skeleton import CANONICAL_JOINTS, JOINT_INDEX, NUM_JOINTS
 
 Say = Callable[[str], None]
@@ -178,15 +178,9 @@ def keyframes_command(data: Mapping[str, Any], keys: str | os.PathLike, out: str
 
     started = time.perf_counter()
     out = check_new_output(out, force)
-    try:
-        takeset = build_dataset(data)
-    except (KeyError, ValueError) as exc:
-        raise ConfigError(f"data={data.get('name')}: {exc}") from None
+    takeset = command_takeset(data)
     key_list, described, used = read_keys(keys, takeset, conversion)
-    kept = [t for t in takeset.takes if not (exclude_key_takes and t.name in used)]
-    if not kept:
-        raise ConfigError(f"data={data.get('name')}: no take is left in the database besides the keys' takes")
-    database = MotionDatabase.from_takeset(TakeSet(takeset.name, kept, takeset.fps, retarget=takeset.retarget))
+    database = database_without(takeset, used if exclude_key_takes else set(), "the keys' takes")
     say(f"database {database.name}: {database.num_takes} takes, {database.num_frames} frames; {len(key_list)} keys "
         f"over {key_list[-1].time_s - key_list[0].time_s:g} s")
     try:

@@ -24,13 +24,13 @@ import numpy as np
 from omegaconf import DictConfig, OmegaConf
 
 from stylemotion.config import ConfigError
-from stylemotion.datasets import TakeSet, build_dataset
+from stylemotion.datasets import TakeSet
 from stylemotion.io.outputs import check_new_output
 from stylemotion.provenance import provenance
+from stylemotion.reconstruct.inputs import command_takeset, database_without
 from stylemotion.reconstruct.markers import read_markers
 from stylemotion.reconstruct.output import write_motion_folder
 from stylemotion.reconstruct.texture import LEG_JOINTS, MODES, MotionTexturer, TextureInputError, check_joints
-from stylemotion.search.database import MotionDatabase
 from stylemotion.skeleton import CANONICAL_JOINTS, JOINT_INDEX, NUM_JOINTS
 
 Say = Callable[[str], None]
@@ -79,15 +79,9 @@ def texture_command(data: Mapping[str, Any], motion: str, out: str | os.PathLike
     if mode not in MODES:
         raise TextureInputError(f"mode={mode} is not one of {list(MODES)}")
     trusted = check_joints((LEG_JOINTS if mode == "complete" else CANONICAL_JOINTS) if joints is None else joints)
-    try:
-        takeset = build_dataset(data)
-    except (KeyError, ValueError) as exc:
-        raise ConfigError(f"data={data.get('name')}: {exc}") from None
+    takeset = command_takeset(data)
     positions, truth, take = load_motion(str(motion or "").strip(), takeset, trusted, conversion)
-    kept = [t for t in takeset.takes if not (exclude_motion_take and t.name == take)]
-    if not kept:
-        raise ConfigError(f"data={data.get('name')}: no take is left in the database besides motion={motion}")
-    database = MotionDatabase.from_takeset(TakeSet(takeset.name, kept, takeset.fps, retarget=takeset.retarget))
+    database = database_without(takeset, {take} if exclude_motion_take and take else set(), f"motion={motion}")
     say(f"database {database.name}: {database.num_takes} takes, {database.num_frames} frames; motion {motion}: "
         f"{len(positions)} frames, mode {mode}")
     try:
