@@ -30,13 +30,13 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from omegaconf import DictConfig, OmegaConf
+from omegaconf import DictConfig
 
 from stylemotion.config import ConfigError, positive_int
 from stylemotion.datasets import TakeSet
 from stylemotion.io.outputs import check_new_output
 from stylemotion.provenance import provenance
-from stylemotion.reconstruct.inputs import command_takeset, database_without
+from stylemotion.reconstruct.inputs import command_takeset, conversion_of, database_without, joints_option, plain_config
 from stylemotion.reconstruct.markers import (
     DEFAULT_MARKERS,
     MarkerGapWarning,
@@ -139,15 +139,11 @@ def reconstruct_command(data: Mapping[str, Any], markers: str, out: str | os.Pat
 
 def reconstruct_from_config(cfg: DictConfig, say: Say = print, command: str = "") -> dict[str, Any]:
     """:func:`reconstruct_command` with the keys of ``stylemotion/configs/reconstruct.yaml``."""
-    plain = OmegaConf.to_container(cfg, resolve=True)
-    if not isinstance(plain, dict):
-        raise ConfigError("the reconstruct config must be a mapping")
-    joints = plain.get("joints")
-    if joints is not None and not isinstance(joints, list):
-        raise ConfigError(f"joints={joints} must be a list of canonical joints, e.g. '[Hand_L,Hand_R,Hips]'")
+    plain = plain_config(cfg, "reconstruct")
+    joints = joints_option(plain, "'[Hand_L,Hand_R,Hips]'")
     return reconstruct_command(
         plain["data"], plain["markers"], plain["out"], features=str(plain.get("features", "E15")),
         k=plain.get("k", 64), joints=joints, noise_mm=plain.get("noise_mm", 0.0), seed=int(plain.get("seed", 0)),
         exclude_markers_take=bool(plain.get("exclude_markers_take", True)), model=plain.get("model") or {},
-        conversion={key: plain.get(key) for key in ("joint_map", "unit_scale", "up_axis")},
+        conversion=conversion_of(plain),
         force=bool(plain.get("force", False)), gif=bool(plain.get("gif", True)), say=say, command=command)

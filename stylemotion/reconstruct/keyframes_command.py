@@ -34,13 +34,13 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from omegaconf import DictConfig, OmegaConf
+from omegaconf import DictConfig
 
 from stylemotion.config import ConfigError
 from stylemotion.datasets import TakeSet
 from stylemotion.io.outputs import check_new_output
 from stylemotion.provenance import provenance
-from stylemotion.reconstruct.inputs import command_takeset, database_without
+from stylemotion.reconstruct.inputs import command_takeset, conversion_of, database_without, plain_config
 from stylemotion.reconstruct.keyframes import (
     DynamicMotionGraph,
     FarKeyframeWarning,
@@ -215,13 +215,10 @@ def keyframes_command(data: Mapping[str, Any], keys: str | os.PathLike, out: str
 
 def keyframes_from_config(cfg: DictConfig, say: Say = print, command: str = "") -> dict[str, Any]:
     """:func:`keyframes_command` with the keys of ``stylemotion/configs/keyframes.yaml``."""
-    plain = OmegaConf.to_container(cfg, resolve=True)
-    if not isinstance(plain, dict):
-        raise ConfigError("the keyframes config must be a mapping")
+    plain = plain_config(cfg, "keyframes")
     if not plain.get("keys"):
         raise ConfigError("keys= is empty: give a keyframe JSON file (stylemotion-keyframes --help)")
     return keyframes_command(
         plain["data"], plain["keys"], plain["out"], exclude_key_takes=bool(plain.get("exclude_key_takes", True)),
-        model=plain.get("model") or {}, conversion={key: plain.get(key) for key in ("joint_map", "unit_scale",
-                                                                                   "up_axis")},
+        model=plain.get("model") or {}, conversion=conversion_of(plain),
         force=bool(plain.get("force", False)), gif=bool(plain.get("gif", True)), say=say, command=command)

@@ -21,13 +21,13 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from omegaconf import DictConfig, OmegaConf
+from omegaconf import DictConfig
 
 from stylemotion.config import ConfigError
 from stylemotion.datasets import TakeSet
 from stylemotion.io.outputs import check_new_output
 from stylemotion.provenance import provenance
-from stylemotion.reconstruct.inputs import command_takeset, database_without
+from stylemotion.reconstruct.inputs import command_takeset, conversion_of, database_without, joints_option, plain_config
 from stylemotion.reconstruct.markers import read_markers
 from stylemotion.reconstruct.output import write_motion_folder
 from stylemotion.reconstruct.texture import LEG_JOINTS, MODES, MotionTexturer, TextureInputError, check_joints
@@ -115,17 +115,13 @@ def texture_command(data: Mapping[str, Any], motion: str, out: str | os.PathLike
 
 def texture_from_config(cfg: DictConfig, say: Say = print, command: str = "") -> dict[str, Any]:
     """:func:`texture_command` with the keys of ``stylemotion/configs/texture.yaml``."""
-    plain = OmegaConf.to_container(cfg, resolve=True)
-    if not isinstance(plain, dict):
-        raise ConfigError("the texture config must be a mapping")
-    joints = plain.get("joints")
-    if joints is not None and not isinstance(joints, list):
-        raise ConfigError(f"joints={joints} must be a list of canonical joints, e.g. '[Hips,Foot_L,Foot_R]'")
+    plain = plain_config(cfg, "texture")
+    joints = joints_option(plain, "'[Hips,Foot_L,Foot_R]'")
     k = plain.get("k", 32)
     if isinstance(k, bool) or not isinstance(k, int):
         raise ConfigError(f"k={k} must be a whole number")
     return texture_command(
         plain["data"], plain["motion"], plain["out"], mode=str(plain.get("mode", "complete")), joints=joints, k=k,
         exclude_motion_take=bool(plain.get("exclude_motion_take", True)), model=plain.get("model") or {},
-        conversion={key: plain.get(key) for key in ("joint_map", "unit_scale", "up_axis")},
+        conversion=conversion_of(plain),
         force=bool(plain.get("force", False)), gif=bool(plain.get("gif", True)), say=say, command=command)
