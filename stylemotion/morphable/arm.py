@@ -1,4 +1,4 @@
-"""Arm motion primitives: a raise-up or wave take cut into ``raise`` and ``lower`` clips (for the Morphable
+"""Arm motion primitives: a raise-up or wave take cut into ``raise``, ``wave`` and ``lower`` clips (for the Morphable
 Graph's arm primitive, Du Fig. 3.9/3.10 and §4.5.3's "hand reaching a target at the end of an arm primitive").
 
 :mod:`stylemotion.primitives` cuts walks and runs at foot contacts; arm takes (Bandai's ``raise-up-*-hand``
@@ -14,13 +14,30 @@ the top), ``f = threshold``:
   the slowest frame within ``search_s`` after the first crossing of the high level — its last frame is the
   keyframe where the hand has arrived;
 * ``lower``: from the slowest frame within ``search_s`` before the last time ``h`` is at the high level, to
-  the slowest frame within ``search_s`` after ``h`` is back below the low level.
+  the slowest frame within ``search_s`` after ``h`` is back below the low level;
+* ``wave`` (``wave-*`` contents only): the hold from the last frame of ``raise`` to the first of ``lower``
+  cut into single cycles of the active hands' side-to-side motion (:func:`wave_cycles`). The hold is put in
+  the body frame: hand positions relative to the root's ground projection, rotated by the mean facing
+  (:func:`stylemotion.representation.facing_yaw`) of the hold so the body faces +Z (+X its left), which makes
+  the cut independent of where the take faces. Per active hand, the dominant horizontal axis is the first
+  principal axis of the hand's ``(x, z)`` over the hold, signed to point to the hand's outside (+X for the
+  left hand, −X for the right); ``w(t)`` is the hand's position along it (m). Two active hands that move
+  mirrored (their ``w`` positively correlated) give the mean of the two; hands that move in parallel give
+  the half difference ``(w_L − w_R) / 2``, positive towards the body's left. The extremes are the local maxima
+  of ``w`` (found over the whole take, kept in the hold) with a prominence of at least ``min_wave_m / 2``
+  (the hand farthest out: towards the body's outside, or for hands in parallel towards its left), and a cycle
+  runs from one extreme to the next, both frames included, so every cycle starts and ends at the same phase
+  (consecutive cycles share that frame).
+  The parts of the hold before the first and after the last extreme are partial cycles and dropped. A hold
+  with fewer than two extremes gives a rejection (no oscillation); a cycle whose amplitude (the lower of its
+  two extremes minus the lowest ``w`` between them, m) is below ``min_wave_m`` or that is shorter than
+  ``min_frames`` is rejected alone.
 
 Clips are :class:`stylemotion.primitives.Clip` (frames of the source range, so positions start at the origin
 facing +Z like every clip) with ``action`` = the take's content (e.g. ``raise-up-left-hand``: one primitive
-per content, hands never mixed) and ``primitive`` = ``raise`` or ``lower``. A take without an active hand,
-that does not come back down, or whose clip would be shorter than ``min_frames`` gives a rejection reason
-instead.
+per content, hands never mixed) and ``primitive`` = ``raise``, ``wave`` or ``lower``. A take without an
+active hand, that does not come back down, or whose clip would be shorter than ``min_frames`` gives a
+rejection reason instead. Asking a ``raise-up-*`` content for ``wave`` is an error.
 """
 
 from __future__ import annotations
@@ -29,16 +46,21 @@ from collections.abc import Iterable
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.signal import find_peaks
 
 from stylemotion.contacts import foot_contacts
 from stylemotion.datasets.base import Take
+from stylemotion.geometry import direction_yaw, facing_direction, rotate_yaw
 from stylemotion.primitives import Clip
+from stylemotion.representation import ROOT_JOINT, facing_yaw
 from stylemotion.skeleton import CANONICAL_JOINTS
 
-#: Arm primitives, in take order.
-ARM_PRIMITIVES = ("raise", "lower")
+#: Arm primitives, in take order (``wave`` only for :data:`WAVE_CONTENTS`).
+ARM_PRIMITIVES = ("raise", "wave", "lower")
 #: Content prefixes of arm takes (Bandai dataset 2).
 ARM_CONTENTS = ("raise-up", "wave")
+#: Content prefixes of the arm takes that have ``wave`` cycles.
+WAVE_CONTENTS = ("wave",)
 HANDS = ("Hand_L", "Hand_R")
 
 
@@ -51,21 +73,40 @@ class ArmSettings:
         threshold: ``f``, share of the height range that counts as leaving rest / reaching the top.
         search_s: window (s) searched for the speed minimum beside each crossing.
         min_frames: shortest clip kept.
+        min_wave_m: smallest amplitude (m, extreme to extreme along the hand's side-to-side axis) of a
+            ``wave`` cycle; extremes need half of it as prominence.
     """
 
     min_raise_m: float = 0.2
     threshold: float = 0.1
     search_s: float = 0.5
     min_frames: int = 8
+    min_wave_m: float = 0.05
 
     def __post_init__(self) -> None:
-        if not self.min_raise_m > 0 or not 0 < self.threshold < 0.5 or not self.search_s >= 0 or self.min_frames < 2:
-            raise ValueError(f"ArmSettings need min_raise_m > 0, 0 < threshold < 0.5, search_s ≥ 0, min_frames ≥ 2; "
-                             f"got {self}")
+        if (not self.min_raise_m > 0 or not 0 < self.threshold < 0.5 or not self.search_s >= 0 or self.min_frames < 2
+                or not self.min_wave_m > 0):
+            raise ValueError(f"ArmSettings need min_raise_m > 0, 0 < threshold < 0.5, search_s ≥ 0, min_frames ≥ 2, "
+                             f"min_wave_m > 0; got {self}")
 
 
 def is_arm_content(content: str) -> bool:
     return any(content == p or content.startswith(p + "-") for p in ARM_CONTENTS)
+
+
+def content_primitives(content: str) -> tuple[str, ...]:
+    """The arm primitives of an arm content, in take order (``wave`` only for :data:`WAVE_CONTENTS`)."""
+    waves = any(content == p or content.startswith(p + "-") for p in WAVE_CONTENTS)
+    return tuple(p for p in ARM_PRIMITIVES if waves or p != "wave")
+
+
+def check_arm_primitive(content: str, primitive: str) -> None:
+    """A ValueError unless ``primitive`` is an arm primitive that ``content``'s takes have."""
+    if primitive not in ARM_PRIMITIVES:
+        raise ValueError(f"unknown arm primitive {primitive!r}; one of {list(ARM_PRIMITIVES)}")
+    if primitive not in content_primitives(content):
+        raise ValueError(f"content {content!r} has no {primitive!r} primitive (only {list(content_primitives(content))}"
+                         f"; {primitive} needs a {'|'.join(WAVE_CONTENTS)}-… content)")
 
 
 def arm_keyframes(positions: np.ndarray, fps: float, settings: ArmSettings | None = None
@@ -109,33 +150,113 @@ def arm_keyframes(positions: np.ndarray, fps: float, settings: ArmSettings | Non
     return ranges, [HANDS[i] for i in active]
 
 
-def segment_arm_take(take: Take, settings: ArmSettings | None = None) -> tuple[list[Clip], str | None]:
-    """The ``raise`` and ``lower`` clips of one arm take (see the module doc), or no clip and the reason."""
+def wave_signal(positions: np.ndarray, fps: float, hold: tuple[int, int], hands: list[str],
+                frames: tuple[int, int] | None = None) -> np.ndarray:
+    """``w(t)`` (m): the active hands' position along their side-to-side axis in the body frame, positive at the
+    extreme where cycles are cut (module doc), over the take frames ``frames = (start, stop)`` (stop exclusive;
+    default the hold). The facing, the axes, their centre and the two hands' correlation are those of the frames
+    ``hold = (start, stop)``."""
+    a, b = hold
+    c, d = hold if frames is None else frames
+    yaw = facing_yaw(positions, fps)[a:b]
+    heading = float(direction_yaw(facing_direction(yaw).mean(0)))
+    ground = positions[c:d, ROOT_JOINT].copy()
+    ground[:, 1] = 0.0
+    signals = []
+    for hand in hands:
+        local = rotate_yaw(positions[c:d, CANONICAL_JOINTS.index(hand)] - ground, -heading)[:, [0, 2]]
+        held = local[a - c:b - c] - local[a - c:b - c].mean(0)
+        axis = np.linalg.eigh(held.T @ held)[1][:, -1]  # first principal axis of the hand's (x, z) over the hold
+        outside = 1.0 if hand == "Hand_L" else -1.0
+        if axis[0] * outside < 0 or (axis[0] == 0 and axis[1] < 0):
+            axis = -axis
+        signals.append((local - local[a - c:b - c].mean(0)) @ axis)
+    if len(signals) == 1:
+        return signals[0]
+    left, right = signals
+    mirrored = float(np.mean(left[a - c:b - c] * right[a - c:b - c])) >= 0
+    return (left + right) / 2 if mirrored else (left - right) / 2
+
+
+def wave_cycles(positions: np.ndarray, fps: float, hold: tuple[int, int], hands: list[str],
+                settings: ArmSettings | None = None) -> tuple[list[tuple[int, int]], list[str]] | str:
+    """The ``wave`` cycles ``(start, stop)`` (take frames, stop exclusive) of the hold ``(start, stop)`` of
+    ``(T, 21, 3)`` positions and the reasons of the cycles rejected, or the reason the hold has none.
+
+    The extremes are looked for in ``w`` over the whole take and kept when they lie in the hold, so that one at
+    or next to the hold's first or last frame is judged (local maximum, prominence) against the frames beyond.
+    """
+    settings = settings or ArmSettings()
+    a, b = hold
+    if b - a < 3:
+        return f"wave: hold of {b - a} frames"
+    s = wave_signal(positions, fps, hold, hands, frames=(0, len(positions)))
+    extremes = [int(e) for e in find_peaks(s, prominence=settings.min_wave_m / 2)[0] if a <= e < b]
+    if len(extremes) < 2:
+        return (f"wave: no oscillation ({len(extremes)} extreme(s) of prominence ≥ {settings.min_wave_m / 2} m; "
+                f"side-to-side range {np.ptp(s[a:b]):.3f} m over the hold [{a}:{b}])")
+    cycles, rejected = [], []
+    for e0, e1 in zip(extremes[:-1], extremes[1:]):
+        amplitude = min(s[e0], s[e1]) - float(s[e0:e1 + 1].min())
+        if amplitude < settings.min_wave_m:
+            rejected.append(f"wave cycle [{e0}:{e1 + 1}]: amplitude {amplitude:.3f} m < min_wave_m="
+                            f"{settings.min_wave_m}")
+        elif e1 + 1 - e0 < settings.min_frames:
+            rejected.append(f"wave cycle [{e0}:{e1 + 1}]: shorter than min_frames={settings.min_frames}")
+        else:
+            cycles.append((e0, e1 + 1))
+    return cycles, rejected
+
+
+def _segment(take: Take, settings: ArmSettings | None, primitives: Iterable[str] | None
+             ) -> tuple[list[Clip], list[str]]:
+    """The clips of ``primitives`` (default all of the content's) of one arm take and the rejection reasons."""
     if not is_arm_content(take.content):
         raise ValueError(f"take {take.name}: content {take.content!r} is not an arm motion ({list(ARM_CONTENTS)})")
+    primitives = content_primitives(take.content) if primitives is None else tuple(primitives)
+    for primitive in primitives:
+        check_arm_primitive(take.content, primitive)
     positions = np.asarray(take.positions)
     found = arm_keyframes(positions, take.fps, settings)
     if isinstance(found, str):
-        return [], f"{take.name}: {found}"
-    ranges, _ = found
+        return [], [f"{take.name}: {found}"]
+    ranges, hands = found
+    cut: list[tuple[str, int, int]] = [(p, *ranges[p]) for p in ("raise",) if p in primitives]
+    rejected = []
+    if "wave" in primitives:
+        cycles = wave_cycles(positions, take.fps, (ranges["raise"][1] - 1, ranges["lower"][0] + 1), hands, settings)
+        if isinstance(cycles, str):
+            rejected.append(f"{take.name}: {cycles}")
+        else:
+            cut += [("wave", a, b) for a, b in cycles[0]]
+            rejected += [f"{take.name}: {r}" for r in cycles[1]]
+    cut += [(p, *ranges[p]) for p in ("lower",) if p in primitives]
     contacts = foot_contacts(positions, take.fps)
     clips = [Clip(action=take.content, primitive=p, style=take.style, take=take.name, content=take.content,
                   start=a, stop=b, fps=float(take.fps), frames=np.asarray(take.frames[a:b], dtype=np.float32),
-                  contacts=contacts[a:b]) for p, (a, b) in ranges.items()]
-    return clips, None
+                  contacts=contacts[a:b]) for p, a, b in cut]
+    return clips, rejected
+
+
+def segment_arm_take(take: Take, settings: ArmSettings | None = None, primitives: Iterable[str] | None = None
+                     ) -> tuple[list[Clip], str | None]:
+    """The clips of one arm take in take order (``primitives``, default the content's: ``raise``, the ``wave``
+    cycles of a wave take, ``lower``; see the module doc) and the rejection reasons (``; ``-joined, None when
+    nothing was rejected). ValueError for a content that is no arm motion or lacks one of ``primitives``."""
+    clips, rejected = _segment(take, settings, primitives)
+    return clips, "; ".join(rejected) or None
 
 
 def arm_clips(takes: Iterable[Take], content: str, primitive: str, settings: ArmSettings | None = None
               ) -> tuple[list[Clip], list[str]]:
-    """The ``primitive`` clips of the takes of ``content`` and the reasons of the takes that gave none."""
-    if primitive not in ARM_PRIMITIVES:
-        raise ValueError(f"unknown arm primitive {primitive!r}; one of {list(ARM_PRIMITIVES)}")
+    """The ``primitive`` clips of the takes of ``content`` and the reasons of the takes (for ``wave``: also of
+    the single cycles) that gave none; ValueError for a primitive ``content`` lacks (``wave`` of a raise-up)."""
+    check_arm_primitive(content, primitive)
     clips, rejected = [], []
     for take in takes:
         if take.content != content:
             continue
-        got, reason = segment_arm_take(take, settings)
-        clips += [c for c in got if c.primitive == primitive]
-        if reason:
-            rejected.append(reason)
+        got, reasons = _segment(take, settings, (primitive,))
+        clips += got
+        rejected += reasons
     return clips, rejected

@@ -1,5 +1,6 @@
-"""Arm primitives (stylemotion.morphable.arm): cuts on constructed takes, and a raise primitive of Bandai
-fitted and driven to hand targets (realdata)."""
+"""Arm primitives (stylemotion.morphable.arm): cuts on constructed takes (raise/lower, and wave cycles against
+their known extremes at any facing), a raise primitive of Bandai fitted and driven to hand targets, and the wave
+cycles of Bandai's wave-left-hand takes (realdata)."""
 
 from __future__ import annotations
 
@@ -10,14 +11,17 @@ import pytest
 
 from stylemotion.datasets import Take, load_dataset
 from stylemotion.datasets.synthetic import generate_take
+from stylemotion.geometry import rotate_yaw
 from stylemotion.morphable import FitSettings, fit_primitive
-from stylemotion.morphable.arm import ArmSettings, arm_clips, arm_keyframes, segment_arm_take
+from stylemotion.morphable.arm import ArmSettings, arm_clips, arm_keyframes, segment_arm_take, wave_signal
 from stylemotion.morphable.constraints import KeyframeConstraint
 from stylemotion.morphable.synthesis import MapSettings, solve_constraints
+from stylemotion.representation import facing_yaw
 from stylemotion.skeleton import CANONICAL_JOINTS
 
 FPS = 30.0
 HAND_L = CANONICAL_JOINTS.index("Hand_L")
+HAND_R = CANONICAL_JOINTS.index("Hand_R")
 
 
 def _standing_pose() -> np.ndarray:
@@ -72,7 +76,81 @@ def test_rejections_name_the_reason() -> None:
     with pytest.raises(ValueError, match="threshold"):
         ArmSettings(threshold=0.7)
     with pytest.raises(ValueError, match="unknown arm primitive"):
-        arm_clips([], "raise-up-left-hand", "wave")
+        arm_clips([], "raise-up-left-hand", "hold")
+
+
+def _ramp(t: np.ndarray, a: float, b: float) -> np.ndarray:
+    x = np.clip((t - a) / (b - a), 0.0, 1.0)
+    return x * x * (3 - 2 * x)
+
+
+def _wave_take(cycles: int, period: float, yaw: float, amplitude_m: float = 0.15, hands: str = "left",
+               content: str = "wave-left-hand") -> tuple[Take, list[float]]:
+    """A standing body that raises its hand(s) by 0.6 m over frames 10–30, moves them side to side from frame 35
+    as ``amplitude_m · sin(2π (t − 35) / period)`` along a body-frame axis 17° off its left (+X) for
+    ``cycles + ½`` periods, holds 5 frames, lowers them over 20 frames and rests 10; the whole take turned by
+    ``yaw`` about +Y and moved off the origin. ``hands``: ``left``, ``mirrored`` (both hands, the right one
+    mirrored: both out at once) or ``parallel`` (both hands moving to the same side). Also returns the frames of
+    the left hand's outward extremes (``cycles + 1``: ``cycles`` whole cycles between them)."""
+    t0, end = 35.0, 35.0 + (cycles + 0.5) * period
+    frames = int(np.ceil(end)) + 5 + 20 + 10
+    t = np.arange(frames, dtype=np.float64)
+    pose = _standing_pose()
+    body_yaw = float(facing_yaw(pose[None], FPS)[0])
+    side = np.sin(2 * np.pi * (t - t0) / period) * ((t >= t0) & (t <= end)) * amplitude_m
+    axis = np.array([np.cos(0.3), 0.0, np.sin(0.3)])  # body frame: mostly +X (the body's left), a little forward
+    lift = 0.6 * (_ramp(t, 10, 30) - _ramp(t, end + 5, end + 25))
+    positions = np.repeat(pose[None], frames, axis=0)
+    moved = [(HAND_L, axis)] + {"left": [], "mirrored": [(HAND_R, axis * [-1, 1, 1])],
+                                "parallel": [(HAND_R, axis)]}[hands]
+    for joint, direction in moved:
+        positions[:, joint] += side[:, None] * rotate_yaw(direction, body_yaw) + lift[:, None] * [0.0, 1.0, 0.0]
+    positions = rotate_yaw(positions, yaw) + np.array([1.5, 0.0, -2.0])
+    name = f"arm_{content}_normal_001"
+    extremes = [t0 + period / 4 + k * period for k in range(cycles + 1)]
+    return Take(name, positions.astype(np.float32), FPS, {"content": content, "style": "normal", "take": "001"}), \
+        extremes
+
+
+@pytest.mark.parametrize("yaw,period,hands", [(0.0, 20.0, "left"), (2.3, 17.0, "left"), (-1.2, 24.0, "mirrored"),
+                                              (0.7, 19.0, "parallel")])
+def test_wave_cycles_match_the_known_extremes_at_any_facing(yaw: float, period: float, hands: str) -> None:
+    content = "wave-left-hand" if hands == "left" else "wave-both-hands"
+    take, extremes = _wave_take(5, period, yaw, hands=hands, content=content)
+    clips, reason = segment_arm_take(take)
+    assert reason is None, reason
+    assert [c.primitive for c in clips] == ["raise"] + ["wave"] * 5 + ["lower"]
+    waves = [c for c in clips if c.primitive == "wave"]
+    for clip, first, last in zip(waves, extremes[:-1], extremes[1:]):
+        # a cycle runs from one outward extreme to the next, both included
+        assert abs(clip.start - first) <= 2 and abs(clip.stop - 1 - last) <= 2, (clip.describe(), first, last)
+        assert clip.action == content and clip.frames.shape == (clip.num_frames, 66)
+        assert clip.duration_s == pytest.approx(period / FPS, abs=2 / FPS)
+    assert [c.take for c in arm_clips([take], content, "wave")[0]] == [take.name] * 5
+
+
+def test_wave_refusals_name_the_reason() -> None:
+    take, _ = _wave_take(5, 20.0, 0.4, amplitude_m=0.0)
+    clips, reason = segment_arm_take(take)
+    assert [c.primitive for c in clips] == ["raise", "lower"] and "wave: no oscillation" in reason
+    clips, rejected = arm_clips([take], "wave-left-hand", "wave")
+    assert clips == [] and len(rejected) == 1 and "no oscillation" in rejected[0]
+    clips, rejected = arm_clips([take], "wave-left-hand", "raise")  # the wave's rejection is not the raise's
+    assert [c.primitive for c in clips] == ["raise"] and rejected == []
+    # 4 cm from side to side: the inner extremes are found (prominence 4 cm ≥ 2.5 cm; the first and last only
+    # stand 2 cm above the hand's rest before and after) but their cycles are below min_wave_m = 5 cm
+    clips, rejected = arm_clips([_wave_take(4, 20.0, 0.4, amplitude_m=0.02)[0]], "wave-left-hand", "wave")
+    assert clips == [] and len(rejected) == 2 and all("amplitude 0.040 m" in r for r in rejected), rejected
+    # 6-frame cycles against min_frames = 8
+    clips, rejected = arm_clips([_wave_take(6, 6.0, 0.4)[0]], "wave-left-hand", "wave")
+    assert clips == [] and len(rejected) == 6 and all("shorter than min_frames" in r for r in rejected), rejected
+    raise_up = _raise_take((10, 30), (50, 70))
+    with pytest.raises(ValueError, match="'raise-up-left-hand' has no 'wave'"):
+        arm_clips([raise_up], "raise-up-left-hand", "wave")
+    with pytest.raises(ValueError, match="'raise-up-left-hand' has no 'wave'"):
+        segment_arm_take(raise_up, primitives=["wave"])
+    with pytest.raises(ValueError, match="min_wave_m"):
+        ArmSettings(min_wave_m=0.0)
 
 
 @pytest.mark.realdata
@@ -96,3 +174,21 @@ def test_bandai_raise_primitive_reaches_held_out_hand_targets(bandai_zip_path: P
                                    MapSettings(constraint_scale_m=0.005))
         assert result.errors_m[0] < 0.02, (clip.describe(), result.errors_m, result.start_errors_m)
         assert result.cost <= result.start_cost  # the MAP objective (constraint + prior) never worsens
+
+
+@pytest.mark.realdata
+def test_bandai_wave_left_hand_cycles_are_single_waves(bandai_zip_path: Path) -> None:
+    takes = load_dataset("bandai", root=bandai_zip_path, contents=["wave-left-hand"], styles=["normal"])
+    train = takes.split(seed=0, val_fraction=0.1, test_fraction=0.1)["train"][:4]
+    assert len(train) == 4
+    for take in train:
+        clips, rejected = arm_clips([take], "wave-left-hand", "wave")
+        assert len(clips) >= 3, (take.name, rejected)
+        for clip in clips:
+            assert 0.3 <= clip.duration_s <= 2.0, clip.describe()
+            s = wave_signal(np.asarray(take.positions, np.float64), take.fps, (clip.start, clip.stop), ["Hand_L"])
+            travel = float(np.ptp(s))
+            assert 0.1 <= travel <= 0.8, (clip.describe(), travel)  # a hand wave: 10–80 cm from side to side
+            # it starts and ends at the same phase: both ends are the hand's outermost positions (within 20 %)
+            assert s.max() - min(s[0], s[-1]) <= 0.2 * travel, (clip.describe(), s[0], s[-1], s.max())
+            assert int(np.argmin(s)) not in (0, len(s) - 1)  # the inward extreme lies inside the cycle
