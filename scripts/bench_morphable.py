@@ -10,8 +10,10 @@ Parts (each prints JSON lines, also appended to ``<out>/morphable.jsonl``):
   variance) and in joint space (RMSE, m) against latent dimensions, FPCA / normalized FPCA / SFPCA, on
   walk_leftStance's training clips;
 * ``tree`` (Fig. 4.12): ``--constraints`` random position, orientation and pose constraints at the last
-  keyframe (targets from fresh mixture samples): median error and evaluations of the k-means, GMM and
-  median trees, the best of 100 random samples, and brute force over the tree's 10,000 codes;
+  keyframe (targets from fresh mixture samples): median error, evaluations and time of the thesis' k-means,
+  GMM and median trees of the codes (beam search), of the model's tree (keyframe space) by beam and by branch
+  and bound at several evaluation budgets, the best of 100 random samples, and brute force over the tree's
+  10,000 codes;
 * ``path``: the 10 m S-curve of ``stylemotion-generate`` with the two stance models (seeds 0 1 2);
 * ``tables`` (Tables 5.2/5.3): pose_SD, V_SD, step_SD of 10,000 samples per stance model against the
   training clips, and the model size against the training data's;
@@ -21,11 +23,12 @@ Parts (each prints JSON lines, also appended to ``<out>/morphable.jsonl``):
   positions against the recorded clips (joint-space RMSE, m) and against the autoencoder's own
   reconstruction (the VAE's compression alone), the unexplained share of its input's variance, and the
   three FPCA variants at the VAE's latent size for comparison;
-* ``arm`` (Fig. 3.9/3.10 for an arm primitive, and a keyframe constraint): ``raise`` clips of the
-  ``--arm-content`` takes (:mod:`stylemotion.morphable.arm`), spline RMSE against ``K``, the three reductions
-  against latent dimensions, a model fitted with the default settings, and the hand reaching targets at the
-  primitive's last frame (the held-out clips' own end positions, and random points of the box the training
-  clips' end positions span): error of the mean motion, of the tree's candidate and after the MAP solve; and
+* ``arm`` (Fig. 3.9/3.10 for an arm primitive, and a keyframe constraint): ``--arm-primitive`` clips
+  (``raise``, ``lower`` or, for wave contents, ``wave`` cycles) of the ``--arm-content`` takes
+  (:mod:`stylemotion.morphable.arm`), spline RMSE against ``K``, the three reductions against latent
+  dimensions, a model fitted with the default settings, and the hand reaching targets at the primitive's
+  last frame (the held-out clips' own end positions, and random points of the box the training clips' end
+  positions span): error of the mean motion, of the tree's candidate and after the MAP solve; and
   Fig. 4.9 for the hand (``density_hand_l.png``);
 * ``rows`` (Tables 5.1–5.3, with ``--vae-run``): the run's evaluation (its VAEs and CVAEs, its settings) with the
   two stance models as ``morphable`` extra rows (:mod:`stylemotion.morphable.rows`), report in ``<out>/report``;
@@ -72,6 +75,7 @@ from stylemotion.synthesis.generate import generate
 STANCES = ("walk_leftStance", "walk_rightStance")
 DIMS = (1, 2, 3, 5, 8, 10, 15, 20, 30, 40)
 CONSTRAINED_JOINTS = ("Hand_L", "Hand_R", "Foot_L", "Foot_R", "Head")
+BOUNDED_BUDGETS = (30, 60, 120, 240)
 
 
 class Bench:
@@ -152,34 +156,62 @@ def _constraint(kind: str, rng: np.random.Generator, model: MorphableModel) -> K
 
 
 def part_tree(b: Bench, count: int, candidates: list[int]) -> None:
+    """Fig. 4.12: the thesis' trees (k-means, GMM and median splits of the codes, 16 per leaf, beam search) and
+    the default tree (k-means on the keyframe values, 4 per leaf) by beam and by branch and bound."""
     for primitive in STANCES:
         model = b.model(primitive)
-        trees = {"kmeans": model.tree}
-        for split in ("gmm", "median"):
+        trees = {}
+        for split in ("kmeans", "gmm", "median"):
             began = time.perf_counter()
-            trees[split] = SpaceTree.build(model.tree.latent, split=split, seed=0)
-            b.emit({"part": "tree_build", "primitive": primitive, "split": split,
-                    "seconds": time.perf_counter() - began, "depth": trees[split].depth})
+            trees[split] = SpaceTree.build(model.tree.latent, split=split, seed=0, leaf_size=16)
+            b.emit({"part": "tree_build", "primitive": primitive, "split": split, "space": "latent", "leaf_size": 16,
+                    "seconds": time.perf_counter() - began, "depth": trees[split].depth,
+                    "nodes": len(trees[split].start)})
+        began = time.perf_counter()
+        bounds = model.keyframe_bounds()
+        b.emit({"part": "tree_bounds", "primitive": primitive, "space": model.tree.space,
+                "nodes": len(model.tree.start), "depth": model.tree.depth, "seconds": time.perf_counter() - began,
+                "bytes": bounds.nbytes})
         rng = np.random.default_rng(1)
         for kind in ("position", "orientation", "pose"):
-            rows: dict[str, list[tuple[float, int]]] = {}
+            rows: dict[str, list[tuple[float, int, float]]] = {}
+
+            def record(method: str, found, seconds: float, rows=rows) -> None:
+                rows.setdefault(method, []).append((found.cost, found.evaluations, seconds))
+
             for _ in range(count):
-                cost = objective(model, [_constraint(kind, rng, model)])
-                exact = brute_force(model.tree.latent, cost)
-                rows.setdefault("brute_force", []).append((exact.cost, exact.evaluations))
+                constraint = _constraint(kind, rng, model)
+                cost = objective(model, [constraint])
+                t = time.perf_counter()
+                record("brute_force", brute_force(model.tree.latent, cost), time.perf_counter() - t)
                 random = model.gmm.sample(100, rng)
-                rows.setdefault("random_100", []).append((float(cost(random).min()), 100))
+                rows.setdefault("random_100", []).append((float(cost(random).min()), 100, 0.0))
                 for split, tree in trees.items():
                     for c in candidates:
-                        found = tree.search(cost, c)
-                        rows.setdefault(f"{split}_c{c}", []).append((found.cost, found.evaluations))
-            brute = np.median([e for e, _ in rows["brute_force"]])
+                        t = time.perf_counter()
+                        record(f"{split}_c{c}", tree.search(cost, c), time.perf_counter() - t)
+                t = time.perf_counter()
+                record("keyframes_c4", model.tree.search(cost, 4), time.perf_counter() - t)
+                bound = bounds.lower_bound([constraint], model.length)
+                for budget in BOUNDED_BUDGETS:
+                    t = time.perf_counter()
+                    found = model.tree.search_bounded(cost, bound, budget)
+                    record(f"bounded_{budget}", found, time.perf_counter() - t)
+                    rows.setdefault(f"bounded_{budget}_exact", []).append((float(found.exact), 0, 0.0))
+            brute = np.median([e for e, _, _ in rows["brute_force"]])
             for method, values in rows.items():
-                err = np.array([e for e, _ in values])
+                err = np.array([e for e, _, _ in values])
+                if method.endswith("_exact"):
+                    b.emit({"part": "tree", "primitive": primitive, "kind": kind, "method": method,
+                            "constraints": count, "share_proved_optimal": float(err.mean())})
+                    continue
                 b.emit({"part": "tree", "primitive": primitive, "kind": kind, "method": method, "constraints": count,
                         "median_error": float(np.median(err)), "median_vs_brute": float(np.median(err) / brute),
-                        "median_evaluations": float(np.median([n for _, n in values])),
-                        "max_evaluations": int(max(n for _, n in values))})
+                        "mean_ratio_to_own_brute": float(np.mean(err / np.maximum([e for e, _, _ in
+                                                                                    rows["brute_force"]], 1e-12))),
+                        "median_evaluations": float(np.median([n for _, n, _ in values])),
+                        "max_evaluations": int(max(n for _, n, _ in values)),
+                        "median_ms": 1000 * float(np.median([t for _, _, t in values]))})
 
 
 def part_path(b: Bench, seeds: list[int]) -> None:
@@ -218,8 +250,9 @@ def part_tables(b: Bench, samples: int) -> None:
         b.emit({"part": "tables", "primitive": primitive, "samples": samples, "sample_seconds": seconds,
                 "training": real, "morphable": fake,
                 "ratio": {k: fake[k] / real[k] for k in ("pose_sd", "v_sd", "step_sd", "pose_across_sd")},
-                "model_bytes": model_bytes, "model_bytes_without_tree": model_bytes - model.tree.latent.nbytes // 2
-                - model.tree.centroid.nbytes - model.tree.children.nbytes, "training_positions_bytes": data_bytes})
+                "model_bytes": model_bytes, "model_bytes_without_tree": sum(
+                    v.nbytes for k, v in model.to_arrays().items() if not k.startswith("tree_")),
+                "training_positions_bytes": data_bytes})
 
 
 def part_density(b: Bench, samples: int, model: MorphableModel | None = None, clips: list | None = None,
@@ -306,9 +339,11 @@ def part_vae(b: Bench, run_folder: Path, k: int | None, iterations: int) -> None
     part_dims(b, k, iterations, primitive, clips, (int(vae.hparams.latent_dim),))
 
 
-def part_arm(b: Bench, content: str, iterations: int, k: int | None = None, targets: int = 50) -> None:
-    """An arm primitive (``content``'s ``raise`` clips): Fig. 3.9, Fig. 3.10, a model (``k`` coefficients, default
-    by the RMSE cut-off), hand keyframes and Fig. 4.9 for the hand."""
+def part_arm(b: Bench, content: str, iterations: int, k: int | None = None, targets: int = 50,
+             primitive: str = "raise") -> None:
+    """An arm primitive (``content``'s ``primitive`` clips: ``raise``, ``lower`` or a wave content's ``wave``
+    cycles): Fig. 3.9, Fig. 3.10, a model (``k`` coefficients, default by the RMSE cut-off), hand keyframes at its
+    last frame and Fig. 4.9 for the hand."""
     from stylemotion.datasets.registry import build_dataset
     from stylemotion.morphable.arm import arm_clips
     from stylemotion.morphable.synthesis import MapSettings, UnreachableConstraintWarning, solve_constraints
@@ -316,8 +351,8 @@ def part_arm(b: Bench, content: str, iterations: int, k: int | None = None, targ
     takes = build_dataset(b.data).split(**b.data.get("split", {}))
     clips, rejected = {}, {}
     for part in ("train", "test"):
-        clips[part], rejected[part] = arm_clips([t for t in takes[part] if t.style == b.style], content, "raise")
-    name = f"{content}_raise"
+        clips[part], rejected[part] = arm_clips([t for t in takes[part] if t.style == b.style], content, primitive)
+    name = f"{content}_{primitive}"
     data = functional_data(clips["train"])
     b.emit({"part": "arm_clips", "primitive": name, "clips": {p: len(c) for p, c in clips.items()},
             "rejected": rejected, "timeline": data.length,
@@ -331,7 +366,7 @@ def part_arm(b: Bench, content: str, iterations: int, k: int | None = None, targ
     else:
         began = time.perf_counter()
         model = fit_primitive(clips["train"], FitSettings(num_coefficients=k),
-                              meta={"data": b.data_name, "action": content, "primitive": "raise"})
+                              meta={"data": b.data_name, "action": content, "primitive": primitive})
         model.build_tree()
         model.save(path)
         b.emit({"part": "fit", "primitive": name, "K_given": k, "seconds_with_tree": time.perf_counter() - began,
@@ -443,6 +478,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--seeds", type=int, nargs="*", default=[0, 1, 2])
     parser.add_argument("--samples", type=int, default=10_000)
     parser.add_argument("--arm-content", default="raise-up-left-hand", help="arm takes of part arm")
+    parser.add_argument("--arm-primitive", default="raise", choices=["raise", "lower", "wave"],
+                        help="the arm primitive of part arm (wave: of a wave-… --arm-content)")
     parser.add_argument("--vae-run", type=Path, help="a finished stylemotion-reproduce run folder (part vae)")
     args = parser.parse_args(argv)
     b = Bench(args.data, Path(args.out), args.style)
@@ -465,7 +502,7 @@ def main(argv: list[str] | None = None) -> int:
     if "latent" in parts:
         part_latent(b, args.K, args.sfpca_iterations)
     if "arm" in parts:
-        part_arm(b, args.arm_content, args.sfpca_iterations, args.K)
+        part_arm(b, args.arm_content, args.sfpca_iterations, args.K, primitive=args.arm_primitive)
     if ("vae" in parts or "rows" in parts) and args.vae_run is None:
         parser.error("parts vae and rows need --vae-run <finished stylemotion-reproduce run folder>")
     if "vae" in parts:

@@ -8,6 +8,7 @@ channels together; evaluation at any number of frames is :class:`scipy.interpola
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -60,8 +61,11 @@ class SplineBasis:
         return np.moveaxis(coeffs, 0, -1).reshape(lead + (channels, self.num_coefficients))
 
     def matrix(self, times: np.ndarray) -> np.ndarray:
-        """``(len(times), K)`` basis function values at normalized ``times`` in ``[0, 1]``."""
+        """``(len(times), K)`` basis function values at normalized ``times`` in ``[0, 1]`` (read-only; short
+        time grids, such as a timeline or a few keyframes evaluated again and again, are cached)."""
         u = np.clip(np.asarray(times, dtype=np.float64), 0.0, 1.0)
+        if u.ndim == 1 and len(u) <= CACHED_TIMES:
+            return _design_matrix(self.knots.tobytes(), u.tobytes())
         return BSpline.design_matrix(u, self.knots, DEGREE).toarray()
 
     def evaluate(self, coefficients: np.ndarray, frames: int | np.ndarray) -> np.ndarray:
@@ -76,3 +80,14 @@ class SplineBasis:
         """
         times = np.linspace(0.0, 1.0, int(frames)) if np.ndim(frames) == 0 else np.asarray(frames)
         return np.einsum("tk,...ck->...tc", self.matrix(times), np.asarray(coefficients, dtype=np.float64))
+
+
+#: Longest time grid whose design matrix is cached.
+CACHED_TIMES = 256
+
+
+@functools.lru_cache(maxsize=128)
+def _design_matrix(knots: bytes, times: bytes) -> np.ndarray:
+    out = BSpline.design_matrix(np.frombuffer(times), np.frombuffer(knots), DEGREE).toarray()
+    out.flags.writeable = False
+    return out

@@ -42,6 +42,8 @@ from stylemotion.representation import JOINT_DIMS, positions_to_frames
 from stylemotion.sampling import MotionSamples, pad_motions
 
 log = logging.getLogger(__name__)
+#: What a tree's splits may cluster (:meth:`MorphableModel.build_tree`).
+TREE_SPACES = ("keyframes", "latent")
 
 FORMAT = "stylemotion.morphable/v1"
 #: Default joint-space RMSE cut-off (metres) for choosing K (Fig. 3.9).
@@ -161,6 +163,8 @@ class MorphableModel:
         fps: frames per second of decoded motions.
         meta: plain values (primitive, action, style, settings, fit record).
         tree: the space-partitioning tree over samples of the mixture (:mod:`.tree`), if built.
+
+    The tree's keyframe boxes (:mod:`.bounds`) are computed when first needed and kept in memory only.
     """
 
     channels: Channels
@@ -171,6 +175,7 @@ class MorphableModel:
     fps: float
     meta: dict[str, Any] = field(default_factory=dict)
     tree: SpaceTree | None = None
+    _bounds: Any = field(default=None, init=False, repr=False, compare=False)
 
     # -- interfaces shared with the VAEs (MotionGraph, evaluation)
 
@@ -266,10 +271,38 @@ class MorphableModel:
             arrays.update(self.tree.to_arrays())
         return arrays
 
-    def build_tree(self, samples: int = TREE_SAMPLES, split: str = "kmeans", seed: int = 0, **kwargs) -> SpaceTree:
-        """Build (and keep) the space-partitioning tree over ``samples`` codes drawn from the mixture."""
-        self.tree = SpaceTree.build(self.gmm.sample(samples, seed), split=split, seed=seed, **kwargs)
+    def build_tree(self, samples: int = TREE_SAMPLES, split: str = "kmeans", seed: int = 0, space: str = "keyframes",
+                   leaf_size: int = 4, **kwargs) -> SpaceTree:
+        """Build (and keep) the space-partitioning tree over ``samples`` codes drawn from the mixture, split
+        by clustering the codes (``space="latent"``, the thesis') or their keyframe positions and rotations
+        (``"keyframes"``, :func:`.bounds.clustering_features`)."""
+        from stylemotion.morphable.bounds import clustering_features
+
+        if space not in TREE_SPACES:
+            raise ValueError(f"unknown tree space {space!r}; one of {list(TREE_SPACES)}")
+        codes = self.gmm.sample(samples, seed)
+        features = clustering_features(self, codes) if space == "keyframes" else None
+        self.tree = SpaceTree.build(codes, split=split, seed=seed, leaf_size=leaf_size, features=features,
+                                    space=space, **kwargs)
+        self._bounds = None
         return self.tree
+
+    def ensure_tree(self) -> SpaceTree:
+        """The tree, built with the defaults (and not saved) if the model has none."""
+        if self.tree is None:
+            log.info("building the space-partitioning tree of %s (not saved with the model)",
+                     self.meta.get("primitive"))
+            self.build_tree()
+        return self.tree
+
+    def keyframe_bounds(self):
+        """The tree's :class:`~.bounds.KeyframeBounds` (computed on first use, ~1 s for 10,000 codes)."""
+        from stylemotion.morphable.bounds import KeyframeBounds
+
+        tree = self.ensure_tree()
+        if self._bounds is None or self._bounds[0] is not tree:
+            self._bounds = (tree, KeyframeBounds.of(self, tree))
+        return self._bounds[1]
 
     def save(self, path: str | Path) -> Path:
         """Write the model to ``path`` (``.npz``) atomically; returns the path."""

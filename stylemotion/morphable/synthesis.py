@@ -9,7 +9,8 @@ For one primitive and constraints ``c``, eq. 4.9 minimizes ``O(s, c) − ln p(s)
 * the prior: ``√λ · L_k⁻¹ (s − μ_k)`` for the mixture component ``k`` holding the tree's candidate, i.e.
   ``−ln p(s)`` up to a constant where that component dominates (the exact ``−ln p(s)`` is reported).
 
-The start is the tree's best code (:meth:`~.tree.SpaceTree.search`), never a random draw.
+The start is the tree's best code, never a random draw: its branch-and-bound search over keyframe boxes
+for constraints at the primitive's first or last frame, its beam search otherwise (:func:`.bounds.best_code`).
 
 **Path following.** :class:`MorphablePrimitive` wraps a model so that
 :func:`stylemotion.synthesis.controller.follow_path` uses it like a VAE: the controller sets each step's
@@ -33,14 +34,16 @@ from scipy.optimize import least_squares
 from scipy.spatial.transform import Rotation
 
 from stylemotion.config import ConfigError
-from stylemotion.geometry import rotate_yaw, rotate_yaw_xz, wrap_angle
-from stylemotion.morphable.constraints import KeyframeConstraint, constraint_errors, objective
+from stylemotion.geometry import rotate_yaw_xz, wrap_angle
+from stylemotion.morphable.bounds import MAX_EVALUATIONS, best_code
+from stylemotion.morphable.constraints import KeyframeConstraint, constraint_errors
+from stylemotion.morphable.lookahead import MeanStep, choose, mean_step, step_states
 from stylemotion.morphable.model import MorphableModel
-from stylemotion.morphable.tree import SpaceTree
-from stylemotion.representation import ROOT_JOINT, facing_yaw
 from stylemotion.skeleton import NUM_JOINTS
 
 log = logging.getLogger(__name__)
+#: Nodes after a primitive known to its look-ahead (``lookahead_steps`` − 1 of them are used).
+LOOKAHEAD_NODES = 4
 
 
 class UnreachableConstraintWarning(UserWarning):
@@ -52,18 +55,30 @@ class MapSettings:
     """Settings of the MAP solve.
 
     Attributes:
-        candidates: beam width of the tree search.
+        candidates: beam width of the tree's beam search (path steps; constraints off the keyframes).
+        tree_evaluations: codes the tree's branch-and-bound search may evaluate for keyframe constraints
+            (:func:`.bounds.best_code`).
         constraint_scale_m: ``σ_c`` of keyframe constraints, metres.
         prior_weight: ``λ``.
         max_evaluations: objective evaluations LM may spend.
         tolerance_m: a constraint missed by more than this after the solve is reported.
+        lookahead_steps: ``T``, steps over which a primitive's variants are compared (§4.5.1; 1 = greedy).
     """
 
     candidates: int = 4
+    tree_evaluations: int = MAX_EVALUATIONS
     constraint_scale_m: float = 0.02
     prior_weight: float = 1.0
     max_evaluations: int = 300
     tolerance_m: float = 0.05
+    lookahead_steps: int = 2
+
+    def __post_init__(self) -> None:
+        if self.candidates < 1 or self.tree_evaluations < 1 or self.max_evaluations < 1 or self.lookahead_steps < 1:
+            raise ValueError(f"MapSettings need candidates, tree_evaluations, max_evaluations and lookahead_steps "
+                             f"≥ 1; got {self}")
+        if not self.constraint_scale_m > 0 or not self.tolerance_m > 0 or self.prior_weight < 0:
+            raise ValueError(f"MapSettings need constraint_scale_m > 0, tolerance_m > 0, prior_weight ≥ 0; got {self}")
 
 
 @dataclass
@@ -89,13 +104,6 @@ class ConstrainedResult:
     neg_log_prior: float
     evaluations: int
     unreachable: list[str] = field(default_factory=list)
-
-
-def _tree(model: MorphableModel) -> SpaceTree:
-    if model.tree is None:
-        log.info("building the space-partitioning tree of %s (not saved with the model)", model.meta.get("primitive"))
-        model.build_tree()
-    return model.tree
 
 
 def _prior_residual(model: MorphableModel, start: np.ndarray, weight: float):
@@ -142,7 +150,7 @@ def solve_constraints(model: MorphableModel, constraints: Sequence[KeyframeConst
         pos, rot = out if need_rot else (out, None)
         return constraint_errors(pos, rot, constraints, model.length)
 
-    found = _tree(model).search(objective(model, constraints), settings.candidates)
+    found = best_code(model, constraints, settings.candidates, settings.tree_evaluations)
     prior = _prior_residual(model, found.latent, settings.prior_weight)
 
     def residuals(s: np.ndarray) -> np.ndarray:
@@ -166,33 +174,31 @@ def solve_constraints(model: MorphableModel, constraints: Sequence[KeyframeConst
 # Path following through the VAE controller
 
 
-def step_states(model: MorphableModel, latent: np.ndarray) -> dict[str, np.ndarray]:
-    """What a step does, for ``(m, d)`` codes: ``displacement`` ``(m, 2)`` root ground displacement (m) in the
-    clip's first facing frame, ``turn`` ``(m,)`` heading change (rad), ``first_pose`` ``(m, 63)`` the first
-    frame's root-local joints (as in the 66-dim frames), ``speed`` ``(m,)`` mean ground speed (m/s)."""
-    _, warp = model.coefficients(latent)
-    duration = model.warps(warp)[:, -1] / model.fps
-    pos = model.canonical_positions(latent)
-    rate = (model.length - 1) / float(np.mean(duration))
-    yaw = facing_yaw(pos, rate)
-    root = pos[:, :, ROOT_JOINT][..., [0, 2]]
-    turn = np.unwrap(yaw, axis=-1)
-    ground = pos[:, 0, ROOT_JOINT].copy()
-    ground[:, 1] = 0.0
-    first = rotate_yaw(pos[:, 0] - ground[:, None], -yaw[:, :1])
-    return {"displacement": rotate_yaw_xz(root[:, -1] - root[:, 0], -yaw[:, 0]),
-            "turn": turn[:, -1] - turn[:, 0], "first_pose": first.reshape(len(pos), -1),
-            "speed": np.linalg.norm(np.diff(root, axis=1), axis=-1).sum(-1) / duration}
-
-
 class MorphablePrimitive:
-    """A :class:`MorphableModel` as a node of :class:`~stylemotion.synthesis.graph.MotionGraph`."""
+    """One or more :class:`MorphableModel` variants of a primitive as a node of
+    :class:`~stylemotion.synthesis.graph.MotionGraph`.
 
-    def __init__(self, model: MorphableModel, settings: MapSettings | None = None):
-        self.model = model
+    With several variants (e.g. the turn variants of a stance, :mod:`.variants`) each step first chooses one by
+    the look-ahead of §4.5.1 (:mod:`.lookahead`, over ``settings.lookahead_steps`` steps and the variants of the
+    nodes that follow, see :func:`link_graph`), then searches its code. ``last_variant`` names the variant of
+    the last step searched; :meth:`decode_latent` decodes with it."""
+
+    def __init__(self, model: MorphableModel | Sequence[MorphableModel], settings: MapSettings | None = None,
+                 names: Sequence[str] | None = None):
+        models = [model] if isinstance(model, MorphableModel) else list(model)
+        if not models:
+            raise ValueError("a Morphable Graph node needs at least one model")
+        names = list(names) if names is not None else _variant_names(models)
+        if len(names) != len(models) or len(set(names)) != len(names):
+            raise ValueError(f"need one distinct name per variant, got {names} for {len(models)} models")
+        self.variants: dict[str, MorphableModel] = dict(zip(names, models))
+        self.model = models[0]
         self.settings = settings or MapSettings()
-        self.fps = model.fps
-        self.timeline_frames = model.length
+        self.fps = self.model.fps
+        self.timeline_frames = self.model.length
+        self.last_variant = names[0]
+        self.following: list[MorphablePrimitive] = []  # the nodes of the next steps (link_graph)
+        self._mean_steps = None
 
     def eval(self) -> MorphablePrimitive:
         return self
@@ -201,69 +207,138 @@ class MorphablePrimitive:
         return self
 
     def sample(self, n: int, seed: int = 0):
-        return self.model.sample(n, seed)
+        """``n`` samples spread evenly over the variants (what the step profile measures)."""
+        from stylemotion.morphable.model import concat_samples
+
+        counts = np.diff(np.linspace(0, n, len(self.variants) + 1).round().astype(int))
+        parts = [m.sample(int(c), seed) for m, c in zip(self.variants.values(), counts) if c > 0]
+        return parts[0] if len(parts) == 1 else concat_samples(parts)
 
     def decode_latent(self, latent):
-        return self.model.decode_latent(latent)
+        return self.variants[self.last_variant].decode_latent(latent)
 
-    def _step_residuals(self, latent: np.ndarray, goal, follow) -> np.ndarray:
-        """``(m, r)`` the controller's cost terms as residuals (without the prior)."""
-        state = step_states(self.model, latent)
-        start_xz, start_yaw = goal.start_xz.double().numpy(), float(goal.start_yaw)
-        end = start_xz + rotate_yaw_xz(state["displacement"], start_yaw)
-        parts = [(end - goal.target_xz.double().numpy()) / follow.position_scale_m,
-                 wrap_angle(start_yaw + state["turn"] - float(goal.target_yaw))[:, None] / follow.heading_scale_rad]
-        if goal.previous_pose is not None:
-            gap = state["first_pose"] - goal.previous_pose.double().numpy()
-            parts.append(gap / (follow.pose_scale_m * np.sqrt(NUM_JOINTS)))
-            parts.append((state["speed"] - float(goal.previous_speed))[:, None] / follow.speed_scale_mps)
-        return np.concatenate(parts, axis=1)
+    def mean_steps(self) -> list[MeanStep]:
+        if self._mean_steps is None:
+            self._mean_steps = [mean_step(m, name) for name, m in self.variants.items()]
+        return self._mean_steps
+
+    def choose_variant(self, goal, follow) -> str:
+        """The variant for the step of ``goal`` (module doc of :mod:`.lookahead`)."""
+        nodes = [self] + self.following[:max(self.settings.lookahead_steps - 1, 0)]
+        options = [n.mean_steps() for n in nodes]
+        targets = [(goal.target_xz.double().numpy(), float(goal.target_yaw))] + list(goal.ahead)
+        if len(self.variants) == 1:
+            return self.last_variant
+        choice = choose(options, goal.start_xz.double().numpy(), float(goal.start_yaw), targets,
+                        follow.position_scale_m, follow.heading_scale_rad)
+        return options[0][choice.index].name
 
     def search_step(self, goal, follow, generator: torch.Generator | None = None
                     ) -> tuple[torch.Tensor, float, float, dict[str, float]]:
-        """One step of :func:`~stylemotion.synthesis.controller.follow_path`: the tree's best code for the
-        step's target, refined by LM on eq. 4.9. Returns ``(code, candidate cost, final cost, terms)``; costs
-        are ``½‖r‖²`` of the step residuals plus ``λ (−ln p(s))`` (``λ``: ``follow.prior_weight``)."""
-        model, lam = self.model, follow.prior_weight
-        offset = model.gmm.max_log_prob()
-
-        def total(latent: np.ndarray) -> np.ndarray:
-            r = self._step_residuals(latent, goal, follow)
-            return 0.5 * (r ** 2).sum(-1) + lam * (offset - model.gmm.log_prob(latent))
-
-        found = _tree(model).search(total, self.settings.candidates)
-        prior = _prior_residual(model, found.latent, lam)
-        fit = least_squares(lambda s: np.concatenate([self._step_residuals(s[None], goal, follow)[0], prior(s)]),
-                            found.latent, method="lm", max_nfev=self.settings.max_evaluations)
-        final = float(total(fit.x[None])[0])
-        best = fit.x if final <= found.cost else found.latent
-        r = self._step_residuals(best[None], goal, follow)[0]
-        terms = {"position": float((r[:2] ** 2).sum()), "heading": float(r[2] ** 2),
-                 "prior": float(lam * (offset - model.gmm.log_prob(best))), "evaluations": float(found.evaluations
-                                                                                                 + fit.nfev)}
-        if goal.previous_pose is not None:
-            terms["pose"], terms["speed"] = float((r[3:-1] ** 2).sum()), float(r[-1] ** 2)
-        return torch.from_numpy(best.astype(np.float32)), float(found.cost), min(final, found.cost), terms
+        """One step of :func:`~stylemotion.synthesis.controller.follow_path`: the variant chosen by look-ahead,
+        then the tree's best code for the step's target, refined by LM on eq. 4.9. Returns ``(code, candidate
+        cost, final cost, terms)``; costs are ``½‖r‖²`` of the step residuals plus ``λ (−ln p(s))`` (``λ``:
+        ``follow.prior_weight``)."""
+        self.last_variant = self.choose_variant(goal, follow)
+        return _map_step(self.variants[self.last_variant], goal, follow, self.settings)
 
 
-def load_morphable_graph(models: Mapping[str, str | Path], action: str = "walk", settings: MapSettings | None = None):
+def link_graph(graph) -> None:
+    """Tell every Morphable Graph node of ``graph`` which nodes take the steps after it (alternating stances,
+    as the controller walks), for the look-ahead."""
+    from stylemotion.synthesis.graph import TRANSITIONS
+
+    for name, node in graph.models.items():
+        if not isinstance(node, MorphablePrimitive):
+            continue
+        node.following, current = [], name
+        for _ in range(LOOKAHEAD_NODES):
+            nxt = [p for p in TRANSITIONS[current] if p in graph.models and not p.startswith("end")]
+            if not nxt or not isinstance(graph.models[nxt[0]], MorphablePrimitive):
+                break
+            current = nxt[0]
+            node.following.append(graph.models[current])
+
+
+def _variant_names(models: Sequence[MorphableModel]) -> list[str]:
+    names = []
+    for i, m in enumerate(models):
+        name = str(m.meta.get("variant") or Path(str(m.meta.get("path", f"variant{i}"))).parent.name or f"variant{i}")
+        names.append(name if name not in names else f"{name}_{i}")
+    return names
+
+
+def _step_residuals(model: MorphableModel, latent: np.ndarray, goal, follow) -> np.ndarray:
+    """``(m, r)`` the controller's cost terms as residuals (without the prior)."""
+    state = step_states(model, latent)
+    start_xz, start_yaw = goal.start_xz.double().numpy(), float(goal.start_yaw)
+    end = start_xz + rotate_yaw_xz(state["displacement"], start_yaw)
+    parts = [(end - goal.target_xz.double().numpy()) / follow.position_scale_m,
+             wrap_angle(start_yaw + state["turn"] - float(goal.target_yaw))[:, None] / follow.heading_scale_rad]
+    if goal.previous_pose is not None:
+        gap = state["first_pose"] - goal.previous_pose.double().numpy()
+        parts.append(gap / (follow.pose_scale_m * np.sqrt(NUM_JOINTS)))
+        parts.append((state["speed"] - float(goal.previous_speed))[:, None] / follow.speed_scale_mps)
+    return np.concatenate(parts, axis=1)
+
+
+def _map_step(model: MorphableModel, goal, follow, settings: MapSettings
+              ) -> tuple[torch.Tensor, float, float, dict[str, float]]:
+    """The tree's best code for one step, refined by LM (see :meth:`MorphablePrimitive.search_step`)."""
+    lam = follow.prior_weight
+    offset = model.gmm.max_log_prob()
+
+    def total(latent: np.ndarray) -> np.ndarray:
+        r = _step_residuals(model, latent, goal, follow)
+        return 0.5 * (r ** 2).sum(-1) + lam * (offset - model.gmm.log_prob(latent))
+
+    found = model.ensure_tree().search(total, settings.candidates)
+    prior = _prior_residual(model, found.latent, lam)
+    fit = least_squares(lambda s: np.concatenate([_step_residuals(model, s[None], goal, follow)[0], prior(s)]),
+                        found.latent, method="lm", max_nfev=settings.max_evaluations)
+    final = float(total(fit.x[None])[0])
+    best = fit.x if final <= found.cost else found.latent
+    r = _step_residuals(model, best[None], goal, follow)[0]
+    terms = {"position": float((r[:2] ** 2).sum()), "heading": float(r[2] ** 2),
+             "prior": float(lam * (offset - model.gmm.log_prob(best))),
+             "evaluations": float(found.evaluations + fit.nfev)}
+    if goal.previous_pose is not None:
+        terms["pose"], terms["speed"] = float((r[3:-1] ** 2).sum()), float(r[-1] ** 2)
+    return torch.from_numpy(best.astype(np.float32)), float(found.cost), min(final, found.cost), terms
+
+
+def load_morphable_graph(models: Mapping[str, str | Path | Sequence[str | Path]], action: str = "walk",
+                         settings: MapSettings | None = None):
     """A :class:`~stylemotion.synthesis.graph.MotionGraph` of Morphable Graph primitives from
-    ``{primitive: model file or run folder}`` (``walk_leftStance`` or ``leftStance``)."""
+    ``{primitive: model file or run folder, or a list of them}`` (``walk_leftStance`` or ``leftStance``); a list
+    gives the primitive's variants (e.g. its turn variants), chosen per step by look-ahead."""
     from stylemotion.synthesis.graph import MotionGraph, _short
 
     if not models:
         raise ConfigError("model=morphable needs +models.walk_leftStance=<run folder or model.npz> "
                           "+models.walk_rightStance=<…>")
     loaded, sources = {}, {}
-    for key, path in sorted(models.items()):
+    for key, paths in sorted(models.items()):
         primitive = _short(str(key), action)
+        paths = [paths] if isinstance(paths, (str, Path)) else list(paths)
+        if not paths:
+            raise ConfigError(f"models.{key} is an empty list; give a run folder or model.npz (or several)")
+        variants = []
+        for path in paths:
+            try:
+                model = MorphableModel.load(path)
+            except (OSError, ValueError, KeyError) as err:
+                raise ConfigError(f"models.{key}={path}: {err}") from err
+            have = f"{model.meta.get('action')}_{model.meta.get('primitive')}"
+            if have != f"{action}_{primitive}":
+                raise ConfigError(f"models.{key}={path} holds a {have} model, not {action}_{primitive}")
+            variants.append(model)
         try:
-            model = MorphableModel.load(path)
-        except (OSError, ValueError, KeyError) as err:
-            raise ConfigError(f"models.{key}={path}: {err}") from err
-        have = f"{model.meta.get('action')}_{model.meta.get('primitive')}"
-        if have != f"{action}_{primitive}":
-            raise ConfigError(f"models.{key}={path} holds a {have} model, not {action}_{primitive}")
-        loaded[primitive], sources[primitive] = MorphablePrimitive(model, settings), str(model.meta["path"])
-    styles = {m.model.meta.get("style") for m in loaded.values()}
-    return MotionGraph(action=action, style="/".join(sorted(str(s) for s in styles)), models=loaded, sources=sources)
+            loaded[primitive] = MorphablePrimitive(variants, settings)
+        except ValueError as err:
+            raise ConfigError(f"models.{key}: {err}") from err
+        sources[primitive] = ", ".join(str(m.meta["path"]) for m in variants)
+    styles = {m.meta.get("style") for node in loaded.values() for m in node.variants.values()}
+    graph = MotionGraph(action=action, style="/".join(sorted(str(s) for s in styles)), models=loaded, sources=sources)
+    link_graph(graph)
+    return graph

@@ -24,8 +24,15 @@ from omegaconf import DictConfig, OmegaConf
 from stylemotion.config import ConfigError, set_torch_threads
 from stylemotion.io.atomic import atomic_write_bytes
 from stylemotion.io.outputs import OutputExistsError
-from stylemotion.morphable.arm import ARM_PRIMITIVES, arm_clips, is_arm_content
+from stylemotion.morphable.arm import (
+    ARM_PRIMITIVES,
+    arm_clips,
+    check_arm_primitive,
+    content_primitives,
+    is_arm_content,
+)
 from stylemotion.morphable.model import FitSettings, MorphableModel, fit_primitive, reconstruction_error
+from stylemotion.morphable.variants import TURN_THRESHOLD_DEG, select_turn, variant_name
 from stylemotion.primitives import parse_primitive
 from stylemotion.training import _record_start
 
@@ -53,18 +60,30 @@ def run(cfg: DictConfig) -> dict[str, Any]:
         datamodule = instantiate(cfg.datamodule, data=OmegaConf.to_container(cfg.data, resolve=True), action=action,
                                  primitives=[primitive], styles=styles, _convert_="all")
         datamodule.setup()
+    turn = cfg.get("turn")
+    if turn is not None:
+        try:
+            datamodule.clips = {part: select_turn(clips, str(turn), float(cfg.get("turn_threshold_deg",
+                                                                                   TURN_THRESHOLD_DEG)))
+                                for part, clips in datamodule.clips.items()}
+        except ValueError as err:
+            raise ConfigError(f"experiment=morphable_graph, turn={turn}: {err}") from err
     model_cfg = OmegaConf.to_container(cfg.model, resolve=True)
     tree_cfg = model_cfg.pop("tree", None) or {}
     model_cfg.pop("family", None)
     try:
         settings = FitSettings(**model_cfg)
         model = fit_primitive(datamodule.clips["train"], settings,
-                              meta={"data": str(cfg.data.get("name")), "seed": int(cfg.seed)})
+                              meta={"data": str(cfg.data.get("name")), "seed": int(cfg.seed),
+                                    "variant": variant_name(None if turn is None else str(turn))})
     except (TypeError, ValueError) as err:  # a bad model.* value, too few clips, a mixture that cannot be fitted
         raise ConfigError(f"experiment=morphable_graph, {action}_{primitive}: {err}") from err
     if tree_cfg.get("samples", 0):
-        model.build_tree(int(tree_cfg["samples"]), str(tree_cfg.get("split", "kmeans")), int(cfg.seed),
-                         leaf_size=int(tree_cfg.get("leaf_size", 16)))
+        try:
+            model.build_tree(int(tree_cfg["samples"]), str(tree_cfg.get("split", "kmeans")), int(cfg.seed),
+                             space=str(tree_cfg.get("space", "keyframes")), leaf_size=int(tree_cfg.get("leaf_size", 4)))
+        except ValueError as err:  # an unknown split or space, a bad leaf size
+            raise ConfigError(f"experiment=morphable_graph, model.tree: {err}") from err
     model.save(model_path)
     metrics: dict[str, Any] = {"fit": model.meta["fit"], "seconds_fit": time.perf_counter() - began,
                                "clips": {p: len(c) for p, c in datamodule.clips.items()},
@@ -83,16 +102,22 @@ def run(cfg: DictConfig) -> dict[str, Any]:
 
 
 def _parse(name: str) -> tuple[str, str]:
-    """``walk_leftStance`` → ``("walk", "leftStance")``; an arm primitive ``<arm content>_<raise|lower>`` (e.g.
-    ``raise-up-left-hand_raise``) → ``(content, primitive)``; ConfigError listing both kinds otherwise."""
+    """``walk_leftStance`` → ``("walk", "leftStance")``; an arm primitive ``<arm content>_<raise|wave|lower>`` (e.g.
+    ``raise-up-left-hand_raise``, ``wave-left-hand_wave``; ``wave`` only of wave contents) → ``(content,
+    primitive)``; ConfigError listing both kinds otherwise."""
     content, _, primitive = name.rpartition("_")
     if primitive in ARM_PRIMITIVES and is_arm_content(content):
+        try:
+            check_arm_primitive(content, primitive)
+        except ValueError as err:
+            valid = ", ".join(f"{content}_{p}" for p in content_primitives(content))
+            raise ConfigError(f"primitive={name}: {err}; use one of {valid}") from None
         return content, primitive
     try:
         return parse_primitive(name)
     except ValueError as err:
         raise ConfigError(f"{err}, or an arm primitive <raise-up-…|wave-…>_<{'|'.join(ARM_PRIMITIVES)}> "
-                          "(e.g. raise-up-left-hand_raise)") from None
+                          "(e.g. raise-up-left-hand_raise, wave-left-hand_wave)") from None
 
 
 class _ArmClips:

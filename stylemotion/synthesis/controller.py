@@ -22,6 +22,8 @@ For each step, with the root at ``(p₀, θ₀)`` (ground position, heading) whe
    :func:`stylemotion.representation.integrate_root` — all in torch, so ``E`` is differentiable.
 3. **Search.** ``K`` codes drawn from the prior (a seeded generator: another seed, another walk);
    the cheapest is refined by Adam on ``z`` for a fixed number of iterations.
+   A primitive may bring its own search (``search_step``, the Morphable Graph's MAP of eq. 4.9); it also
+   gets the next steps' targets (:data:`LOOKAHEAD_TARGETS`) to choose among its variants by looking ahead.
 4. The chosen code is decoded at the output frame rate and appended to the motion
    (:mod:`.stitching`); the root's new ``(p₀, θ₀)`` is read from the stitched motion itself.
 
@@ -48,6 +50,9 @@ from stylemotion.synthesis.path import GroundPath
 from stylemotion.synthesis.stitching import append_clip
 
 log = logging.getLogger(__name__)
+#: Targets of the steps after the current one handed to a step search (a graph walk's look-ahead, e.g. the
+#: Morphable Graph's §4.5.1; the VAE search ignores them), at the same spacing along the path.
+LOOKAHEAD_TARGETS = 4
 
 
 class SharpTurnWarning(UserWarning):
@@ -108,6 +113,7 @@ class StepRecord:
         cost_best_candidate, cost_final: ``E`` before and after refining ``z``.
         terms: the final cost's terms.
         latent: the chosen ``z``.
+        variant: which of the primitive's variants took the step (Morphable Graph turn variants; else empty).
     """
 
     primitive: str
@@ -121,6 +127,7 @@ class StepRecord:
     cost_final: float
     terms: dict[str, float]
     latent: list[float]
+    variant: str = ""
 
 
 @dataclass
@@ -163,6 +170,7 @@ class _StepGoal:
     target_yaw: torch.Tensor  # ()
     previous_pose: torch.Tensor | None  # (63,) root-local joints of the previous clip's last frame
     previous_speed: torch.Tensor | None  # () its mean ground speed, m/s
+    ahead: list[tuple[np.ndarray, float]] = field(default_factory=list)  # the next steps' (target_xz, target_yaw)
 
 
 def step_cost(model, z: torch.Tensor, goal: _StepGoal, settings: FollowSettings
@@ -272,11 +280,15 @@ def follow_path(graph: MotionGraph, path: GroundPath, seed: int = 0, settings: F
             primitive = graph.next(steps[-1].primitive, last=True)  # the last step: end primitive if modelled
         target_s = float(s0) + remaining / needed
         target_xz, target_yaw = path.point_at(target_s), float(path.heading_at(min(target_s, path.length - 1e-9)))
+        spacing = remaining / needed
+        ahead = [(path.point_at(target_s + k * spacing),
+                  float(path.heading_at(min(target_s + k * spacing, path.length - 1e-9))))
+                 for k in range(1, min(needed, LOOKAHEAD_TARGETS + 1))]
         goal = _StepGoal(
             start_xz=torch.tensor(place_xz, dtype=torch.float32), start_yaw=torch.tensor(place_yaw),
             target_xz=torch.tensor(target_xz, dtype=torch.float32), target_yaw=torch.tensor(target_yaw),
             previous_pose=None if motion is None else torch.tensor(motion[-1, JOINT_DIMS], dtype=torch.float32),
-            previous_speed=None if previous_speed is None else torch.tensor(previous_speed))
+            previous_speed=None if previous_speed is None else torch.tensor(previous_speed), ahead=ahead)
         model = graph.models[primitive]
         own_search = getattr(model, "search_step", None)  # e.g. a Morphable Graph primitive's MAP (eq. 4.9)
         z, start_cost, final_cost, terms = (own_search(goal, settings, generator) if own_search
@@ -294,7 +306,7 @@ def follow_path(graph: MotionGraph, path: GroundPath, seed: int = 0, settings: F
             primitive=primitive, start_frame=before, target_xz=[float(v) for v in target_xz],
             target_yaw=float(target_yaw), end_xz=[float(v) for v in place_xz], end_yaw=float(place_yaw),
             duration_s=float(decoded.duration_s[0]), cost_best_candidate=start_cost, cost_final=final_cost,
-            terms=terms, latent=[float(v) for v in z]))
+            terms=terms, latent=[float(v) for v in z], variant=str(getattr(model, "last_variant", ""))))
         log.debug("step %d %s: cost %.2f → %.2f, end %s", len(steps), primitive, start_cost, final_cost, place_xz)
         if primitive.startswith("end"):
             break

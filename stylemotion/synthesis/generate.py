@@ -145,8 +145,12 @@ def generate(cfg: DictConfig | Mapping[str, Any], command: str = "") -> dict[str
     if kind == "morphable":
         from stylemotion.morphable.synthesis import MapSettings, load_morphable_graph
 
+        try:
+            map_settings = MapSettings(**(cfg.get("morphable") or {}))
+        except (TypeError, ValueError) as err:  # an unknown or out-of-range morphable.* key
+            raise ConfigError(f"morphable.*: {err}") from err
         graph = load_morphable_graph(cfg.get("models") or {}, action=str(cfg.get("action", "walk")),
-                                     settings=MapSettings(**(cfg.get("morphable") or {})))
+                                     settings=map_settings)
     elif kind == "vae":
         graph = load_graph(str(cfg["style"]), run=cfg.get("run"), models=cfg.get("models"),
                            action=str(cfg.get("action", "walk")), neutral_style=str(cfg.get("neutral_style", "normal")))
