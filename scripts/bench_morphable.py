@@ -234,6 +234,51 @@ def part_path(b: Bench, seeds: list[int]) -> None:
                 "load": os.getloadavg()[0]})
 
 
+#: Paths of part lookahead: the standard S-curve, a sharper double S, and a right-angle corner.
+LOOKAHEAD_PATHS = {
+    "s_curve": {"s_curve": {"length_m": 10.0, "amplitude_m": 1.0, "waves": 1.0}},
+    "double_s": {"s_curve": {"length_m": 10.0, "amplitude_m": 1.0, "waves": 2.0}},
+    "corner": {"points": [[0.0, 0.0], [0.0, 3.0], [0.0, 4.0], [0.3, 4.7], [1.0, 5.0], [2.0, 5.0], [5.0, 5.0]]},
+}
+
+
+def _variant_models(runs: list[Path]) -> dict[str, dict[str, str]]:
+    """``{walk_<stance>: {variant: model file}}`` of stylemotion-train experiment=morphable_graph run folders."""
+    found: dict[str, dict[str, str]] = {}
+    for run in runs:
+        model = MorphableModel.load(run)
+        key = f"{model.meta['action']}_{model.meta['primitive']}"
+        found.setdefault(key, {})[str(model.meta.get("variant", "all"))] = str(model.meta["path"])
+    return found
+
+
+def part_lookahead(b: Bench, runs: list[Path]) -> None:
+    """The graph walk's look-ahead (§4.5.1) among turn variants, against one model per stance, on three paths."""
+    models = _variant_models(runs)
+    three = ["straight", "left", "right"]
+    graphs = {"one model": (["all"], 1), "3 variants, greedy": (three, 1), "3 variants, T=2": (three, 2),
+              "3 variants, T=3": (three, 3), "all + turns, T=2": (["all", "left", "right"], 2)}
+    for path_name, path in LOOKAHEAD_PATHS.items():
+        for graph_name, (variants, steps) in graphs.items():
+            names = ["all" if v == "all" else f"turn-{v}" for v in variants]
+            chosen = {key: [found[n] for n in names] for key, found in models.items()}
+            out = b.out / "lookahead" / path_name / graph_name.replace(" ", "_").replace(",", "").replace("+", "")
+            cfg = {"model": {"family": "morphable"}, "models": chosen, "style": "neutral", "seed": 0, "out": str(out),
+                   "force": True, "path": path, "morphable": {"lookahead_steps": steps},
+                   "outputs": {"bvh": False, "gif": False}}
+            with warnings.catch_warnings(record=True) as caught:
+                warnings.simplefilter("always", SharpTurnWarning)
+                s = generate(cfg)
+            used = [st["variant"] for st in json.loads((out / "summary.json").read_text())["steps_detail"]]
+            b.emit({"part": "lookahead", "path": path_name, "graph": graph_name, "variants": names,
+                    "lookahead_steps": steps, **{f"deviation_{k}": s["deviation"][k] for k in ("mean_m", "max_m",
+                                                                                            "final_m")},
+                    "steps": s["steps"], "skating": s["foot_skating_ratio"],
+                    "transition_speed_ratio": s["transitions"]["ratio"], "synthesis_s": s["synthesis_seconds"],
+                    "variants_used": {n: used.count(n) for n in set(used)}, "sharp_turn_warnings": len(caught),
+                    "load": os.getloadavg()[0]})
+
+
 def part_tables(b: Bench, samples: int) -> None:
     for primitive in STANCES:
         model, clips = b.model(primitive), b.clips(primitive)["train"]
@@ -481,10 +526,14 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--arm-primitive", default="raise", choices=["raise", "lower", "wave"],
                         help="the arm primitive of part arm (wave: of a wave-… --arm-content)")
     parser.add_argument("--vae-run", type=Path, help="a finished stylemotion-reproduce run folder (part vae)")
+    parser.add_argument("--variant-runs", type=Path, nargs="*", default=[],
+                        help="part lookahead: stylemotion-train experiment=morphable_graph run folders of both walk "
+                             "stances with turn=null (variant all), left, right and straight")
     args = parser.parse_args(argv)
     b = Bench(args.data, Path(args.out), args.style)
     parts = args.parts.split(",")
-    unknown = set(parts) - {"k", "dims", "tree", "path", "tables", "density", "latent", "vae", "arm", "rows"}
+    unknown = set(parts) - {"k", "dims", "tree", "path", "tables", "density", "latent", "vae", "arm", "rows",
+                            "lookahead"}
     if unknown:
         parser.error(f"unknown parts {sorted(unknown)}")
     if "k" in parts:
@@ -509,6 +558,10 @@ def main(argv: list[str] | None = None) -> int:
         part_vae(b, args.vae_run, args.K, args.sfpca_iterations)
     if "rows" in parts:
         part_rows(b, args.vae_run)
+    if "lookahead" in parts:
+        if not args.variant_runs:
+            parser.error("part lookahead needs --variant-runs <run folders>")
+        part_lookahead(b, args.variant_runs)
     return 0
 
 

@@ -25,7 +25,7 @@ from __future__ import annotations
 import logging
 import warnings
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -207,12 +207,20 @@ class MorphablePrimitive:
         return self
 
     def sample(self, n: int, seed: int = 0):
-        """``n`` samples spread evenly over the variants (what the step profile measures)."""
+        """``n`` samples spread evenly over the variants (what the step profile measures). Variants differ in
+        timeline, coefficients and latent size, so a several-variant node's samples carry the motions
+        (positions, frames, durations) and, where their shapes differ, empty features, normalized frames and
+        codes."""
         from stylemotion.morphable.model import concat_samples
 
         counts = np.diff(np.linspace(0, n, len(self.variants) + 1).round().astype(int))
         parts = [m.sample(int(c), seed) for m, c in zip(self.variants.values(), counts) if c > 0]
-        return parts[0] if len(parts) == 1 else concat_samples(parts)
+        if len(parts) == 1:
+            return parts[0]
+        for name in ("features", "normalized_frames", "latent"):
+            if len({tuple(getattr(p, name).shape[1:]) for p in parts}) > 1:
+                parts = [replace(p, **{name: getattr(p, name).reshape(len(p), -1)[:, :0]}) for p in parts]
+        return concat_samples(parts)
 
     def decode_latent(self, latent):
         return self.variants[self.last_variant].decode_latent(latent)

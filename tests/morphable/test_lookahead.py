@@ -102,3 +102,12 @@ def test_the_walk_chooses_variants_and_decodes_with_them(turn_models, tmp_path):
         MapSettings(lookahead_steps=0)
     same = MorphablePrimitive([turn_models[("leftStance", "all")]] * 2)  # same variant name twice: suffixed
     assert list(same.variants) == ["all", "all_1"]
+
+
+def test_variants_of_different_shapes_sample_together(turn_models, left_clips):
+    other = fit_primitive(select_turn(left_clips["train"], "left", 5.0),
+                          FitSettings(latent_dim=2, reduction="fpca", num_coefficients=5), meta={"variant": "small"})
+    node = MorphablePrimitive([turn_models[("leftStance", "all")], other])
+    samples = node.sample(10, seed=0)
+    assert samples.positions.shape[0] == 10 and samples.num_frames.shape == (10,)
+    assert samples.latent.shape == (10, 0) and samples.features.shape[1] == 0  # codes of different spaces: dropped
