@@ -42,9 +42,11 @@ def keyframe_frames(length: int) -> list[int]:
     return [int(round(t * (length - 1))) for t in KEYFRAME_TIMES]
 
 
-def keyframe_values(model, latent: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def keyframe_values(model, latent: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
     """Positions ``(n, 2, 21, 3)`` (m) and global rotations ``(n, 2, 21, 3, 3)`` of ``(n, d)`` codes at the
-    keyframes."""
+    keyframes (rotations None for a model of the 66-dim frames, which has no joint orientations)."""
+    if model.channels.kind != "quaternion":
+        return model.poses_at(latent, keyframe_frames(model.length)), None
     return model.poses_at(latent, keyframe_frames(model.length), rotations=True)
 
 
@@ -53,6 +55,8 @@ def clustering_features(model, latent: np.ndarray) -> np.ndarray:
     distance approximates the objective's orientation error (``‖ΔR‖_F ≈ √2 θ`` for small angles)."""
     pos, rot = keyframe_values(model, latent)
     n = len(latent)
+    if rot is None:
+        return pos.reshape(n, -1)
     return np.concatenate([pos.reshape(n, -1), rot.reshape(n, -1) * (ORIENTATION_SCALE_M / np.sqrt(2.0))], axis=1)
 
 
@@ -66,33 +70,35 @@ def _outward(lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 @dataclass
 class KeyframeBounds:
     """Per-node boxes: ``position_lo``/``position_hi`` ``(M, 2, 21, 3)`` metres and ``rotation_lo``/
-    ``rotation_hi`` ``(M, 2, 21, 9)`` matrix entries (float32, rounded outwards); ``frames``: the keyframes'
-    canonical indices."""
+    ``rotation_hi`` ``(M, 2, 21, 9)`` matrix entries (float32, rounded outwards; None for a frames model);
+    ``frames``: the keyframes' canonical indices."""
 
     position_lo: np.ndarray
     position_hi: np.ndarray
-    rotation_lo: np.ndarray
-    rotation_hi: np.ndarray
+    rotation_lo: np.ndarray | None
+    rotation_hi: np.ndarray | None
     frames: list[int]
 
     @classmethod
     def of(cls, model, tree: SpaceTree) -> KeyframeBounds:
         pos, rot = keyframe_values(model, tree.latent)
         p_lo, p_hi = _outward(*tree.node_bounds(pos))
-        r_lo, r_hi = _outward(*tree.node_bounds(rot.reshape(*rot.shape[:3], 9)))
+        r_lo, r_hi = (None, None) if rot is None else _outward(*tree.node_bounds(rot.reshape(*rot.shape[:3], 9)))
         return cls(p_lo, p_hi, r_lo, r_hi, keyframe_frames(model.length))
 
     @property
     def nbytes(self) -> int:
-        return sum(a.nbytes for a in (self.position_lo, self.position_hi, self.rotation_lo, self.rotation_hi))
+        arrays = (self.position_lo, self.position_hi, self.rotation_lo, self.rotation_hi)
+        return sum(a.nbytes for a in arrays if a is not None)
 
     def lower_bound(self, constraints: Sequence[KeyframeConstraint], length: int):
         """``nodes → (bound, guess)`` for :meth:`~.tree.SpaceTree.search_bounded` (guess: the error at the
-        boxes' centres), or None when a constraint is not at a keyframe."""
+        boxes' centres), or None when a constraint is not at a keyframe (or is an orientation without rotation
+        boxes)."""
         slots = []
         for c in constraints:
             frame = int(round(c.frame * (length - 1)))
-            if frame not in self.frames:
+            if frame not in self.frames or (c.kind == "orientation" and self.rotation_lo is None):
                 return None
             slots.append(self.frames.index(frame))
 

@@ -67,3 +67,20 @@ def test_constraints_off_the_keyframes_use_the_beam_search(left_model):
 def test_unknown_tree_space_is_refused(left_model):
     with pytest.raises(ValueError, match="unknown tree space 'pca'"):
         left_model.build_tree(100, space="pca")
+
+
+def test_a_frames_model_bounds_positions_and_poses(left_clips):
+    from stylemotion.morphable import FitSettings, fit_primitive
+
+    model = fit_primitive(left_clips["train"], FitSettings(representation="frames", latent_dim=3, reduction="fpca",
+                                                           num_coefficients=6))
+    model.build_tree(400, seed=0)  # keyframe space: positions only (the frames have no joint orientations)
+    assert model.tree.space == "keyframes" and model.keyframe_bounds().rotation_lo is None
+    code = model.gmm.sample(1, seed=3)
+    target = model.poses_at(code, [model.length - 1])[0, 0]
+    pose = KeyframeConstraint("pose", target + 0.01)
+    exact = brute_force(model.tree.latent, objective(model, [pose]))
+    found = best_code(model, [pose], max_evaluations=len(model.tree.latent))
+    assert found.exact and found.cost == pytest.approx(exact.cost)
+    turn = KeyframeConstraint("orientation", np.eye(3), joint="Hips")
+    assert model.keyframe_bounds().lower_bound([turn], model.length) is None  # no rotation boxes: beam search
