@@ -66,6 +66,7 @@ from stylemotion.morphable.model import (
     spline_rmse,
 )
 from stylemotion.morphable.tree import SpaceTree, brute_force
+from stylemotion.morphable.variants import variant_name
 from stylemotion.primitives import parse_primitive, time_normalize
 from stylemotion.sampling import pad_motions
 from stylemotion.skeleton import CANONICAL_JOINTS
@@ -260,7 +261,7 @@ def part_lookahead(b: Bench, runs: list[Path]) -> None:
               "3 variants, T=3": (three, 3), "all + turns, T=2": (["all", "left", "right"], 2)}
     for path_name, path in LOOKAHEAD_PATHS.items():
         for graph_name, (variants, steps) in graphs.items():
-            names = ["all" if v == "all" else f"turn-{v}" for v in variants]
+            names = [variant_name(None if v == "all" else v) for v in variants]
             chosen = {key: [found[n] for n in names] for key, found in models.items()}
             out = b.out / "lookahead" / path_name / graph_name.replace(" ", "_").replace(",", "").replace("+", "")
             cfg = {"model": {"family": "morphable"}, "models": chosen, "style": "neutral", "seed": 0, "out": str(out),

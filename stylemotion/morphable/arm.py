@@ -90,13 +90,17 @@ class ArmSettings:
                              f"min_wave_m > 0; got {self}")
 
 
+def _of_kind(content: str, prefixes: tuple[str, ...]) -> bool:
+    return any(content == p or content.startswith(p + "-") for p in prefixes)
+
+
 def is_arm_content(content: str) -> bool:
-    return any(content == p or content.startswith(p + "-") for p in ARM_CONTENTS)
+    return _of_kind(content, ARM_CONTENTS)
 
 
 def content_primitives(content: str) -> tuple[str, ...]:
     """The arm primitives of an arm content, in take order (``wave`` only for :data:`WAVE_CONTENTS`)."""
-    waves = any(content == p or content.startswith(p + "-") for p in WAVE_CONTENTS)
+    waves = _of_kind(content, WAVE_CONTENTS)
     return tuple(p for p in ARM_PRIMITIVES if waves or p != "wave")
 
 

@@ -284,7 +284,6 @@ class MorphableModel:
         features = clustering_features(self, codes) if space == "keyframes" else None
         self.tree = SpaceTree.build(codes, split=split, seed=seed, leaf_size=leaf_size, features=features,
                                     space=space, **kwargs)
-        self._bounds = None
         return self.tree
 
     def ensure_tree(self) -> SpaceTree:
@@ -300,7 +299,7 @@ class MorphableModel:
         from stylemotion.morphable.bounds import KeyframeBounds
 
         tree = self.ensure_tree()
-        if self._bounds is None or self._bounds[0] is not tree:
+        if self._bounds is None or self._bounds[0] is not tree:  # kept with the tree it was computed for
             self._bounds = (tree, KeyframeBounds.of(self, tree))
         return self._bounds[1]
 

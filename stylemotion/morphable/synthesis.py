@@ -42,8 +42,6 @@ from stylemotion.morphable.model import MorphableModel
 from stylemotion.skeleton import NUM_JOINTS
 
 log = logging.getLogger(__name__)
-#: Nodes after a primitive known to its look-ahead (``lookahead_steps`` − 1 of them are used).
-LOOKAHEAD_NODES = 4
 
 
 class UnreachableConstraintWarning(UserWarning):
@@ -233,11 +231,11 @@ class MorphablePrimitive:
 
     def choose_variant(self, goal, follow) -> str:
         """The variant for the step of ``goal`` (module doc of :mod:`.lookahead`)."""
-        nodes = [self] + self.following[:max(self.settings.lookahead_steps - 1, 0)]
-        options = [n.mean_steps() for n in nodes]
-        targets = [(goal.target_xz.double().numpy(), float(goal.target_yaw))] + list(goal.ahead)
         if len(self.variants) == 1:
             return self.last_variant
+        nodes = [self] + self.following[:self.settings.lookahead_steps - 1]
+        options = [n.mean_steps() for n in nodes]
+        targets = [(goal.target_xz.double().numpy(), float(goal.target_yaw))] + list(goal.ahead)
         choice = choose(options, goal.start_xz.double().numpy(), float(goal.start_yaw), targets,
                         follow.position_scale_m, follow.heading_scale_rad)
         return options[0][choice.index].name
@@ -255,13 +253,14 @@ class MorphablePrimitive:
 def link_graph(graph) -> None:
     """Tell every Morphable Graph node of ``graph`` which nodes take the steps after it (alternating stances,
     as the controller walks), for the look-ahead."""
+    from stylemotion.synthesis.controller import LOOKAHEAD_TARGETS
     from stylemotion.synthesis.graph import TRANSITIONS
 
     for name, node in graph.models.items():
         if not isinstance(node, MorphablePrimitive):
             continue
         node.following, current = [], name
-        for _ in range(LOOKAHEAD_NODES):
+        for _ in range(LOOKAHEAD_TARGETS):  # as many nodes as the controller hands on targets of later steps
             nxt = [p for p in TRANSITIONS[current] if p in graph.models and not p.startswith("end")]
             if not nxt or not isinstance(graph.models[nxt[0]], MorphablePrimitive):
                 break

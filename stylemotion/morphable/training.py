@@ -79,9 +79,9 @@ def run(cfg: DictConfig) -> dict[str, Any]:
     except (TypeError, ValueError) as err:  # a bad model.* value, too few clips, a mixture that cannot be fitted
         raise ConfigError(f"experiment=morphable_graph, {action}_{primitive}: {err}") from err
     if tree_cfg.get("samples", 0):
+        given = {k: tree_cfg[k] for k in ("split", "space", "leaf_size") if tree_cfg.get(k) is not None}
         try:
-            model.build_tree(int(tree_cfg["samples"]), str(tree_cfg.get("split", "kmeans")), int(cfg.seed),
-                             space=str(tree_cfg.get("space", "keyframes")), leaf_size=int(tree_cfg.get("leaf_size", 4)))
+            model.build_tree(int(tree_cfg["samples"]), seed=int(cfg.seed), **given)  # defaults: build_tree's
         except ValueError as err:  # an unknown split or space, a bad leaf size
             raise ConfigError(f"experiment=morphable_graph, model.tree: {err}") from err
     model.save(model_path)

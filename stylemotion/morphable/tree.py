@@ -113,9 +113,8 @@ class SpaceTree:
         children = np.full((len(nodes), branching), -1, dtype=np.int64)
         for i, n in enumerate(nodes):
             children[i, :len(n["children"])] = n["children"]
-        tree = cls(latent[np.concatenate(order)], np.stack([n["centroid"] for n in nodes]), children,
+        return cls(latent[np.concatenate(order)], np.stack([n["centroid"] for n in nodes]), children,
                    np.array([n["start"] for n in nodes]), np.array([n["stop"] for n in nodes]), split, space)
-        return tree
 
     @property
     def is_leaf(self) -> np.ndarray:

@@ -225,6 +225,11 @@ def _end_state(frames: np.ndarray, fps: float, start_xz: np.ndarray, start_yaw: 
     return root[-1].numpy(), float(yaw[-1])
 
 
+def _path_target(path: GroundPath, s: float) -> tuple[np.ndarray, float]:
+    """The path's point (m) and heading (rad) ``s`` metres along it."""
+    return path.point_at(s), float(path.heading_at(min(s, path.length - 1e-9)))
+
+
 def check_turns(graph: MotionGraph, path: GroundPath) -> list[str]:
     """Warnings for stretches of ``path`` that turn more within one step length than any step can."""
     stances = [graph.profiles[p] for p in ("leftStance", "rightStance")]
@@ -278,12 +283,9 @@ def follow_path(graph: MotionGraph, path: GroundPath, seed: int = 0, settings: F
             break
         if needed == 1 and steps and not primitive.startswith("end"):
             primitive = graph.next(steps[-1].primitive, last=True)  # the last step: end primitive if modelled
-        target_s = float(s0) + remaining / needed
-        target_xz, target_yaw = path.point_at(target_s), float(path.heading_at(min(target_s, path.length - 1e-9)))
         spacing = remaining / needed
-        ahead = [(path.point_at(target_s + k * spacing),
-                  float(path.heading_at(min(target_s + k * spacing, path.length - 1e-9))))
-                 for k in range(1, min(needed, LOOKAHEAD_TARGETS + 1))]
+        target_xz, target_yaw = _path_target(path, float(s0) + spacing)
+        ahead = [_path_target(path, float(s0) + k * spacing) for k in range(2, min(needed, LOOKAHEAD_TARGETS + 1) + 1)]
         goal = _StepGoal(
             start_xz=torch.tensor(place_xz, dtype=torch.float32), start_yaw=torch.tensor(place_yaw),
             target_xz=torch.tensor(target_xz, dtype=torch.float32), target_yaw=torch.tensor(target_yaw),
