@@ -23,6 +23,8 @@ from datetime import datetime
 from pathlib import Path
 from typing import Any
 
+from stylemotion.io.errors import UserInputError
+
 #: The packaged Hydra configs, as a folder on disk.
 CONFIG_DIR = Path(__file__).resolve().parent / "configs"
 #: The same configs as a Hydra search path (what the console scripts pass to ``hydra.main``).
@@ -39,7 +41,7 @@ def config_dir() -> str:
     return str(CONFIG_DIR)
 
 
-class ConfigError(ValueError):
+class ConfigError(UserInputError, ValueError):
     """A config value that cannot be used; the message names the key and the value."""
 
 

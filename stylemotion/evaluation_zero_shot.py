@@ -52,6 +52,7 @@ from stylemotion.evaluation.sources import NEUTRAL, EvalModel, check_one_autoenc
 from stylemotion.evaluation.tables import across_sample_sd, distance_table
 from stylemotion.finished_run import FinishedRun, read_json_object
 from stylemotion.io.atomic import atomic_write_bytes
+from stylemotion.io.errors import UserInputError
 from stylemotion.io.outputs import check_new_output, inside
 from stylemotion.models.checkpoints import fingerprint, load_autoencoder, load_generative
 from stylemotion.models.zero_shot import ZeroShotStyleVAE
@@ -65,7 +66,7 @@ Say = Callable[[str], None]
 ROWS = ("zero_shot", "cvae", "real")
 
 
-class ZeroShotRunError(ValueError):
+class ZeroShotRunError(UserInputError, ValueError):
     """The reproduce run (or a given checkpoint) cannot serve the leave-one-style-out evaluation."""
 
 

@@ -59,6 +59,7 @@ from stylemotion.config import positive_int, set_torch_threads  # also registers
 from stylemotion.datasets import build_dataset, data_config_key
 from stylemotion.evaluation.run import recorded_path, run_evaluation, summary_lines
 from stylemotion.io.atomic import atomic_write_bytes
+from stylemotion.io.errors import UserInputError
 from stylemotion.io.outputs import inside, safe_name
 from stylemotion.primitives import SegmentSettings, action_of, parse_primitive, segment_takes
 from stylemotion.provenance import provenance
@@ -72,7 +73,7 @@ ENGINES = ("pool", "local", "slurm")
 POLL_SECONDS = 2.0
 
 
-class StageConflictError(RuntimeError):
+class StageConflictError(UserInputError, RuntimeError):
     """A stage folder holds results of different settings than the current run's."""
 
 

@@ -35,6 +35,7 @@ from omegaconf import DictConfig, OmegaConf
 
 from stylemotion.config import ConfigError, check_trainer_numbers, set_torch_threads
 from stylemotion.io.atomic import atomic_write_bytes
+from stylemotion.io.errors import UserInputError
 from stylemotion.io.outputs import OutputExistsError
 from stylemotion.provenance import provenance
 
@@ -47,7 +48,7 @@ LOGGER_RESULTS = ("events.out.tfevents.*", "metrics.csv")
 LOGGER_FILES = (*LOGGER_RESULTS, "hparams.yaml")
 
 
-class CheckpointNotFoundError(FileNotFoundError):
+class CheckpointNotFoundError(UserInputError, FileNotFoundError):
     """``ckpt_path`` names a checkpoint that does not exist."""
 
 

@@ -23,12 +23,13 @@ import numpy as np
 
 from stylemotion.annotate.subsequence import subsequence_dtw
 from stylemotion.annotate.templates import MotionTemplate, local_cost
+from stylemotion.io.errors import UserInputError
 
 #: Matching threshold τ (the thesis used 0.13 with its features; our masked costs are smaller: benchmarks/annotate.md).
 DEFAULT_TAU = 0.02
 
 
-class AnnotationInputError(ValueError):
+class AnnotationInputError(UserInputError, ValueError):
     """A document or template set the annotation cannot use; the message names the value."""
 
 

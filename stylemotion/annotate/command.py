@@ -35,6 +35,7 @@ from stylemotion.config import ConfigError, positive_int
 from stylemotion.datasets import build_dataset
 from stylemotion.datasets.loading import ConversionSettings
 from stylemotion.io.atomic import atomic_folder, atomic_write_bytes
+from stylemotion.io.errors import UserInputError
 from stylemotion.io.outputs import check_new_output, inside
 from stylemotion.provenance import provenance
 from stylemotion.style_example.example import StyleExampleError, convert_example, parse_example
@@ -42,7 +43,7 @@ from stylemotion.style_example.example import StyleExampleError, convert_example
 Say = Callable[[str], None]
 
 
-class AnnotateInputError(ValueError):
+class AnnotateInputError(UserInputError, ValueError):
     """A ``stylemotion-annotate`` input that cannot be used; the message names the key and the value."""
 
 

@@ -17,13 +17,14 @@ from __future__ import annotations
 import numpy as np
 
 from stylemotion.geometry import facing_direction, left_direction, wrap_angle
+from stylemotion.io.errors import UserInputError
 from stylemotion.representation import facing_yaw
 from stylemotion.skeleton import JOINT_INDEX, NUM_JOINTS
 
 J = JOINT_INDEX
 
 
-class FeatureInputError(ValueError):
+class FeatureInputError(UserInputError, ValueError):
     """Positions that relational features cannot be computed on (wrong shape, non-finite, degenerate body)."""
 
 

@@ -22,12 +22,13 @@ from stylemotion.annotate.templates import DELTA, MotionTemplate, TemplateInputE
 from stylemotion.annotate.tensors import MotionTensor, TensorInputError, build_tensor
 from stylemotion.datasets.base import Take
 from stylemotion.io.atomic import atomic_write_bytes
+from stylemotion.io.errors import UserInputError
 from stylemotion.io.outputs import inside
 
 MODEL_FORMAT = 1
 
 
-class ModelFolderError(ValueError):
+class ModelFolderError(UserInputError, ValueError):
     """A templates folder that cannot be read; the message names the file and what is wrong."""
 
 

@@ -17,13 +17,14 @@ from dataclasses import dataclass
 import numpy as np
 from dtaidistance import dtw_ndim
 
+from stylemotion.io.errors import UserInputError
 from stylemotion.morphable.warping import resample
 
 #: Quantization threshold δ of the thesis (entries ≤ δ become 0, ≥ 1 − δ become 1, the rest wildcards).
 DELTA = 0.05
 
 
-class TemplateInputError(ValueError):
+class TemplateInputError(UserInputError, ValueError):
     """Examples a template cannot be learned from; the message names the class and the count or shape."""
 
 

@@ -32,6 +32,7 @@ from scipy.optimize import lsq_linear
 from tensorly.tenalg import mode_dot, multi_mode_dot
 
 from stylemotion.annotate.templates import resample_length, warp_to
+from stylemotion.io.errors import UserInputError
 from stylemotion.representation import positions_to_frames
 from stylemotion.skeleton import NUM_JOINTS
 
@@ -40,7 +41,7 @@ WEIGHT_BOUNDS = (-0.2, 1.2)
 DOF = NUM_JOINTS * 3
 
 
-class TensorInputError(ValueError):
+class TensorInputError(UserInputError, ValueError):
     """Examples a motion tensor cannot be built from; the message names the class, style and count."""
 
 

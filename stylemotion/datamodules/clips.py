@@ -41,6 +41,7 @@ from torch.utils.data import Dataset
 
 from stylemotion.datamodules.base import SplitDataModule
 from stylemotion.datasets import TakeSet
+from stylemotion.io.errors import UserInputError
 from stylemotion.primitives import (
     PRIMITIVES,
     Clip,
@@ -60,7 +61,7 @@ DEFAULT_EXAMPLE: dict[str, Any] = {"primitive": None, "content": None, "pick": "
                                    "take": None, "start": None, "split": "all"}
 
 
-class NoClipsError(ValueError):
+class NoClipsError(UserInputError, ValueError):
     """A selection (split, primitive, style or style example) holds no clip."""
 
 

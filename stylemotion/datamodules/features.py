@@ -53,6 +53,7 @@ from torch.utils.data import Dataset
 from stylemotion.datamodules.base import SplitDataModule
 from stylemotion.datamodules.clips import ClipDataModule, NoClipsError
 from stylemotion.datasets import TakeSet
+from stylemotion.io.errors import UserInputError
 from stylemotion.models.autoencoder import MotionAutoencoder
 from stylemotion.models.checkpoints import autoencoder_info, load_autoencoder
 from stylemotion.primitives import Clip, parse_primitive, time_normalize
@@ -70,11 +71,11 @@ FEATURE_SCALES = ("global", "channel")
 MIN_TRAIN_CLIPS = 32
 
 
-class TooFewClipsError(ValueError):
+class TooFewClipsError(UserInputError, ValueError):
     """A primitive has too few clips in a split to train or validate a model."""
 
 
-class ReceptiveFieldError(ValueError):
+class ReceptiveFieldError(UserInputError, ValueError):
     """A style example (or the canonical length of the content clips) is shorter than the
     autoencoder's receptive field."""
 

@@ -24,6 +24,7 @@ from torch.utils.data import Dataset
 from stylemotion.datamodules.base import SplitDataModule
 from stylemotion.datamodules.normalization import DEFAULT_STD_FLOOR, channel_stats
 from stylemotion.datasets import Take, TakeSet
+from stylemotion.io.errors import UserInputError
 from stylemotion.representation import FRAME_DIM, REPRESENTATION
 
 log = logging.getLogger(__name__)
@@ -31,7 +32,7 @@ log = logging.getLogger(__name__)
 SPLITS = ("train", "val", "test")
 
 
-class EmptySplitError(ValueError):
+class EmptySplitError(UserInputError, ValueError):
     """A split needed for training or testing holds no window."""
 
 

@@ -17,6 +17,7 @@ import numpy as np
 
 from stylemotion.datasets.loading import ConversionSettings, load_canonical_positions
 from stylemotion.io.atomic import atomic_write_bytes
+from stylemotion.io.errors import UserInputError
 from stylemotion.io.sources import FileSource
 from stylemotion.skeleton import CANONICAL_JOINTS
 
@@ -24,7 +25,7 @@ from stylemotion.skeleton import CANONICAL_JOINTS
 OUTPUT_SUFFIXES = (".npz",)
 
 
-class ConvertError(ValueError):
+class ConvertError(UserInputError, ValueError):
     """A bad argument of ``stylemotion-convert`` (frame rate, output path); the message names it."""
 
 

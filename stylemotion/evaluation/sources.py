@@ -19,6 +19,7 @@ from typing import Any, Protocol, runtime_checkable
 import numpy as np
 import torch
 
+from stylemotion.io.errors import UserInputError
 from stylemotion.models.autoencoder import IncompatibleModelError
 from stylemotion.models.checkpoints import load_generative
 from stylemotion.models.cvae import StyleCVAE
@@ -34,7 +35,7 @@ class MixedAutoencodersError(IncompatibleModelError):
     """Models of one evaluation were trained on features of different autoencoders."""
 
 
-class MissingExampleError(ValueError):
+class MissingExampleError(UserInputError, ValueError):
     """A style model's example clip cannot be found (or does not match) in the evaluation data."""
 
 

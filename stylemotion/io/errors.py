@@ -1,9 +1,20 @@
-"""Errors and warnings that name where bad input was found."""
+"""Errors and warnings that name where bad input was found.
+
+:class:`UserInputError` is the one base of every error that bad input (a value, a file, a folder, a
+checkpoint) causes, as opposed to a bug: every command turns it into one line naming the file, line,
+key or value, and exit status 2 (:mod:`stylemotion.cli.skeleton`). Each module's own error class
+derives from it (and from the builtin it replaces, e.g. ``ValueError``, so older ``except`` clauses
+still catch it).
+"""
 
 from __future__ import annotations
 
 
-class MotionDataError(ValueError):
+class UserInputError(Exception):
+    """Input the user gave that cannot be used; the message names the file, line, key or value."""
+
+
+class MotionDataError(UserInputError, ValueError):
     """Bad motion data: names the file (and line, joint or key) and what was expected."""
 
     def __init__(self, source: str, message: str, line: int | None = None):

@@ -13,12 +13,14 @@ import re
 import unicodedata
 from pathlib import Path
 
+from stylemotion.io.errors import UserInputError
 
-class OutputExistsError(FileExistsError):
+
+class OutputExistsError(UserInputError, FileExistsError):
     """An output (folder or file) exists and the command was not told to replace it."""
 
 
-class UnsafePathError(ValueError):
+class UnsafePathError(UserInputError, ValueError):
     """A path built from data would leave its output folder."""
 
 

@@ -31,6 +31,7 @@ import torch
 import torch.nn.functional as F
 from torch import nn
 
+from stylemotion.io.errors import UserInputError
 from stylemotion.models.normalization import Normalizer
 from stylemotion.representation import FRAME_DIM, JOINT_DIMS, REPRESENTATION, frames_to_positions
 from stylemotion.skeleton import CANONICAL_JOINTS, CANONICAL_PARENTS, NUM_JOINTS
@@ -38,7 +39,7 @@ from stylemotion.skeleton import CANONICAL_JOINTS, CANONICAL_PARENTS, NUM_JOINTS
 POOLING = ("avg", "max")
 
 
-class IncompatibleModelError(ValueError):
+class IncompatibleModelError(UserInputError, ValueError):
     """A model (or checkpoint) does not fit the data or code it is used with."""
 
 

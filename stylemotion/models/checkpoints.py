@@ -36,6 +36,7 @@ from typing import Any
 import lightning.pytorch as pl
 import torch
 
+from stylemotion.io.errors import UserInputError
 from stylemotion.models.autoencoder import IncompatibleModelError, MotionAutoencoder
 
 log = logging.getLogger(__name__)
@@ -50,7 +51,7 @@ KINDS = ("autoencoder", "vae", "cvae", "zero_shot")
 GENERATIVE_KINDS = ("vae", "cvae", "zero_shot")
 
 
-class MissingAutoencoderError(FileNotFoundError):
+class MissingAutoencoderError(UserInputError, FileNotFoundError):
     """A generative model's autoencoder is neither embedded in its checkpoint nor found on disk."""
 
 

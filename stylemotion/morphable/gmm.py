@@ -17,10 +17,12 @@ from scipy.special import logsumexp
 from sklearn.exceptions import ConvergenceWarning
 from sklearn.mixture import GaussianMixture
 
+from stylemotion.io.errors import UserInputError
+
 log = logging.getLogger(__name__)
 
 
-class MixtureFitError(ValueError):
+class MixtureFitError(UserInputError, ValueError):
     """No mixture could be fitted to the latent codes."""
 
 

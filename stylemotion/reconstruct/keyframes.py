@@ -45,6 +45,7 @@ import numpy as np
 
 from stylemotion.contacts import foot_contacts
 from stylemotion.geometry import rotate_yaw, wrap_angle
+from stylemotion.io.errors import UserInputError
 from stylemotion.reconstruct.texture import MotionTexturer
 from stylemotion.representation import facing_yaw
 from stylemotion.search.database import MotionDatabase
@@ -60,11 +61,11 @@ FAR_KEY_M = 0.5
 Say = Callable[[str], None]
 
 
-class KeyframeError(ValueError):
+class KeyframeError(UserInputError, ValueError):
     """A keyframe, setting or database that cannot be used; the message names the value."""
 
 
-class NoConnectionError(RuntimeError):
+class NoConnectionError(UserInputError, RuntimeError):
     """Two consecutive keyframes whose trees never met; the message names the keys and how close they came."""
 
 

@@ -32,6 +32,7 @@ from pathlib import Path
 
 import numpy as np
 
+from stylemotion.io.errors import UserInputError
 from stylemotion.skeleton import CANONICAL_JOINTS, JOINT_INDEX
 
 #: Table 2.3's six markers: the 4 end effectors (wrists, ankles), the head and the root.
@@ -40,7 +41,7 @@ DEFAULT_MARKERS = ("Hand_L", "Hand_R", "Foot_L", "Foot_R", "Head", "Hips")
 MARKER_FORMATS = (".bvh", ".npz", ".csv")
 
 
-class MarkerInputError(ValueError):
+class MarkerInputError(UserInputError, ValueError):
     """Marker input that cannot be used; the message names the joint, frame, column or value."""
 
 

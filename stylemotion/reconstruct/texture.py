@@ -46,6 +46,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.linalg import splu
 
+from stylemotion.io.errors import UserInputError
 from stylemotion.reconstruct.markers import check_joint_names
 from stylemotion.reconstruct.sparse import marker_frames, to_local, to_world
 from stylemotion.search.database import MotionDatabase
@@ -64,7 +65,7 @@ DEFAULT_WEIGHTS = {"complete": {"pose": 1.0, "motion": 4.0, "smooth": 4.0, "cont
                    "texture": {"pose": 0.05, "motion": 10.0, "smooth": 40.0, "control": 4.0}}
 
 
-class TextureInputError(ValueError):
+class TextureInputError(UserInputError, ValueError):
     """A motion, joint, mode or setting that cannot be used; the message names the value."""
 
 

@@ -36,6 +36,7 @@ from stylemotion.config import ConfigError, positive_int
 from stylemotion.datasets import TakeSet, build_dataset
 from stylemotion.datasets.loading import ConversionSettings
 from stylemotion.io.atomic import atomic_folder, atomic_write_bytes
+from stylemotion.io.errors import UserInputError
 from stylemotion.io.outputs import check_new_output, inside, safe_name
 from stylemotion.provenance import provenance
 from stylemotion.search.database import MotionDatabase
@@ -48,7 +49,7 @@ from stylemotion.style_example.example import StyleExampleError, convert_example
 Say = Callable[[str], None]
 
 
-class SearchInputError(ValueError):
+class SearchInputError(UserInputError, ValueError):
     """A ``stylemotion-search`` input that cannot be used; the message names the key and the value."""
 
 

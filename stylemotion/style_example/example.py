@@ -27,7 +27,7 @@ from stylemotion.datasets.base import Take, TakeSet
 from stylemotion.datasets.loading import ConversionSettings, convert_motion
 from stylemotion.datasets.retarget import skeleton_record
 from stylemotion.io.bvh import parse_bvh
-from stylemotion.io.errors import MotionDataError
+from stylemotion.io.errors import MotionDataError, UserInputError
 from stylemotion.io.outputs import safe_name
 from stylemotion.io.sources import FileSource
 from stylemotion.primitives import Clip, Segmentation, SegmentSettings, parse_primitive, segment_action
@@ -43,7 +43,7 @@ MAX_REASONS = 6
 EXAMPLE_FILE = "example/example.npz"
 
 
-class StyleExampleError(ValueError):
+class StyleExampleError(UserInputError, ValueError):
     """A ``stylemotion-style`` input that cannot be used; the message names the key and the value."""
 
 

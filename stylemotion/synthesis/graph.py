@@ -34,6 +34,7 @@ import numpy as np
 import torch
 
 from stylemotion.evaluation.sources import NEUTRAL, load_model
+from stylemotion.io.errors import UserInputError
 from stylemotion.models.autoencoder import IncompatibleModelError
 from stylemotion.models.checkpoints import load_autoencoder, load_generative
 from stylemotion.models.vae import PrimitiveVAE
@@ -56,7 +57,7 @@ PROFILE_SAMPLES = 512
 STYLE_FOLDER_KIND = "style"
 
 
-class UnknownStyleError(KeyError):
+class UnknownStyleError(UserInputError, KeyError):
     """The requested style has no trained model for a primitive the graph needs."""
 
     def __str__(self) -> str:  # KeyError quotes its message otherwise

@@ -30,6 +30,7 @@ import numpy as np
 from scipy.interpolate import CubicSpline
 
 from stylemotion.geometry import direction_yaw, wrap_angle
+from stylemotion.io.errors import UserInputError
 
 #: Spacing of the dense polyline a spline is sampled to, metres.
 SPLINE_SPACING_M = 0.02
@@ -39,7 +40,7 @@ MAX_COORDINATE_M = 1e6
 _BOOLEAN_WORDS = frozenset({"true", "false"})
 
 
-class PathError(ValueError):
+class PathError(UserInputError, ValueError):
     """A path that cannot be followed (too few points, non-finite values, zero length, bad file)."""
 
 

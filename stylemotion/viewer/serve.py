@@ -7,8 +7,10 @@ import functools
 import os
 from http.server import SimpleHTTPRequestHandler, ThreadingHTTPServer
 
+from stylemotion.io.errors import UserInputError
 
-class PortInUseError(OSError):
+
+class PortInUseError(UserInputError, OSError):
     """The port asked for is taken on 127.0.0.1."""
 
 
