@@ -30,7 +30,6 @@ For each primitive ``p`` of a finished ``stylemotion-reproduce`` run and each of
 
 from __future__ import annotations
 
-import json
 import logging
 import math
 import shutil
@@ -53,6 +52,7 @@ from stylemotion.evaluation.tables import across_sample_sd, distance_table
 from stylemotion.finished_run import FinishedRun, read_json_object
 from stylemotion.io.atomic import atomic_write_bytes
 from stylemotion.io.errors import UserInputError
+from stylemotion.io.jsonfile import write_json
 from stylemotion.io.outputs import check_new_output, inside
 from stylemotion.models.checkpoints import fingerprint, load_autoencoder, load_generative
 from stylemotion.models.zero_shot import ZeroShotStyleVAE
@@ -378,7 +378,7 @@ def leave_one_style_out(run: str | Path, out: str | Path, styles: Sequence[str] 
                         "checkpoints_from": None if checkpoints is None else str(checkpoints),
                         "settings": asdict(source.settings), **provenance(),
                         "seconds": time.perf_counter() - started}}
-    atomic_write_bytes(out / "zero_shot.json", json.dumps(payload, indent=1, default=str).encode())
+    write_json(out / "zero_shot.json", payload)
     atomic_write_bytes(out / "zero_shot.md", markdown(payload).encode())
     return payload
 

@@ -58,8 +58,8 @@ from omegaconf import DictConfig, OmegaConf, open_dict
 from stylemotion.config import positive_int, set_torch_threads  # also registers the configs' resolvers
 from stylemotion.datasets import build_dataset, data_config_key
 from stylemotion.evaluation.run import recorded_path, run_evaluation, summary_lines
-from stylemotion.io.atomic import atomic_write_bytes
 from stylemotion.io.errors import UserInputError
+from stylemotion.io.jsonfile import write_json
 from stylemotion.io.outputs import inside, safe_name
 from stylemotion.primitives import SegmentSettings, action_of, parse_primitive, segment_takes
 from stylemotion.provenance import provenance
@@ -108,7 +108,7 @@ def _hash(payload: Any) -> str:
 
 
 def _write_json(path: Path, payload: Any) -> None:
-    atomic_write_bytes(path, json.dumps(payload, indent=1, default=str).encode())
+    write_json(path, payload)
 
 
 class Reproduction:

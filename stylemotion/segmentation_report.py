@@ -21,7 +21,6 @@ written.
 from __future__ import annotations
 
 import dataclasses
-import json
 import logging
 from collections import Counter, defaultdict
 from pathlib import Path
@@ -32,6 +31,7 @@ from omegaconf import DictConfig, OmegaConf
 
 from stylemotion.datasets import Take, TakeSet, build_dataset
 from stylemotion.io.atomic import atomic_folder
+from stylemotion.io.jsonfile import write_json
 from stylemotion.io.outputs import check_new_output, inside, safe_name
 from stylemotion.primitives import (
     PRIMITIVES,
@@ -304,17 +304,9 @@ def write_report(cfg: DictConfig | dict, out: Path, force: bool = False, command
         report["figures"] = {"takes": plots, "sheets": sheets}
         report["command"] = command
         report["provenance"] = provenance(command or None)
-        (tmp / "report.json").write_text(json.dumps(report, indent=1, default=_json_default))
+        write_json(tmp / "report.json", report)
         (tmp / "report.md").write_text(format_report(report, command, plots, sheets))
     return report
-
-
-def _json_default(value: Any) -> Any:
-    if isinstance(value, (np.integer, np.floating)):
-        return value.item()
-    if isinstance(value, (tuple, set)):
-        return list(value)
-    raise TypeError(f"not JSON serializable: {type(value).__name__}")
 
 
 def summary_lines(report: dict[str, Any], out: Path) -> list[str]:

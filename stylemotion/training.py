@@ -36,6 +36,7 @@ from omegaconf import DictConfig, OmegaConf
 from stylemotion.config import ConfigError, check_trainer_numbers, set_torch_threads
 from stylemotion.io.atomic import atomic_write_bytes
 from stylemotion.io.errors import UserInputError
+from stylemotion.io.jsonfile import write_json
 from stylemotion.io.outputs import OutputExistsError
 from stylemotion.provenance import provenance
 
@@ -298,7 +299,7 @@ def _write_run_record(path: Path, start: dict[str, Any], run_id: str, resumed: b
         except (OSError, ValueError):
             log.warning("%s is unreadable: starting a new record", path)
     record.setdefault("starts", []).append(start)
-    atomic_write_bytes(path, json.dumps(record, indent=2).encode())
+    write_json(path, record, indent=2)
 
 
 def _best_checkpoint(trainer: pl.Trainer) -> str | None:
@@ -323,7 +324,7 @@ def _plain(value: Any) -> Any:
 
 @rank_zero_only
 def _write_metrics(path: Path, metrics: dict[str, Any]) -> None:
-    atomic_write_bytes(path, json.dumps(metrics, indent=2).encode())
+    write_json(path, metrics, indent=2)
     log.info("metrics written to %s", path)
 
 

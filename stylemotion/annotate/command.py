@@ -17,7 +17,6 @@ Outputs are written atomically into a new folder; an existing one is refused unl
 
 from __future__ import annotations
 
-import json
 import os
 import time
 from collections.abc import Callable, Mapping
@@ -36,6 +35,7 @@ from stylemotion.datasets import build_dataset
 from stylemotion.datasets.loading import ConversionSettings
 from stylemotion.io.atomic import atomic_folder, atomic_write_bytes
 from stylemotion.io.errors import UserInputError
+from stylemotion.io.jsonfile import write_json
 from stylemotion.io.outputs import check_new_output, inside
 from stylemotion.provenance import provenance
 from stylemotion.style_example.example import StyleExampleError, convert_example, parse_example
@@ -152,7 +152,7 @@ def annotate(document: str, templates: str | os.PathLike, out: str | os.PathLike
         plot_timeline(records, list(model.classes), len(labels), model.fps, inside(tmp, "timeline.png"),
                       f"{record['file']}: tau={settings.tau}, key frames {'on' if settings.keyframes else 'off'}")
         report["timing_s"] = round(time.perf_counter() - started, 3)
-        atomic_write_bytes(inside(tmp, "segments.json"), (json.dumps(report, indent=1) + "\n").encode())
+        write_json(inside(tmp, "segments.json"), report)
     say(f"{len(records)} segment(s), {report['labelled_fraction']:.0%} of {len(labels)} frames labelled; "
         f"written to {out}")
     return report

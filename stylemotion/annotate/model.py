@@ -23,6 +23,7 @@ from stylemotion.annotate.tensors import MotionTensor, TensorInputError, build_t
 from stylemotion.datasets.base import Take
 from stylemotion.io.atomic import atomic_write_bytes
 from stylemotion.io.errors import UserInputError
+from stylemotion.io.jsonfile import write_json
 from stylemotion.io.outputs import inside
 
 MODEL_FORMAT = 1
@@ -118,7 +119,7 @@ def save_model(model: AnnotationModel, folder: Path, extra: dict[str, Any] | Non
     }
     atomic_write_bytes(inside(folder, "templates.npz"), _npz(templates))
     atomic_write_bytes(inside(folder, "tensors.npz"), _npz(tensors))
-    atomic_write_bytes(inside(folder, "model.json"), (json.dumps(meta, indent=1) + "\n").encode())
+    write_json(inside(folder, "model.json"), meta)
 
 
 def load_model(folder: str | Path) -> AnnotationModel:

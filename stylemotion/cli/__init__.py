@@ -1,25 +1,10 @@
-"""Console scripts: thin Hydra/argparse entry points. The work they start lives in the library
-(:mod:`stylemotion.training`, :mod:`stylemotion.reproduction`, :mod:`stylemotion.evaluation.run`,
-:mod:`stylemotion.segmentation_report`, :mod:`stylemotion.synthesis.generate`,
-:mod:`stylemotion.datasets.convert`, :mod:`stylemotion.datasets.summary`), so notebooks can call it.
+"""Console scripts: thin entry points on one skeleton (:mod:`stylemotion.cli.skeleton`).
 
-Every command explains itself (``--help``: Hydra help configs in ``stylemotion/configs/hydra/help/``),
-reports what it did through :mod:`logging` (Hydra writes it to the console and to ``<job>.log`` in
-its run folder), and turns a bad value, path or existing output into one line
-``stylemotion-<command>: <message naming the key or file>`` and exit status 1 (:func:`reported`).
+Each module here names its command's library function (imported when the command runs, so ``--help``
+and a bad argument answer without loading models or data) and hands it to
+:func:`~stylemotion.cli.skeleton.hydra_command` or :func:`~stylemotion.cli.skeleton.argparse_command`.
+The work lives in the library, so notebooks can call it. Every command explains itself (``--help``:
+Hydra help configs in ``stylemotion/configs/hydra/help/``), reports what it did through :mod:`logging`,
+and ends bad input in one line ``stylemotion-<command>: <message naming the key or file>`` with exit
+status 2.
 """
-
-from __future__ import annotations
-
-import sys
-from collections.abc import Iterator
-from contextlib import contextmanager
-
-
-@contextmanager
-def reported(command: str, *errors: type[BaseException]) -> Iterator[None]:
-    """Run the block; one of ``errors`` (the user's input, not a bug) exits with ``<command>: <message>``."""
-    try:
-        yield
-    except errors as exc:
-        sys.exit(f"{command}: {exc}")

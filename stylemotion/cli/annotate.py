@@ -10,27 +10,21 @@ dataset, threshold or an existing ``out`` ends in one line naming it.
 from __future__ import annotations
 
 import logging
-import sys
 
-import hydra
 from omegaconf import DictConfig
 
-from stylemotion.annotate.command import AnnotateInputError, annotate_from_config
-from stylemotion.cli import reported
-from stylemotion.config import CONFIG_PACKAGE, ConfigError
-from stylemotion.io.outputs import OutputExistsError
+from stylemotion.cli.skeleton import hydra_command
 
 log = logging.getLogger(__name__)
 
 
-def _main(cfg: DictConfig) -> None:
-    with reported("stylemotion-annotate", ConfigError, OutputExistsError, AnnotateInputError):
-        annotate_from_config(cfg, say=log.info, command="stylemotion-annotate " + " ".join(sys.argv[1:]))
+def annotate(cfg: DictConfig, command: str) -> None:
+    from stylemotion.annotate.command import annotate_from_config
+
+    annotate_from_config(cfg, say=log.info, command=command)
 
 
-def main() -> None:
-    """Console script ``stylemotion-annotate``."""
-    hydra.main(config_path=CONFIG_PACKAGE, config_name="annotate", version_base="1.3")(_main)()
+main = hydra_command("stylemotion-annotate", "annotate", annotate)
 
 
 if __name__ == "__main__":

@@ -2,17 +2,18 @@
 
 The work and the file's contents: :mod:`stylemotion.datasets.convert`. A bad ``--fps`` (0, negative,
 nan, inf), an output that is a folder or not ``.npz``, and a file that cannot be converted end in one
-line ``stylemotion-convert: error: …`` naming the argument or file, with exit status 1.
+line ``stylemotion-convert: …`` naming the argument or file, with exit status 2 (:mod:`stylemotion.cli.skeleton`).
 """
 
 from __future__ import annotations
 
 import argparse
 import sys
+from collections.abc import Sequence
 
-from stylemotion.datasets.convert import ConvertError, check_arguments, convert_file
+from stylemotion.cli.skeleton import argparse_command
+from stylemotion.datasets.convert import check_arguments, convert_file
 from stylemotion.datasets.loading import ConversionSettings
-from stylemotion.io.errors import MotionDataError
 
 
 def _unit(value: str) -> float | str:
@@ -22,7 +23,7 @@ def _unit(value: str) -> float | str:
         return value
 
 
-def main(argv: list[str] | None = None) -> int:
+def convert(argv: Sequence[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="stylemotion-convert", description=__doc__.splitlines()[0])
     parser.add_argument("src", help="BVH file (or archive.zip::member.bvh)")
     parser.add_argument("dst", help="output .npz (positions (frames, 21, 3) metres Y up, joint_names, fps)")
@@ -33,15 +34,14 @@ def main(argv: list[str] | None = None) -> int:
                         help="metres per file unit or a unit name (m, cm, mm, inch, cmu); default: detect")
     parser.add_argument("--up-axis", choices=["y", "z"], default="y")
     args = parser.parse_args(argv)
-    try:
-        check_arguments(args.dst, args.fps)
-        settings = ConversionSettings(args.fps, args.joint_map, args.unit_scale, args.up_axis)
-        positions = convert_file(args.src, args.dst, settings)
-    except (ConvertError, MotionDataError) as exc:
-        print(f"stylemotion-convert: error: {exc}", file=sys.stderr)
-        return 1
+    check_arguments(args.dst, args.fps)
+    settings = ConversionSettings(args.fps, args.joint_map, args.unit_scale, args.up_axis)
+    positions = convert_file(args.src, args.dst, settings)
     print(f"{args.dst}: {positions.shape[0]} frames at {args.fps:g} fps, 21 joints, metres, Y up")
     return 0
+
+
+main = argparse_command("stylemotion-convert", convert)
 
 
 def cli() -> None:

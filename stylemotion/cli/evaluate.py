@@ -11,33 +11,27 @@ The work is :func:`stylemotion.evaluation.run.run_evaluation`; progress and the 
 from __future__ import annotations
 
 import logging
-import sys
 
-import hydra
 from omegaconf import DictConfig
 
-from stylemotion.cli import reported
-from stylemotion.config import CONFIG_PACKAGE, ConfigError, set_torch_threads
-from stylemotion.evaluation.run import run_evaluation, summary_lines
-from stylemotion.io.outputs import OutputExistsError
+from stylemotion.cli.skeleton import hydra_command
+from stylemotion.config import set_torch_threads
 
 log = logging.getLogger(__name__)
 
 
-def _main(cfg: DictConfig) -> None:
-    command = "stylemotion-eval " + " ".join(sys.argv[1:])
-    with reported("stylemotion-eval", ConfigError, OutputExistsError):
-        set_torch_threads(cfg.get("threads"))
-        results = run_evaluation(cfg.data, list(cfg.checkpoints), cfg.evaluation, cfg.out, int(cfg.seed),
-                                 cfg.get("autoencoder_ckpt"), bool(cfg.force), command, progress=log.info)
+def evaluate(cfg: DictConfig, command: str) -> None:
+    from stylemotion.evaluation.run import run_evaluation, summary_lines
+
+    set_torch_threads(cfg.get("threads"))
+    results = run_evaluation(cfg.data, list(cfg.checkpoints), cfg.evaluation, cfg.out, int(cfg.seed),
+                             cfg.get("autoencoder_ckpt"), bool(cfg.force), command, progress=log.info)
     for line in summary_lines(results):
         log.info(line)
     log.info("report written to %s", cfg.out)
 
 
-def main() -> None:
-    """Console script ``stylemotion-eval``."""
-    hydra.main(config_path=CONFIG_PACKAGE, config_name="eval", version_base="1.3")(_main)()
+main = hydra_command("stylemotion-eval", "eval", evaluate)
 
 
 if __name__ == "__main__":

@@ -13,33 +13,26 @@ The work and the folder's contents: :mod:`stylemotion.synthesis.generate`. The s
 from __future__ import annotations
 
 import logging
-import sys
 
-import hydra
 from omegaconf import DictConfig
 
-from stylemotion.cli import reported
-from stylemotion.config import CONFIG_PACKAGE, ConfigError, set_torch_threads
-from stylemotion.io.outputs import OutputExistsError
-from stylemotion.synthesis.generate import generate, summary_lines
-from stylemotion.synthesis.graph import UnknownStyleError
-from stylemotion.synthesis.path import PathError
+from stylemotion.cli.skeleton import hydra_command
+from stylemotion.config import set_torch_threads
 
 log = logging.getLogger(__name__)
 
 
-def _main(cfg: DictConfig) -> None:
-    with reported("stylemotion-generate", ConfigError, OutputExistsError, PathError, UnknownStyleError):
-        set_torch_threads(cfg.get("threads"))
-        summary = generate(cfg, "stylemotion-generate " + " ".join(sys.argv[1:]))
+def generate(cfg: DictConfig, command: str) -> None:
+    from stylemotion.synthesis.generate import generate, summary_lines
+
+    set_torch_threads(cfg.get("threads"))
+    summary = generate(cfg, command)
     for line in summary_lines(summary):
         log.info(line)
     log.info("written to %s", cfg.out)
 
 
-def main() -> None:
-    """Console script ``stylemotion-generate``."""
-    hydra.main(config_path=CONFIG_PACKAGE, config_name="generate", version_base="1.3")(_main)()
+main = hydra_command("stylemotion-generate", "generate", generate)
 
 
 if __name__ == "__main__":

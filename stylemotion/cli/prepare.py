@@ -13,26 +13,25 @@ from __future__ import annotations
 import logging
 from pathlib import Path
 
-import hydra
-from hydra.core.hydra_config import HydraConfig
 from omegaconf import DictConfig
 
-from stylemotion.config import CONFIG_PACKAGE
-from stylemotion.datasets.summary import format_summary, write_dataset_summary
+from stylemotion.cli.skeleton import hydra_command
 
 log = logging.getLogger(__name__)
 
 
-def _main(cfg: DictConfig) -> None:
+def prepare(cfg: DictConfig, command: str) -> None:
+    from hydra.core.hydra_config import HydraConfig
+
+    from stylemotion.datasets.summary import format_summary, write_dataset_summary
+
     out_dir = Path(HydraConfig.get().runtime.output_dir)
     summary = write_dataset_summary(cfg.data, out_dir)
     log.info(format_summary(summary))
     log.info("summary written to %s", out_dir / "summary.json")
 
 
-def main() -> None:
-    """Console script ``stylemotion-data``."""
-    hydra.main(config_path=CONFIG_PACKAGE, config_name="prepare", version_base="1.3")(_main)()
+main = hydra_command("stylemotion-data", "prepare", prepare)
 
 
 if __name__ == "__main__":

@@ -10,28 +10,21 @@ feature set, ``k``, dataset or an existing ``out`` ends in one line naming it.
 from __future__ import annotations
 
 import logging
-import sys
 
-import hydra
 from omegaconf import DictConfig
 
-from stylemotion.cli import reported
-from stylemotion.config import CONFIG_PACKAGE, ConfigError
-from stylemotion.io.outputs import OutputExistsError
-from stylemotion.reconstruct.command import reconstruct_from_config
-from stylemotion.reconstruct.markers import MarkerInputError
+from stylemotion.cli.skeleton import hydra_command
 
 log = logging.getLogger(__name__)
 
 
-def _main(cfg: DictConfig) -> None:
-    with reported("stylemotion-reconstruct", ConfigError, OutputExistsError, MarkerInputError):
-        reconstruct_from_config(cfg, say=log.info, command="stylemotion-reconstruct " + " ".join(sys.argv[1:]))
+def reconstruct(cfg: DictConfig, command: str) -> None:
+    from stylemotion.reconstruct.command import reconstruct_from_config
+
+    reconstruct_from_config(cfg, say=log.info, command=command)
 
 
-def main() -> None:
-    """Console script ``stylemotion-reconstruct``."""
-    hydra.main(config_path=CONFIG_PACKAGE, config_name="reconstruct", version_base="1.3")(_main)()
+main = hydra_command("stylemotion-reconstruct", "reconstruct", reconstruct)
 
 
 if __name__ == "__main__":

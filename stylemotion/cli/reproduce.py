@@ -11,25 +11,20 @@ from __future__ import annotations
 
 import logging
 
-import hydra
 from omegaconf import DictConfig
 
-from stylemotion.cli import reported
-from stylemotion.config import CONFIG_PACKAGE, ConfigError
-from stylemotion.io.outputs import OutputExistsError
-from stylemotion.reproduction import StageConflictError, reproduce
+from stylemotion.cli.skeleton import hydra_command
 
 log = logging.getLogger(__name__)
 
 
-def _main(cfg: DictConfig) -> None:
-    with reported("stylemotion-reproduce", StageConflictError, OutputExistsError, ConfigError):
-        reproduce(cfg, say=log.info)  # the console and <out>/hydra/<time>/reproduce.log
+def reproduce(cfg: DictConfig, command: str) -> None:
+    from stylemotion.reproduction import reproduce
+
+    reproduce(cfg, say=log.info)  # the console and <out>/hydra/<time>/reproduce.log
 
 
-def main() -> None:
-    """Console script ``stylemotion-reproduce``."""
-    hydra.main(config_path=CONFIG_PACKAGE, config_name="reproduce", version_base="1.3")(_main)()
+main = hydra_command("stylemotion-reproduce", "reproduce", reproduce)
 
 
 if __name__ == "__main__":

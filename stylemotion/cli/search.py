@@ -10,27 +10,21 @@ The work and the folder it writes: :mod:`stylemotion.search.command`. A bad quer
 from __future__ import annotations
 
 import logging
-import sys
 
-import hydra
 from omegaconf import DictConfig
 
-from stylemotion.cli import reported
-from stylemotion.config import CONFIG_PACKAGE, ConfigError
-from stylemotion.io.outputs import OutputExistsError
-from stylemotion.search.command import SearchInputError, search_from_config
+from stylemotion.cli.skeleton import hydra_command
 
 log = logging.getLogger(__name__)
 
 
-def _main(cfg: DictConfig) -> None:
-    with reported("stylemotion-search", ConfigError, OutputExistsError, SearchInputError):
-        search_from_config(cfg, say=log.info, command="stylemotion-search " + " ".join(sys.argv[1:]))
+def search(cfg: DictConfig, command: str) -> None:
+    from stylemotion.search.command import search_from_config
+
+    search_from_config(cfg, say=log.info, command=command)
 
 
-def main() -> None:
-    """Console script ``stylemotion-search``."""
-    hydra.main(config_path=CONFIG_PACKAGE, config_name="search", version_base="1.3")(_main)()
+main = hydra_command("stylemotion-search", "search", search)
 
 
 if __name__ == "__main__":

@@ -10,31 +10,24 @@ The work and the folder's contents: :mod:`stylemotion.segmentation_report`.
 from __future__ import annotations
 
 import logging
-import sys
 from pathlib import Path
 
-import hydra
 from omegaconf import DictConfig
 
-from stylemotion.cli import reported
-from stylemotion.config import CONFIG_PACKAGE
-from stylemotion.io.outputs import OutputExistsError
-from stylemotion.segmentation_report import summary_lines, write_report
+from stylemotion.cli.skeleton import hydra_command
 
 log = logging.getLogger(__name__)
 
 
-def _main(cfg: DictConfig) -> None:
-    command = "stylemotion-segment " + " ".join(sys.argv[1:])
-    with reported("stylemotion-segment", OutputExistsError):
-        report = write_report(cfg, Path(cfg.out), bool(cfg.force), command)
+def segment(cfg: DictConfig, command: str) -> None:
+    from stylemotion.segmentation_report import summary_lines, write_report
+
+    report = write_report(cfg, Path(cfg.out), bool(cfg.force), command)
     for line in summary_lines(report, Path(cfg.out)):
         log.info(line)
 
 
-def main() -> None:
-    """Console script ``stylemotion-segment``."""
-    hydra.main(config_path=CONFIG_PACKAGE, config_name="segment", version_base="1.3")(_main)()
+main = hydra_command("stylemotion-segment", "segment", segment)
 
 
 if __name__ == "__main__":

@@ -11,28 +11,23 @@ and ``style.log`` in the Hydra run folder). A bad example, frame range, run, nam
 from __future__ import annotations
 
 import logging
-import sys
 
-import hydra
 from omegaconf import DictConfig
 
-from stylemotion.cli import reported
-from stylemotion.config import CONFIG_PACKAGE, ConfigError, set_torch_threads
-from stylemotion.io.outputs import OutputExistsError
-from stylemotion.style_example import StyleExampleError, add_style_from_config
+from stylemotion.cli.skeleton import hydra_command
+from stylemotion.config import set_torch_threads
 
 log = logging.getLogger(__name__)
 
 
-def _main(cfg: DictConfig) -> None:
-    with reported("stylemotion-style", ConfigError, OutputExistsError, StyleExampleError):
-        set_torch_threads(cfg.get("threads"))
-        add_style_from_config(cfg, say=log.info, command="stylemotion-style " + " ".join(sys.argv[1:]))
+def style(cfg: DictConfig, command: str) -> None:
+    from stylemotion.style_example import add_style_from_config
+
+    set_torch_threads(cfg.get("threads"))
+    add_style_from_config(cfg, say=log.info, command=command)
 
 
-def main() -> None:
-    """Console script ``stylemotion-style``."""
-    hydra.main(config_path=CONFIG_PACKAGE, config_name="style", version_base="1.3")(_main)()
+main = hydra_command("stylemotion-style", "style", style)
 
 
 if __name__ == "__main__":

@@ -14,27 +14,23 @@ from __future__ import annotations
 
 import importlib
 
-import hydra
 from omegaconf import DictConfig
 
-from stylemotion.cli import reported
-from stylemotion.config import CONFIG_PACKAGE, ConfigError
-from stylemotion.io.outputs import OutputExistsError
-from stylemotion.training import CheckpointNotFoundError, objective, run
+from stylemotion.cli.skeleton import hydra_command
 
 
-def _main(cfg: DictConfig) -> float | None:
-    with reported("stylemotion-train", ConfigError, OutputExistsError, CheckpointNotFoundError):
-        if cfg.get("runner"):  # a model family fitted without Lightning (e.g. experiment=morphable_graph)
-            runner = importlib.import_module(str(cfg.runner))
-            return runner.objective(runner.run(cfg)["metrics"])
-        result = run(cfg)
+def train(cfg: DictConfig, command: str) -> float | None:
+    """One training run; returns the sweep objective (a validation metric, see ``objective``)."""
+    if cfg.get("runner"):  # a model family fitted without Lightning (e.g. experiment=morphable_graph)
+        runner = importlib.import_module(str(cfg.runner))
+        return runner.objective(runner.run(cfg)["metrics"])
+    from stylemotion.training import objective, run
+
+    result = run(cfg)
     return objective(result["metrics"], cfg)
 
 
-def main() -> None:
-    """Console script ``stylemotion-train``."""
-    hydra.main(config_path=CONFIG_PACKAGE, config_name="train", version_base="1.3")(_main)()
+main = hydra_command("stylemotion-train", "train", train)
 
 
 if __name__ == "__main__":

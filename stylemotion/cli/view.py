@@ -3,23 +3,38 @@
 PATH: BVH files, motion NPZ files or run folders (see :mod:`stylemotion.viewer.motions`). The folder
 ``--out`` (refused if it exists, unless ``--force``) holds ``index.html`` and everything it needs, opens
 from disk and from any static server; ``--serve`` serves it on 127.0.0.1 and prints the URL. Bad input,
-an existing ``--out`` and a port in use end in one line ``stylemotion-view: error: …`` with exit status 1,
-before anything is written.
+an existing ``--out`` and a port in use end in one line ``stylemotion-view: …`` with exit status 2,
+before anything is written (:mod:`stylemotion.cli.skeleton`).
 """
 
 from __future__ import annotations
 
 import argparse
+import math
 import sys
+from collections.abc import Sequence
 
-from stylemotion.io.errors import MotionDataError
-from stylemotion.io.outputs import OutputExistsError, check_new_output
+from stylemotion.cli.skeleton import argparse_command
+from stylemotion.io.errors import UserInputError
+from stylemotion.io.outputs import check_new_output
 from stylemotion.viewer.motions import read_inputs
 from stylemotion.viewer.page import LAYOUTS, write_viewer
-from stylemotion.viewer.serve import PortInUseError, bind, serve_folder, url
+from stylemotion.viewer.serve import bind, serve_folder, url
 
 
-def main(argv: list[str] | None = None) -> int:
+def _check_numbers(args: argparse.Namespace) -> None:
+    """Refuse numbers no page can use (a NaN spacing would reach the page's data)."""
+    if not (math.isfinite(args.spacing) and args.spacing >= 0):
+        raise UserInputError(f"--spacing {args.spacing}: expected a finite number of metres ≥ 0")
+    if not (math.isfinite(args.fps) and args.fps > 0):
+        raise UserInputError(f"--fps {args.fps}: expected a finite number of frames per second > 0")
+    if args.max_samples < 1:
+        raise UserInputError(f"--max-samples {args.max_samples}: expected a whole number ≥ 1")
+    if not 0 <= args.port <= 65535:
+        raise UserInputError(f"--port {args.port}: expected a port number in 0–65535")
+
+
+def view(argv: Sequence[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="stylemotion-view", description=__doc__.splitlines()[0])
     parser.add_argument("paths", nargs="+", metavar="PATH", help="BVH file, motion NPZ or run folder")
     parser.add_argument("--out", required=True, help="output folder (index.html and its files)")
@@ -32,6 +47,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--max-samples", type=int, default=16, help="most motions taken from one samples file")
     parser.add_argument("--title", default="", help="page title (default: the paths)")
     args = parser.parse_args(argv)
+    _check_numbers(args)
     server = None
     try:
         check_new_output(args.out, args.force, key="--out")
@@ -40,15 +56,10 @@ def main(argv: list[str] | None = None) -> int:
         motions = read_inputs(args.paths, fps=args.fps, max_samples=args.max_samples)
         index = write_viewer(motions, args.out, args.force, args.title or " ".join(args.paths), args.layout,
                              args.spacing)
-    except OutputExistsError:
-        print(f"stylemotion-view: error: {args.out} already exists; choose another --out or pass --force",
-              file=sys.stderr)
-        return 1
-    except (MotionDataError, PortInUseError, ValueError) as exc:
+    except BaseException:
         if server is not None:
             server.server_close()
-        print(f"stylemotion-view: error: {exc}", file=sys.stderr)
-        return 1
+        raise
     print(f"{index}: {len(motions)} motion(s)")
     if server is not None:
         print(f"serving {args.out} at {url(server)} (Ctrl-C stops)", flush=True)
@@ -57,6 +68,9 @@ def main(argv: list[str] | None = None) -> int:
         except KeyboardInterrupt:
             pass
     return 0
+
+
+main = argparse_command("stylemotion-view", view)
 
 
 def cli() -> None:

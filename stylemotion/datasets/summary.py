@@ -2,14 +2,13 @@
 
 from __future__ import annotations
 
-import json
 from collections import Counter
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
 from stylemotion.datasets.base import Take, TakeSet
-from stylemotion.io.atomic import atomic_write_bytes
+from stylemotion.io.jsonfile import write_json
 
 
 def dataset_summary(takeset: TakeSet, split: dict[str, list[Take]] | None = None) -> dict[str, Any]:
@@ -72,5 +71,5 @@ def write_dataset_summary(data_cfg: Mapping[str, Any], out_dir: str | Path) -> d
     split = takeset.split(**(data_cfg.get("split") or {}))
     summary = dataset_summary(takeset, split)
     summary["provenance"] = provenance()
-    atomic_write_bytes(Path(out_dir) / "summary.json", json.dumps(summary, indent=2).encode())
+    write_json(Path(out_dir) / "summary.json", summary, indent=2)
     return summary

@@ -13,20 +13,17 @@ from __future__ import annotations
 
 import csv
 import io
-import json
-import math
 import os
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
-
-import numpy as np
 
 from stylemotion.evaluation.figures import write_figures
 from stylemotion.evaluation.markdown import DEFINITIONS, format_markdown
 from stylemotion.evaluation.pipeline import VARIATION_KEYS
 from stylemotion.evaluation.tables import VARIANCE_KEYS
 from stylemotion.io.atomic import atomic_folder
+from stylemotion.io.jsonfile import write_json
 from stylemotion.io.outputs import check_new_output, inside
 from stylemotion.viz.tensorboard import write_report_events
 
@@ -44,28 +41,13 @@ def write_report(results: dict[str, Any], out: str | os.PathLike, force: bool = 
         figures = write_figures(results, tmp)
         write_report_events(tmp, results, figures)
         tables = write_csvs(results, tmp)
-        (tmp / "report.json").write_text(json.dumps(_plain(results), indent=1, allow_nan=False))
+        write_json(tmp / "report.json", results)
         text = format_markdown(results, figures, tables)
         (tmp / "report.md").write_text(text)
         from stylemotion.viewer.report import write_report_html  # the viewer imports this package's markdown
 
         write_report_html(tmp, text, figures, samples)
     return out
-
-
-def _plain(value: Any) -> Any:
-    """JSON-safe copy: numpy scalars/arrays to Python, NaN/inf to None."""
-    if isinstance(value, dict):
-        return {str(k): _plain(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_plain(v) for v in value]
-    if isinstance(value, np.ndarray):
-        return _plain(value.tolist())
-    if isinstance(value, (np.integer,)):
-        return int(value)
-    if isinstance(value, (float, np.floating)):
-        return float(value) if math.isfinite(value) else None
-    return value
 
 
 def _csv_text(header: list[str], rows: list[list[Any]]) -> str:

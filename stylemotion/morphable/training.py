@@ -11,7 +11,6 @@ split of ``data``), the primitive and style from ``primitive`` and ``style``.
 
 from __future__ import annotations
 
-import json
 import logging
 import time
 from pathlib import Path
@@ -23,6 +22,7 @@ from omegaconf import DictConfig, OmegaConf
 
 from stylemotion.config import ConfigError, set_torch_threads
 from stylemotion.io.atomic import atomic_write_bytes
+from stylemotion.io.jsonfile import write_json
 from stylemotion.io.outputs import OutputExistsError
 from stylemotion.morphable.arm import (
     ARM_PRIMITIVES,
@@ -95,7 +95,7 @@ def run(cfg: DictConfig) -> dict[str, Any]:
     if cfg.get("samples", True):
         _write_samples(model, output_dir / "samples", int(cfg.seed), str(cfg.data.get("name")))
     metrics["seconds"] = time.perf_counter() - began
-    atomic_write_bytes(output_dir / "metrics.json", json.dumps(metrics, indent=1, default=float).encode())
+    write_json(output_dir / "metrics.json", metrics)
     log.info("%s_%s: %s written; training joint RMSE %.4f m, test %.4f m", action, primitive, model_path,
              model.meta["fit"]["joint_rmse_m"], metrics.get("test/joint_rmse_m", float("nan")))
     return {"model": model, "metrics": metrics}

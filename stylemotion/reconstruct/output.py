@@ -4,7 +4,6 @@
 from __future__ import annotations
 
 import io
-import json
 import os
 import time
 from pathlib import Path
@@ -13,6 +12,7 @@ from typing import Any
 import numpy as np
 
 from stylemotion.io.atomic import atomic_folder, atomic_write_bytes
+from stylemotion.io.jsonfile import write_json
 from stylemotion.io.outputs import check_new_output, inside
 from stylemotion.skeleton import CANONICAL_JOINTS
 
@@ -49,4 +49,4 @@ def write_motion_folder(out: str | os.PathLike, force: bool, positions: np.ndarr
             save_walk_animation(positions, fps, track if gif_path_xz is None else np.asarray(gif_path_xz),
                                 inside(tmp, "motion.gif"), keyframes=gif_keys, title=gif_title)
         summary.setdefault("timing_s", {})["command"] = round(time.perf_counter() - started, 3)
-        atomic_write_bytes(inside(tmp, "summary.json"), (json.dumps(summary, indent=1) + "\n").encode())
+        write_json(inside(tmp, "summary.json"), summary)

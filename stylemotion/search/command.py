@@ -21,7 +21,6 @@ The folder ``out`` (refused when it exists unless ``force``; built beside it and
 
 from __future__ import annotations
 
-import json
 import os
 import time
 from collections.abc import Callable, Mapping
@@ -35,8 +34,9 @@ from omegaconf import DictConfig, OmegaConf
 from stylemotion.config import ConfigError, positive_int
 from stylemotion.datasets import TakeSet, build_dataset
 from stylemotion.datasets.loading import ConversionSettings
-from stylemotion.io.atomic import atomic_folder, atomic_write_bytes
+from stylemotion.io.atomic import atomic_folder
 from stylemotion.io.errors import UserInputError
+from stylemotion.io.jsonfile import write_json
 from stylemotion.io.outputs import check_new_output, inside, safe_name
 from stylemotion.provenance import provenance
 from stylemotion.search.database import MotionDatabase
@@ -208,7 +208,7 @@ def search(data: Mapping[str, Any], query: str, out: str | os.PathLike, *, featu
         "provenance": provenance(command or None),
     }
     with atomic_folder(out, on_exists=lambda: check_new_output(out, force)) as tmp:
-        _write_json(inside(tmp, "matches.json"), records)
+        write_json(inside(tmp, "matches.json"), records)
         if result.matches:
             from stylemotion.search.figures import plot_distance_matrix
 
@@ -217,7 +217,7 @@ def search(data: Mapping[str, Any], query: str, out: str | os.PathLike, *, featu
                                  f"{database.name}, features={features}, k={k}: query {query}")
         report["files"] = _exports(tmp, q, result, index, export_bvh, export_gif, export_top)
         report["timing_s"]["total"] = round(time.perf_counter() - started, 3)
-        _write_json(inside(tmp, "search.json"), report)
+        write_json(inside(tmp, "search.json"), report)
     if not records:
         say(f"no match: no path through the k-NN graph of the {q.positions.shape[0]} query frames; raise k (now {k})")
     elif len(records) < top and k < database.num_frames:
@@ -227,10 +227,6 @@ def search(data: Mapping[str, Any], query: str, out: str | os.PathLike, *, featu
                                                          f"{records[0]['start']}-{records[0]['end']} cost "
                                                          f"{records[0]['cost']:.4g}" if records else ""))
     return report
-
-
-def _write_json(path: Path, value: Any) -> None:
-    atomic_write_bytes(path, (json.dumps(value, indent=1) + "\n").encode())
 
 
 def _match_stem(match: SegmentMatch) -> str:

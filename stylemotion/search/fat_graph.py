@@ -20,7 +20,6 @@ members, neighbour count) and ``clusters.npz`` (memberships).
 from __future__ import annotations
 
 import io
-import json
 import os
 from dataclasses import dataclass
 from pathlib import Path
@@ -29,6 +28,7 @@ from typing import Any
 import numpy as np
 
 from stylemotion.io.atomic import atomic_write_bytes
+from stylemotion.io.jsonfile import write_json
 from stylemotion.search.index import FrameIndex
 
 #: Frames per batched radius query (bounds the (chunk, k) arrays).
@@ -125,7 +125,7 @@ def write_clusters(clusters: FatGraphClusters, index: FrameIndex, folder: str | 
             "radius": clusters.radius, "k": clusters.k, "frames": index.size, "clusters": clusters.num_clusters,
             "base_poses": cluster_records(clusters, index)}
     json_path, npz_path = folder / "clusters.json", folder / "clusters.npz"
-    atomic_write_bytes(json_path, (json.dumps(meta, indent=1) + "\n").encode())
+    write_json(json_path, meta)
     buffer = io.BytesIO()
     np.savez(buffer, assignment=clusters.assignment, bases=clusters.bases, counts=clusters.counts,
              take_id=index.database.take_id, frame_in_take=index.database.frame_in_take)

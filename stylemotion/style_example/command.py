@@ -27,7 +27,6 @@ example: ``positions`` (frames, 21, 3) metres, ``fps``, ``joint_names``), ``repo
 from __future__ import annotations
 
 import io
-import json
 import os
 import time
 from collections.abc import Callable, Iterator, Mapping, Sequence
@@ -42,9 +41,9 @@ from omegaconf import DictConfig, OmegaConf
 from stylemotion.config import ConfigError, config_dir, positive_int
 from stylemotion.datasets import TakeSet, build_dataset
 from stylemotion.datasets.loading import ConversionSettings
-from stylemotion.evaluation.report import _plain
 from stylemotion.evaluation.sources import EvalModel, load_model
 from stylemotion.io.atomic import atomic_folder
+from stylemotion.io.jsonfile import plain, write_json
 from stylemotion.io.outputs import check_new_output, inside
 from stylemotion.models.checkpoints import autoencoder_info, load_autoencoder
 from stylemotion.primitives import Clip, parse_primitive, segment_action
@@ -233,8 +232,8 @@ def add_style(example: str, run: str | os.PathLike, name: str, out: str | os.Pat
         results["meta"].update(provenance(command or None), seconds=time.perf_counter() - started,
                                run_relative=os.path.relpath(source.folder.resolve(), out.resolve()))
         write_example(converted, tmp / EXAMPLE_FILE)
-        results = _plain(results)
-        (tmp / "report.json").write_text(json.dumps(results, indent=1, allow_nan=False))
+        results = plain(results)
+        write_json(tmp / "report.json", results)
         (tmp / "report.md").write_text(markdown(results))
     for line in summary_lines(results):
         say(line)

@@ -45,6 +45,7 @@ from stylemotion.datasets.loading import ConversionSettings, load_canonical_posi
 from stylemotion.evaluation.sources import NEUTRAL
 from stylemotion.export import write_motion_bvh
 from stylemotion.io.atomic import atomic_folder
+from stylemotion.io.jsonfile import write_json
 from stylemotion.io.outputs import check_new_output
 from stylemotion.io.sources import FileSource
 from stylemotion.provenance import provenance
@@ -182,7 +183,7 @@ def generate(cfg: DictConfig | Mapping[str, Any], command: str = "") -> dict[str
             "path": cfg.get("path"), **provenance(command or None), "seconds": time.perf_counter() - started,
         }
         summary["steps_detail"] = [asdict(s) for s in motion.steps]
-        (tmp / "summary.json").write_text(json.dumps(summary, indent=1, default=float))
+        write_json(tmp / "summary.json", summary)
     return summary
 
 

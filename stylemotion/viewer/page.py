@@ -26,6 +26,7 @@ import numpy as np
 
 from stylemotion.contacts import FOOT_POINTS
 from stylemotion.io.atomic import atomic_folder
+from stylemotion.io.errors import UserInputError
 from stylemotion.io.outputs import check_new_output
 from stylemotion.skeleton import CANONICAL_JOINTS, CANONICAL_PARENTS
 from stylemotion.viewer.motions import ViewerMotion
@@ -54,7 +55,7 @@ def page_data(motions: Sequence[ViewerMotion], title: str = "", layout: str = "s
               spacing_m: float = 1.0) -> dict[str, Any]:
     """What ``data.js`` holds (see ``docs/viewer.md``)."""
     if layout not in LAYOUTS:
-        raise ValueError(f"layout {layout!r}: expected one of {', '.join(LAYOUTS)}")
+        raise UserInputError(f"layout {layout!r}: expected one of {', '.join(LAYOUTS)}")
     colors = group_colors(motions)
     return {
         "format": 1,
@@ -86,7 +87,7 @@ def build_viewer(motions: Sequence[ViewerMotion], folder: Path, title: str = "",
                  spacing_m: float = 1.0) -> Path:
     """Write the page's files into the existing folder ``folder`` (no atomicity: see :func:`write_viewer`)."""
     if not motions:
-        raise ValueError("a viewer page needs at least one motion")
+        raise UserInputError("a viewer page needs at least one motion")
     data = page_data(motions, title, layout, spacing_m)
     static = resources.files("stylemotion.viewer").joinpath("static")
     vendor = resources.files("stylemotion.viewer").joinpath("vendor")

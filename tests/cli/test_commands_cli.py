@@ -42,8 +42,8 @@ def command(module: str, *args: str, cwd: Path, timeout: float = 120) -> subproc
 
 
 def one_line_error(done: subprocess.CompletedProcess, script: str) -> str:
-    """The message of a command that refused its input: exit status 1, one line, no traceback."""
-    assert done.returncode == 1, done.stdout[-2000:] + done.stderr[-2000:]
+    """The message of a command that refused its input: exit status 2, one line, no traceback."""
+    assert done.returncode == 2, done.stdout[-2000:] + done.stderr[-2000:]
     assert "Traceback" not in done.stderr
     lines = done.stderr.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith(f"{script}: "), done.stderr
@@ -85,10 +85,10 @@ def test_bad_threads_is_one_line_naming_the_key(module: str, threads: str, tmp_p
 
 
 def convert(capsys: pytest.CaptureFixture, *args: str) -> str:
-    """``stylemotion-convert args`` in-process; the one line it wrote to stderr (it must exit 1)."""
-    assert convert_main(list(args)) == 1
+    """``stylemotion-convert args`` in-process; the one line it wrote to stderr (it must exit 2)."""
+    assert convert_main(list(args)) == 2
     err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and err[0].startswith("stylemotion-convert: error: "), err
+    assert len(err) == 1 and err[0].startswith("stylemotion-convert: "), err
     return err[0]
 
 

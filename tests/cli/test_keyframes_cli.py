@@ -89,5 +89,5 @@ def test_the_console_command_runs_and_refuses_in_one_line(tmp_path):
     bad = _write(tmp_path / "bad.json", {"keys": [{"time": 0, "take": "nope", "frame": 0}]})
     done = subprocess.run(run + [f"keys={bad}", f"out={tmp_path / 'p'}"], cwd=root, env=env,
                           capture_output=True, text=True, timeout=180)
-    assert done.returncode == 1 and "take='nope'" in done.stderr and "Traceback" not in done.stderr
+    assert done.returncode == 2 and "take='nope'" in done.stderr and "Traceback" not in done.stderr
     assert not (tmp_path / "p").exists()

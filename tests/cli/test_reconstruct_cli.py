@@ -75,4 +75,4 @@ def test_the_console_command_runs_and_refuses_in_one_line(tmp_path):
     assert json.loads((tmp_path / "o" / "summary.json").read_text())["settings"]["k"] == 16
     done = subprocess.run(run + [f"out={tmp_path / 'p'}", "joints=[Hips,Tail]"], cwd=root, env=env,
                           capture_output=True, text=True, timeout=120)
-    assert done.returncode == 1 and "'Tail'" in done.stderr and "Traceback" not in done.stderr
+    assert done.returncode == 2 and "'Tail'" in done.stderr and "Traceback" not in done.stderr

@@ -104,7 +104,7 @@ def test_run_folder_has_a_unique_id_records_itself_and_is_never_overwritten(tmp_
     kept = {p: p.read_bytes() for p in [run_dir / "metrics.json", *(run_dir / "checkpoints").glob("*.ckpt")]}
 
     again = train_cli(*SMOKE, f"hydra.run.dir={run_dir}", cwd=tmp_path)
-    assert again.returncode == 1 and "Traceback" not in again.stderr
+    assert again.returncode == 2 and "Traceback" not in again.stderr
     (line,) = again.stderr.strip().splitlines()
     assert line.startswith(f"stylemotion-train: {run_dir} already holds a run's results")
     assert "ckpt_path=last" in line and "force=true" in line
@@ -118,7 +118,7 @@ def test_run_folder_has_a_unique_id_records_itself_and_is_never_overwritten(tmp_
 ])
 def test_bad_values_end_in_one_line_naming_the_key(override, message, tmp_path):
     done = train_cli(*SMOKE, override, f"hydra.run.dir={tmp_path / 'run'}", cwd=tmp_path)
-    assert done.returncode == 1 and "Traceback" not in done.stderr
+    assert done.returncode == 2 and "Traceback" not in done.stderr
     (line,) = done.stderr.strip().splitlines()
     assert line.startswith(f"stylemotion-train: {message}")
 

@@ -208,7 +208,7 @@ def test_convert_cli_matches_dataset_path(other_skeleton_paths: dict[str, Path],
     expected = to_canonical_positions(read_bvh(src), fps=30)
     np.testing.assert_array_equal(data["positions"], expected)
     assert data["positions"].dtype == np.float32 and data["positions"].shape == expected.shape
-    assert main([str(tmp_path / "missing.bvh"), str(tmp_path / "x.npz")]) == 1
+    assert main([str(tmp_path / "missing.bvh"), str(tmp_path / "x.npz")]) == 2
     assert not (tmp_path / "x.npz").exists()
 
 

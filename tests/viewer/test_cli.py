@@ -40,9 +40,9 @@ def test_bad_input_writes_nothing(motion_files, tmp_path, capsys):
     bad = tmp_path / "bad.npz"
     np.savez(bad, positions=np.zeros((5, 17, 3)), fps=30.0)
     out = tmp_path / "view"
-    assert main([str(motion_files[0]), str(bad), "--out", str(out)]) == 1
+    assert main([str(motion_files[0]), str(bad), "--out", str(out)]) == 2
     err = capsys.readouterr().err
-    assert err.startswith("stylemotion-view: error: ") and str(bad) in err and "(5, 17, 3)" in err
+    assert err.startswith("stylemotion-view: ") and str(bad) in err and "(5, 17, 3)" in err
     assert not out.exists() and [p.name for p in tmp_path.iterdir() if p.name.startswith(".")] == []
 
 
@@ -50,7 +50,7 @@ def test_existing_out_refused_unless_forced(motion_files, tmp_path, capsys):
     out = tmp_path / "view"
     out.mkdir()
     (out / "keep.txt").write_text("mine")
-    assert main([str(motion_files[0]), "--out", str(out)]) == 1
+    assert main([str(motion_files[0]), "--out", str(out)]) == 2
     assert "already exists" in capsys.readouterr().err and (out / "keep.txt").exists()
     assert main([str(motion_files[0]), "--out", str(out), "--force"]) == 0
     assert (out / "index.html").is_file() and not (out / "keep.txt").exists()
@@ -62,6 +62,6 @@ def test_port_in_use(motion_files, tmp_path, capsys):
         taken.listen(1)
         port = taken.getsockname()[1]
         out = tmp_path / "view"
-        assert main([str(motion_files[0]), "--out", str(out), "--serve", "--port", str(port)]) == 1
+        assert main([str(motion_files[0]), "--out", str(out), "--serve", "--port", str(port)]) == 2
     assert f"port {port} on 127.0.0.1 is in use" in capsys.readouterr().err
     assert not out.exists()

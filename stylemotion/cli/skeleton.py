@@ -1,0 +1,114 @@
+"""The one skeleton every console script runs on.
+
+A command is its library function plus this skeleton: :func:`hydra_command` (the Hydra commands) or
+:func:`argparse_command` (``stylemotion-convert``, ``stylemotion-view``) give the console-script entry
+point. Both
+
+* turn a :class:`~stylemotion.io.errors.UserInputError` (a bad value, file, folder or checkpoint, or an
+  existing output) into ONE line ``stylemotion-<command>: <message>`` on stderr and exit status 2
+  (:data:`EXIT_BAD_INPUT`);
+* turn Ctrl-C into one line and exit status 130 (:data:`EXIT_INTERRUPTED`); outputs are written
+  atomically (:mod:`stylemotion.io.atomic`), so an interrupted command leaves nothing half-written;
+* show the full traceback instead when asked: ``STYLEMOTION_DEBUG=1`` or ``HYDRA_FULL_ERROR=1``;
+* hand the work the command line as typed (:func:`command_line`), which it records in its provenance.
+
+Any other exception is a bug and keeps its traceback. Messages go through :mod:`logging` (Hydra sends
+them to the console and to ``<job>.log``).
+"""
+
+from __future__ import annotations
+
+import functools
+import os
+import sys
+from collections.abc import Callable, Iterator, Sequence
+from contextlib import contextmanager
+from typing import Any
+
+from stylemotion.io.errors import UserInputError
+
+#: Exit status of a command stopped by bad input (argparse uses the same for a bad argument).
+EXIT_BAD_INPUT = 2
+#: Exit status of a command stopped by Ctrl-C (128 + SIGINT).
+EXIT_INTERRUPTED = 130
+#: Environment variables that ask for full tracebacks instead of one-line messages.
+DEBUG_VARIABLES = ("STYLEMOTION_DEBUG", "HYDRA_FULL_ERROR")
+
+
+def debugging() -> bool:
+    """True when :data:`DEBUG_VARIABLES` ask for tracebacks (set to anything but empty or ``0``)."""
+    return any(os.environ.get(name, "").strip() not in ("", "0") for name in DEBUG_VARIABLES)
+
+
+def command_line(command: str, argv: Sequence[str] | None = None) -> str:
+    """``command`` and its arguments as typed (``sys.argv[1:]`` unless ``argv`` is given)."""
+    return " ".join([command, *(sys.argv[1:] if argv is None else argv)])
+
+
+@contextmanager
+def one_line_errors(command: str) -> Iterator[None]:
+    """Run the block; bad input and Ctrl-C end it in one line on stderr (module docstring).
+
+    Raises:
+        SystemExit: :data:`EXIT_BAD_INPUT` after a :class:`UserInputError`, :data:`EXIT_INTERRUPTED`
+            after Ctrl-C (unless :func:`debugging`, which re-raises the original).
+    """
+    try:
+        yield
+    except UserInputError as exc:
+        if debugging():
+            raise
+        print(f"{command}: {exc}", file=sys.stderr, flush=True)
+        raise SystemExit(EXIT_BAD_INPUT) from None
+    except KeyboardInterrupt:
+        if debugging():
+            raise
+        print(f"{command}: interrupted; finished outputs are untouched and nothing half-written was kept",
+              file=sys.stderr, flush=True)
+        raise SystemExit(EXIT_INTERRUPTED) from None
+
+
+def hydra_command(command: str, config_name: str, work: Callable[[Any, str], Any]) -> Callable[[], None]:
+    """The console-script entry point of a Hydra command.
+
+    Args:
+        command: its name, e.g. ``stylemotion-search`` (the prefix of every error line).
+        config_name: its config in ``stylemotion/configs`` (``search`` → ``search.yaml``).
+        work: ``work(cfg, command_line) -> value``; the value is the job's return value (a sweep's
+            objective for ``stylemotion-train``). Hydra names the job after ``work``'s module, so the log
+            of ``stylemotion/cli/search.py`` is ``search.log``.
+    """
+
+    @functools.wraps(work)
+    def task(cfg: Any) -> Any:
+        with one_line_errors(command):
+            return work(cfg, command_line(command))
+
+    def main() -> None:
+        import hydra
+
+        from stylemotion.config import CONFIG_PACKAGE
+
+        with one_line_errors(command):
+            hydra.main(config_path=CONFIG_PACKAGE, config_name=config_name, version_base="1.3")(task)()
+
+    main.__doc__ = f"Console script ``{command}``."
+    return main
+
+
+def argparse_command(command: str, work: Callable[[Sequence[str] | None], int]) -> Callable[..., int]:
+    """``main(argv=None) -> exit status`` of an argparse command: ``work(argv)`` under :func:`one_line_errors`.
+
+    A :class:`UserInputError` returns :data:`EXIT_BAD_INPUT` after its one line (argparse's own errors
+    exit with the same status).
+    """
+
+    @functools.wraps(work)
+    def main(argv: Sequence[str] | None = None) -> int:
+        try:
+            with one_line_errors(command):
+                return work(argv)
+        except SystemExit as exc:
+            return exc.code if isinstance(exc.code, int) else EXIT_BAD_INPUT
+
+    return main
