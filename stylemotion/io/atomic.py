@@ -50,7 +50,12 @@ def atomic_folder(out: Path, on_exists: Callable[[], None] | None = None) -> Ite
                 on_exists()
             trash = Path(tempfile.mkdtemp(prefix=f".{out.name}.old.", dir=out.parent))
             out.replace(trash / out.name)
-            tmp.replace(out)
+            try:
+                tmp.replace(out)
+            except BaseException:  # the new folder did not move in: put the old one back
+                (trash / out.name).replace(out)
+                trash.rmdir()
+                raise
             shutil.rmtree(trash, ignore_errors=True)
         else:
             tmp.replace(out)
