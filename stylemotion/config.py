@@ -6,12 +6,9 @@ line are checked here before any work (:func:`positive_int`, :func:`set_torch_th
 :func:`check_trainer_numbers`); a bad one is a :class:`ConfigError` naming the key and the value.
 Resolvers registered on import: ``${cpu_precision:}`` and ``${unique_id:}`` (run ids).
 
-Settings defaults live once, in the dataclasses that use them: on import the settings dataclasses
-are registered as Hydra structured configs (group ``schema``: ``segment`` =
-:class:`~stylemotion.primitives.SegmentSettings`, ``evaluation`` =
-:class:`~stylemotion.evaluation.settings.EvalSettings`, ``follow`` =
-:class:`~stylemotion.synthesis.controller.FollowSettings`), and the YAML files take them in their
-defaults lists instead of repeating their values; keys and types are checked by Hydra.
+Importing this module loads no model, data set or evaluation code. Settings defaults live once, in the
+dataclasses that use them; they are registered as Hydra structured configs explicitly, before a config
+is composed (:func:`stylemotion.cli.schemas.register_schemas`), with :func:`structured_schema` from here.
 """
 
 from __future__ import annotations
@@ -174,18 +171,6 @@ def build_settings(cls: type, values: Mapping[str, Any] | None, key: str) -> Any
         raise ConfigError(f"{key}.{where}: {str(exc).splitlines()[0]}" if where else f"{key}: {exc}") from None
 
 
-def _register_schemas() -> None:
-    from hydra.core.config_store import ConfigStore
-
-    from stylemotion.evaluation.settings import EvalSettings
-    from stylemotion.primitives import SegmentSettings
-    from stylemotion.synthesis.controller import FollowSettings
-
-    store = ConfigStore.instance()
-    for name, cls in (("segment", SegmentSettings), ("evaluation", EvalSettings), ("follow", FollowSettings)):
-        store.store(group="schema", name=name, node=structured_schema(cls))
-
-
 def _register_resolvers() -> None:
     from omegaconf import OmegaConf
 
@@ -196,4 +181,3 @@ def _register_resolvers() -> None:
 
 
 _register_resolvers()
-_register_schemas()

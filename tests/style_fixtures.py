@@ -15,10 +15,13 @@ from pathlib import Path
 import torch
 from hydra import compose, initialize_config_dir
 
+from stylemotion.cli.schemas import register_schemas
 from stylemotion.config import CONFIG_DIR
 from stylemotion.datasets.synthetic import generate_take
 from stylemotion.export import write_motion_bvh
 from stylemotion.reproduction import reproduce
+
+register_schemas()  # the configs composed here take structured schemas (stylemotion.cli.schemas)
 
 #: The run's data: 6 takes of 6 s per style (4 train, 1 val, 1 test): ~20 training clips per primitive.
 DATA = ["data.takes_per_pair=6", "data.duration_s=6.0", "data.styles=[normal,elderly,youthful]",

@@ -11,11 +11,14 @@ from hydra import compose, initialize_config_dir
 from hydra.errors import ConfigCompositionException
 from omegaconf import OmegaConf
 
+from stylemotion.cli.schemas import register_schemas, register_schemas_for
 from stylemotion.config import CONFIG_DIR, ConfigError, build_settings
 from stylemotion.evaluation.run import settings_from_config
 from stylemotion.evaluation.settings import EvalSettings, SampleCounts
 from stylemotion.primitives import SegmentSettings
 from stylemotion.synthesis.controller import FollowSettings
+
+register_schemas()  # the configs composed here take structured schemas (stylemotion.cli.schemas)
 
 
 def _compose(name: str, overrides: list[str]):
@@ -66,3 +69,20 @@ def test_settings_from_plain_values_name_the_bad_key():
 def test_yaml_files_do_not_restate_the_defaults(file, node):
     raw = yaml.safe_load((CONFIG_DIR / file).read_text())
     assert node not in raw, f"{file} restates the defaults of '{node}'; they live in the settings dataclass"
+
+
+@pytest.mark.parametrize("name", sorted(p.stem for p in CONFIG_DIR.glob("*.yaml")))
+def test_each_command_registers_the_schemas_its_config_needs(name):
+    """``hydra_command`` registers only ``CONFIG_SCHEMAS[name]`` (importing no other settings module):
+    every packaged config composes with just those."""
+    from hydra.core.config_store import ConfigStore
+
+    repo = ConfigStore.instance().repo
+    saved = repo.pop("schema", None)
+    try:
+        register_schemas_for(name)
+        _compose(name, [])
+    finally:
+        repo.pop("schema", None)
+        if saved is not None:
+            repo["schema"] = saved

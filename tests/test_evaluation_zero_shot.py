@@ -12,6 +12,7 @@ import torch
 from hydra import compose, initialize_config_dir
 from omegaconf import OmegaConf
 
+from stylemotion.cli.schemas import register_schemas
 from stylemotion.config import CONFIG_DIR
 from stylemotion.evaluation_zero_shot import (
     ZeroShotRunError,
@@ -24,6 +25,8 @@ from stylemotion.evaluation_zero_shot import (
 from stylemotion.io.outputs import OutputExistsError
 from stylemotion.models.checkpoints import fingerprint, load_autoencoder, load_generative
 from stylemotion.reproduction import reproduce
+
+register_schemas()  # the configs composed here take structured schemas (stylemotion.cli.schemas)
 
 torch.set_num_threads(1)
 PRIMITIVE = "walk_leftStance"

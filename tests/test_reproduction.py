@@ -17,6 +17,7 @@ from hydra import compose, initialize_config_dir
 from vae_fixtures import feature_module, fit, tiny_autoencoder_ckpt
 
 import stylemotion
+from stylemotion.cli.schemas import register_schemas
 from stylemotion.config import CONFIG_DIR
 from stylemotion.evaluation.run import run_evaluation
 from stylemotion.evaluation.sources import MissingExampleError, MixedAutoencodersError
@@ -24,6 +25,8 @@ from stylemotion.io.outputs import OutputExistsError
 from stylemotion.models.vae import PrimitiveVAE
 from stylemotion.reproduction import Reproduction, StageConflictError, choose_budget
 from stylemotion.reproduction import reproduce as run_reproduction
+
+register_schemas()  # the configs composed here take structured schemas (stylemotion.cli.schemas)
 
 torch.set_num_threads(1)
 QUIET = "trainer.enable_progress_bar=false,callbacks.progress_bar=null,trainer.enable_model_summary=false," \

@@ -13,10 +13,13 @@ import pytest
 from hydra import compose, initialize_config_dir
 from omegaconf import OmegaConf
 
+from stylemotion.cli.schemas import register_schemas
 from stylemotion.config import CONFIG_DIR
 from stylemotion.io.outputs import OutputExistsError
 from stylemotion.primitives import SegmentSettings
 from stylemotion.segmentation_report import write_report
+
+register_schemas()  # the configs composed here take structured schemas (stylemotion.cli.schemas)
 
 REPO = Path(__file__).resolve().parents[2]
 SMALL = ["data.takes_per_pair=1", "data.duration_s=3.0", "data.styles=[normal,elderly]", "data.contents=[walk,run]",
