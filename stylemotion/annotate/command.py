@@ -33,12 +33,12 @@ from stylemotion.annotate.templates import TemplateInputError
 from stylemotion.config import ConfigError, positive_int
 from stylemotion.datasets import build_dataset
 from stylemotion.datasets.loading import ConversionSettings
+from stylemotion.datasets.user_motion import UserMotionError, convert_example, parse_example
 from stylemotion.io.atomic import atomic_folder, atomic_write_bytes
 from stylemotion.io.errors import UserInputError
 from stylemotion.io.jsonfile import write_json
 from stylemotion.io.outputs import check_new_output, inside
 from stylemotion.provenance import provenance
-from stylemotion.style_example.example import StyleExampleError, convert_example, parse_example
 
 Say = Callable[[str], None]
 
@@ -88,7 +88,7 @@ def load_document(document: str, fps: float, conversion: Mapping[str, Any] | Non
             raise AnnotateInputError(f"document={document}: no such file")
         settings = ConversionSettings(fps=fps, **{k: v for k, v in (conversion or {}).items() if v is not None})
         example = convert_example(spec, settings)
-    except StyleExampleError as exc:
+    except UserMotionError as exc:
         raise AnnotateInputError(str(exc)) from None
     record = {"file": example.name, "sha256": example.sha256, "file_fps": example.file_fps,
               "file_frames": example.file_frames, "file_range": [example.start, example.end],

@@ -4,7 +4,7 @@ A marker is a canonical joint (:data:`stylemotion.skeleton.CANONICAL_JOINTS`) wh
 frame. Tracks are read from
 
 * a BVH (any skeleton a joint map names), converted as datasets convert theirs
-  (:func:`stylemotion.style_example.example.convert_example`); the markers are its canonical joints;
+  (:func:`stylemotion.datasets.user_motion.convert_example`); the markers are its canonical joints;
 * an NPZ as ``stylemotion-convert`` writes it: ``positions`` ``(frames, 21, 3)`` metres, ``fps``,
   ``joint_names``;
 * a CSV of marker tracks (:func:`write_marker_csv` writes one)::
@@ -177,13 +177,13 @@ def _read_npz(path: Path, joints: Sequence[str]) -> MarkerTracks:
 
 def _read_bvh(text: str, joints: Sequence[str], fps: float, conversion: dict | None) -> MarkerTracks:
     from stylemotion.datasets.loading import ConversionSettings
-    from stylemotion.style_example.example import StyleExampleError, convert_example, parse_example
+    from stylemotion.datasets.user_motion import UserMotionError, convert_example, parse_example
 
     try:
         spec = parse_example(text, key="markers")
         settings = ConversionSettings(fps=fps, **{k: v for k, v in (conversion or {}).items() if v is not None})
         example = convert_example(spec, settings)
-    except StyleExampleError as exc:
+    except UserMotionError as exc:
         raise MarkerInputError(str(exc)) from None
     return tracks_from_positions(example.positions, joints, example.fps, text)
 

@@ -4,7 +4,7 @@
     stylemotion-search query=synthetic_walk_normal_000:30-90 features=E15x3 k=32
 
 ``query`` is a BVH file of any skeleton a joint map names (or ``archive.zip::member.bvh``), converted as
-datasets convert theirs (:mod:`stylemotion.style_example.example`, the code ``stylemotion-style`` uses for its
+datasets convert theirs (:mod:`stylemotion.datasets.user_motion`, the reader ``stylemotion-style`` uses for its
 example; ``start-end`` frames of the **file's** rate, end exclusive) and put on the dataset's skeleton
 (``retarget_query``); or the name of a take of the dataset, ``start-end`` then frames of the take at the
 dataset's fps. A take query's own take is left out of the results unless ``exclude_query_take=false``.
@@ -34,6 +34,7 @@ from omegaconf import DictConfig, OmegaConf
 from stylemotion.config import ConfigError, positive_int
 from stylemotion.datasets import TakeSet, build_dataset
 from stylemotion.datasets.loading import ConversionSettings
+from stylemotion.datasets.user_motion import UserMotionError, convert_example, on_run_skeleton, parse_example
 from stylemotion.io.atomic import atomic_folder
 from stylemotion.io.errors import UserInputError
 from stylemotion.io.jsonfile import write_json
@@ -44,7 +45,6 @@ from stylemotion.search.features import feature_names, feature_spec
 from stylemotion.search.index import ENGINES, FrameIndex
 from stylemotion.search.lng import NORMALIZATIONS
 from stylemotion.search.matching import DEFAULT_K, SearchResult, SegmentMatch, search_motion
-from stylemotion.style_example.example import StyleExampleError, convert_example, on_run_skeleton, parse_example
 
 Say = Callable[[str], None]
 
@@ -67,7 +67,7 @@ def _take_query(text: str, database: MotionDatabase) -> Query | None:
     """The query as frames of a take of the dataset, or None when ``text`` names no take."""
     try:
         spec = parse_example(text, key="query")
-    except StyleExampleError:
+    except UserMotionError:
         prefix, _, bounds = text.rpartition(":")
         if prefix in database.take_names and not Path(prefix).expanduser().is_file():
             raise SearchInputError(f"query={text}: the frame range {bounds!r} must be START-END, two whole numbers "
@@ -109,7 +109,7 @@ def load_query(text: str, takeset: TakeSet, database: MotionDatabase, conversion
         example = convert_example(spec, settings)
         if retarget:
             example = on_run_skeleton(example, takeset)
-    except StyleExampleError as exc:
+    except UserMotionError as exc:
         raise SearchInputError(str(exc)) from None
     record = {"kind": "bvh", "file": example.name, "sha256": example.sha256, "file_fps": example.file_fps,
               "file_frames": example.file_frames, "file_range": [example.start, example.end],
