@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from stylemotion.evaluation.sources import NEUTRAL
+from stylemotion.models.loading import NEUTRAL
 from stylemotion.synthesis.controller import SharpTurnWarning
 from stylemotion.synthesis.generate import generate
 from stylemotion.synthesis.graph import available_models

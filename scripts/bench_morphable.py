@@ -342,7 +342,7 @@ def part_vae(b: Bench, run_folder: Path, k: int | None, iterations: int) -> None
 
     from stylemotion.datamodules.features import encode_frames
     from stylemotion.finished_run import FinishedRun, read_json_object
-    from stylemotion.models.checkpoints import load_generative
+    from stylemotion.models.loading import load_generative
     from stylemotion.sampling import decode_features
 
     primitive = "walk_leftStance"

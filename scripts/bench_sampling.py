@@ -52,7 +52,7 @@ def stand_in(folder: Path):
 
 
 def load(path: Path):
-    from stylemotion.models.checkpoints import load_generative
+    from stylemotion.models.loading import load_generative
 
     return load_generative(path)
 

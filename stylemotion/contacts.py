@@ -25,13 +25,10 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.ndimage import label, median_filter
 
-from stylemotion.skeleton import JOINT_INDEX, NUM_JOINTS
+from stylemotion.skeleton import FOOT_POINTS, JOINT_INDEX, NUM_JOINTS
 
 #: Feet in the order of the last axis of every contact array.
 FEET: tuple[str, str] = ("left", "right")
-#: ``(foot, point)`` joint indices: heel (ankle) and ball (toes) of the left and the right foot.
-FOOT_POINTS: np.ndarray = np.array([[JOINT_INDEX["Foot_L"], JOINT_INDEX["Toes_L"]],
-                                    [JOINT_INDEX["Foot_R"], JOINT_INDEX["Toes_R"]]])
 
 
 @dataclass(frozen=True)

@@ -47,14 +47,15 @@ from stylemotion.config import config_dir, positive_int, set_torch_threads
 from stylemotion.datasets import TakeSet, build_dataset
 from stylemotion.evaluation.pipeline import example_column_gram, real_side, recognition
 from stylemotion.evaluation.settings import EvalSettings
-from stylemotion.evaluation.sources import NEUTRAL, EvalModel, check_one_autoencoder, load_model
+from stylemotion.evaluation.sources import check_one_autoencoder
 from stylemotion.evaluation.tables import across_sample_sd, distance_table
 from stylemotion.finished_run import FinishedRun, read_json_object
 from stylemotion.io.atomic import atomic_write_bytes
 from stylemotion.io.errors import UserInputError
 from stylemotion.io.jsonfile import write_json
 from stylemotion.io.outputs import check_new_output, inside
-from stylemotion.models.checkpoints import fingerprint, load_autoencoder, load_generative
+from stylemotion.models.checkpoints import fingerprint, load_autoencoder
+from stylemotion.models.loading import NEUTRAL, EvalModel, load_generative, load_model
 from stylemotion.models.zero_shot import ZeroShotStyleVAE
 from stylemotion.primitives import parse_primitive
 from stylemotion.provenance import provenance

@@ -21,9 +21,15 @@ from collections.abc import Iterable
 
 import numpy as np
 
-from stylemotion.contacts import FOOT_POINTS
 from stylemotion.ik import MIN_BONE_LENGTH
-from stylemotion.skeleton import CANONICAL_JOINTS, CANONICAL_PARENTS, JOINT_INDEX, bone_lengths, forward_kinematics
+from stylemotion.skeleton import (
+    CANONICAL_JOINTS,
+    CANONICAL_PARENTS,
+    FOOT_POINTS,
+    JOINT_INDEX,
+    bone_lengths,
+    forward_kinematics,
+)
 
 #: Canonical index of the child joint of each bone, i.e. every joint but the root (20).
 BONE_JOINTS: tuple[int, ...] = tuple(j for j, p in enumerate(CANONICAL_PARENTS) if p >= 0)

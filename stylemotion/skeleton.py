@@ -50,6 +50,10 @@ CANONICAL_PARENTS: tuple[int, ...] = tuple(
 
 #: Index of a canonical joint by name, e.g. ``JOINT_INDEX["Hips"] == 0``.
 JOINT_INDEX: dict[str, int] = {name: i for i, name in enumerate(CANONICAL_JOINTS)}
+#: ``(foot, point)`` joint indices: heel (ankle) and ball (toes) of the left and the right foot (the foot
+#: points of contacts, bone retargeting and the viewer; the order of :data:`stylemotion.primitives.contacts.FEET`).
+FOOT_POINTS: np.ndarray = np.array([[JOINT_INDEX["Foot_L"], JOINT_INDEX["Toes_L"]],
+                                    [JOINT_INDEX["Foot_R"], JOINT_INDEX["Toes_R"]]])
 
 #: Left/right joint index pairs of the canonical skeleton (for mirroring and symmetry checks).
 CANONICAL_MIRROR = tuple(JOINT_INDEX[n.replace("_L", "_R")] if n.endswith("_L") else

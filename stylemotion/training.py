@@ -242,7 +242,7 @@ def run(cfg: DictConfig, extra_callbacks: list[pl.Callback] | None = None,
         callbacks.append(HyperparametersWithMetric(hyperparameters(cfg), str(cfg.get("monitor") or "")))
     else:  # nothing to log the learning rate to (Lightning refuses the monitor without a logger)
         callbacks = [cb for cb in callbacks if not isinstance(cb, LearningRateMonitor)]
-    record = _record_start(output_dir, cfg, ckpt_path)
+    record = record_start(output_dir, cfg, ckpt_path)
     _write_text(output_dir / "config_resolved.yaml", OmegaConf.to_yaml(cfg, resolve=True))
 
     pl.seed_everything(cfg.seed, workers=True)
@@ -278,7 +278,7 @@ def run(cfg: DictConfig, extra_callbacks: list[pl.Callback] | None = None,
     return {"trainer": trainer, "model": model, "datamodule": datamodule, "metrics": metrics}
 
 
-def _record_start(output_dir: Path, cfg: DictConfig, ckpt_path: str | None) -> dict[str, Any]:
+def record_start(output_dir: Path, cfg: DictConfig, ckpt_path: str | None) -> dict[str, Any]:
     """Log what runs (version, commit, folder) and add this start to ``<output_dir>/run.json``
     (``{"run_id", "output_dir", "starts": [provenance + time + resumed_from, …]}``; a fresh start
     replaces the file). Returns this start's record."""

@@ -23,7 +23,8 @@ from stylemotion.evaluation_zero_shot import (
     train_config,
 )
 from stylemotion.io.outputs import OutputExistsError
-from stylemotion.models.checkpoints import fingerprint, load_autoencoder, load_generative
+from stylemotion.models.checkpoints import fingerprint, load_autoencoder
+from stylemotion.models.loading import load_generative
 from stylemotion.reproduction import reproduce
 
 register_schemas()  # the configs composed here take structured schemas (stylemotion.cli.schemas)

@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from stylemotion.contacts import FOOT_POINTS, planted_point_speed
 from stylemotion.contacts import leg_length as contacts_leg_length
+from stylemotion.contacts import planted_point_speed
 from stylemotion.datasets.synthetic import generate_take
 from stylemotion.retarget import (
     BONE_JOINTS,
@@ -18,7 +18,14 @@ from stylemotion.retarget import (
     retarget_positions,
     target_bone_lengths,
 )
-from stylemotion.skeleton import CANONICAL_PARENTS, JOINT_INDEX, NUM_JOINTS, bone_lengths, forward_kinematics
+from stylemotion.skeleton import (
+    CANONICAL_PARENTS,
+    FOOT_POINTS,
+    JOINT_INDEX,
+    NUM_JOINTS,
+    bone_lengths,
+    forward_kinematics,
+)
 
 FEET = list(FOOT_POINTS.ravel())
 #: Bones of the hip-to-toe chains (the pelvis bone to each hip joint included).

@@ -18,16 +18,9 @@ from stylemotion.evaluation.pipeline import evaluate_models
 from stylemotion.evaluation.reference import PrimitiveData, primitive_data
 from stylemotion.evaluation.report import write_report
 from stylemotion.evaluation.settings import EvalSettings
-from stylemotion.evaluation.sources import (
-    NEUTRAL,
-    EvalModel,
-    MissingExampleError,
-    MixedAutoencodersError,
-    RealClipSource,
-    SampleSource,
-    load_model,
-)
+from stylemotion.evaluation.sources import MissingExampleError, MixedAutoencodersError, RealClipSource
 from stylemotion.evaluation.tables import diagonal_minima, distance_table, variance_stats
+from stylemotion.models.loading import NEUTRAL, EvalModel, SampleSource, load_model
 
 __all__ = ["NEUTRAL", "EvalModel", "EvalSettings", "MissingExampleError", "MixedAutoencodersError", "PrimitiveData",
            "RealClipSource", "SampleSource", "StyleClassifier", "diagonal_minima",

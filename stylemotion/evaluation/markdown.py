@@ -9,6 +9,7 @@ from typing import Any
 import numpy as np
 
 from stylemotion.evaluation.tables import VARIANCE_KEYS
+from stylemotion.io.markdown import md_table
 
 #: The thesis' numbers this evaluation is compared with (Tables 5.1–5.3 of Du's dissertation).
 THESIS: dict[str, Any] = {
@@ -89,12 +90,6 @@ def pct(value: Any) -> str:
     return "–" if value is None or not math.isfinite(value) else f"{100 * value:.1f} %"
 
 
-def _md_table(header: list[str], rows: list[list[str]]) -> str:
-    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
-    lines += ["| " + " | ".join(r) + " |" for r in rows]
-    return "\n".join(lines)
-
-
 def format_markdown(results: dict[str, Any], figures: list[str], tables: list[str]) -> str:
     """``report.md``: every table with its units and definitions, readable without the other files."""
     meta = results.get("meta", {})
@@ -111,7 +106,7 @@ def format_markdown(results: dict[str, Any], figures: list[str], tables: list[st
             f"{fmt(100 * ae['test_mpjpe_m'], 3)} cm (root-local poses {fmt(100 * ae['test_local_mpjpe_m'], 3)} cm) "
             f"over {fmt(ae['test_windows'])} test windows of {ae['window_frames']} frames." if ae else "", ""]
     if meta.get("checkpoints"):
-        out += ["Models:", "", _md_table(["primitive", "model", "style", "checkpoint"],
+        out += ["Models:", "", md_table(["primitive", "model", "style", "checkpoint"],
                                          [[c.get("primitive", ""), c.get("name", ""), c.get("style", ""),
                                            f"`{c.get('path')}`"] for c in meta["checkpoints"]]), ""]
     out += _thesis_section(results)
@@ -152,7 +147,7 @@ def _thesis_section(results: dict[str, Any]) -> list[str]:
                              f"{pct(min(there))} – {pct(max(there))}" if there else "–"])
     out += ["The thesis' styles (proud, depressed, angry, female, childlike, old) are not Bandai's, so style rows "
             "are compared as ranges.", "",
-            _md_table(["what", "here", "thesis"], rows) if rows else "(no comparable result)", ""]
+            md_table(["what", "here", "thesis"], rows) if rows else "(no comparable result)", ""]
     return out
 
 
@@ -167,7 +162,7 @@ def _table_5_1_section(results: dict[str, Any]) -> list[str]:
                  for name, values in t.get("extra_rows", {}).items()]
         d = t["diagonal"]
         out += [f"### {p} ({fmt(t['samples'])} samples per model)", "",
-                _md_table(["model \\ example"] + t["examples"], rows), "",
+                md_table(["model \\ example"] + t["examples"], rows), "",
                 f"Rows with the minimum on the diagonal: {len(d['rows'])} of {len(t['models'])} "
                 f"({', '.join(d['rows'])}); columns: {len(d['columns'])} of {len(t['models'])} "
                 f"({', '.join(d['columns'])}).",
@@ -186,12 +181,12 @@ def _variance_section(results: dict[str, Any]) -> list[str]:
         ratio = results["variance_ratio"][p]
         body = [[r] + [fmt(s[k]) for k in VARIANCE_KEYS] + [pct(ratio[r][k]) for k in VARIANCE_KEYS]
                 + [fmt(s["speed_mean_mps"], 3), fmt(s["step_mean_cm"], 3), fmt(s["motions"])] for r, s in rows.items()]
-        out += [f"### {p}", "", _md_table(["row", "pose_SD", "V_SD", "step_SD", "pose %", "V %", "step %",
+        out += [f"### {p}", "", md_table(["row", "pose_SD", "V_SD", "step_SD", "pose %", "V %", "step %",
                                            "mean speed m/s", "mean step cm", "motions"], body), ""]
         real = results.get("variance_real", {}).get(p, {})
         if real:
             out += ["Real clips of each style (all splits), for reference:", "",
-                    _md_table(["style", "pose_SD", "V_SD", "step_SD", "mean speed m/s", "mean step cm", "clips"],
+                    md_table(["style", "pose_SD", "V_SD", "step_SD", "mean speed m/s", "mean step cm", "clips"],
                               [[st] + [fmt(s[k]) for k in VARIANCE_KEYS]
                                + [fmt(s["speed_mean_mps"], 3), fmt(s["step_mean_cm"], 3), fmt(s["motions"])]
                                for st, s in real.items()]), ""]
@@ -214,7 +209,7 @@ def _variation_section(results: dict[str, Any]) -> list[str]:
                 for m, r in ratios.items()]
         header = ["model", "style", "pose_across_SD", "its style's real clips", "pose_across %", "V_SD %", "step_SD %",
                   "diversity %"]
-        out += [f"### {p}", "", _md_table(header, body), ""]
+        out += [f"### {p}", "", md_table(header, body), ""]
     return out
 
 
@@ -228,7 +223,7 @@ def _recognition_section(results: dict[str, Any]) -> list[str]:
     for p, c in rec["per_primitive"].items():
         out += [f"### {p}: confusion on {fmt(c['heldout_clips'])} real held-out clips (rows true, columns predicted; "
                 f"{fmt(c['train_clips'])} train clips, {c['components']} PCA dims)", "",
-                _md_table(["true \\ predicted"] + c["styles"], [[s] + [str(v) for v in row]
+                md_table(["true \\ predicted"] + c["styles"], [[s] + [str(v) for v in row]
                                                                   for s, row in zip(c["styles"], c["confusion"])]), "",
                 f"![confusion {p}](classifier_confusion_{p}.png)", ""]
     body = []
@@ -238,7 +233,7 @@ def _recognition_section(results: dict[str, Any]) -> list[str]:
             body.append([p, m, d["target_style"], pct(d["share"]), pct(d["real_share"]),
                          f"{top} ({pct(d['predicted'][top])})"])
     out += ["Share of each model's samples assigned to its target style (real ground truth clips for reference):", "",
-            _md_table(["primitive", "model", "target", "samples", "real", "most predicted"], body), ""]
+            md_table(["primitive", "model", "target", "samples", "real", "most predicted"], body), ""]
     return out
 
 
@@ -250,7 +245,7 @@ def _metric_sections(results: dict[str, Any]) -> list[str]:
             ref, div = results["frechet_reference"][p][m], results["diversity"][p][m]
             body.append([p, m, fmt(fd), fmt(ref.get("neutral_samples")), fmt(ref.get("real_floor")),
                          fmt(ref["ground_truth_clips"]), fmt(div["samples"]), fmt(div["real"])])
-    out += [_md_table(["primitive", "model", "FD samples↔truth", "FD neutral samples↔truth", "FD real floor",
+    out += [md_table(["primitive", "model", "FD samples↔truth", "FD neutral samples↔truth", "FD real floor",
                        "truth clips", "diversity samples", "diversity real"], body), ""]
     pooled = [f"{m} {pct(v)} (real {pct(results['foot_skating_real'].get(m))})"
               for m, v in results.get("foot_skating", {}).items()]
@@ -262,7 +257,7 @@ def _metric_sections(results: dict[str, Any]) -> list[str]:
             body.append([p, m, pct(s["ratio"]), pct(r["ratio"]), pct(s["contact_share"]), pct(r["contact_share"]),
                          pct(s["no_plant_share"]), pct(r["no_plant_share"]), fmt(s["planted_mid_mps"], 3),
                          fmt(r["planted_mid_mps"], 3)])
-    out += [_md_table(["primitive", "model", "skating", "real", "contact", "real", "no plant", "real",
+    out += [md_table(["primitive", "model", "skating", "real", "contact", "real", "no plant", "real",
                        "planted mid m/s", "real"], body), ""]
     out += ["## Nearest training clip (copying check)", "", "Medians, cm (RMS joint distance of root-local poses).", ""]
     body = []
@@ -271,6 +266,6 @@ def _metric_sections(results: dict[str, Any]) -> list[str]:
             cm = [d.get(k) for k in ("samples_median_m", "heldout_neutral_median_m", "ground_truth_median_m",
                                      "to_example_median_m", "ground_truth_to_example_median_m")]
             body.append([p, m] + [fmt(None if v is None else 100 * v, 3) for v in cm])
-    out += [_md_table(["primitive", "model", "samples → training", "unseen neutral → training",
+    out += [md_table(["primitive", "model", "samples → training", "unseen neutral → training",
                        "ground truth → training", "samples → example", "ground truth → example"], body), ""]
     return out

@@ -1,7 +1,7 @@
 """One evaluation: models × real data → the plain-valued results a report is written from.
 
-:func:`evaluate_models` takes :class:`~stylemotion.evaluation.sources.EvalModel`s (loaded from
-checkpoints or any :class:`~stylemotion.evaluation.sources.SampleSource`), the dataset they were
+:func:`evaluate_models` takes :class:`~stylemotion.models.loading.EvalModel`s (loaded from
+checkpoints or any :class:`~stylemotion.models.loading.SampleSource`), the dataset they were
 trained on and the autoencoder they share, and computes per primitive:
 
 * Table 5.1 (:mod:`.tables`) on ``samples.table_5_1`` samples per model;
@@ -51,15 +51,10 @@ from stylemotion.evaluation.metrics import (
 )
 from stylemotion.evaluation.reference import PrimitiveData, primitive_data
 from stylemotion.evaluation.settings import EvalSettings
-from stylemotion.evaluation.sources import (
-    NEUTRAL,
-    EvalModel,
-    MissingExampleError,
-    check_one_autoencoder,
-    motions_from_clips,
-)
+from stylemotion.evaluation.sources import MissingExampleError, check_one_autoencoder, motions_from_clips
 from stylemotion.evaluation.tables import diagonal_minima, distance_table, example_gram, mean_motion, variance_stats
 from stylemotion.models.autoencoder import local_mpjpe, mpjpe
+from stylemotion.models.loading import NEUTRAL, EvalModel
 from stylemotion.models.style import mean_gram
 from stylemotion.primitives import Segmentation, parse_primitive, segment_action, time_normalize
 from stylemotion.sampling import MotionSamples

@@ -24,7 +24,8 @@ import numpy as np
 from stylemotion.contacts import foot_signals
 from stylemotion.datamodules.clips import ClipDataModule
 from stylemotion.datasets import TakeSet
-from stylemotion.evaluation.sources import EvalModel, MissingExampleError
+from stylemotion.evaluation.sources import MissingExampleError
+from stylemotion.models.loading import EvalModel
 from stylemotion.primitives import (
     STANCE_FOOT,
     Clip,

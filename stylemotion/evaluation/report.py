@@ -31,7 +31,7 @@ from stylemotion.viz.tensorboard import write_report_events
 def write_report(results: dict[str, Any], out: str | os.PathLike, force: bool = False,
                  samples: Mapping[str, Any] | None = None) -> Path:
     """Write the report folder of ``results`` (from :func:`stylemotion.evaluation.pipeline.evaluate_models`
-    plus ``meta``) atomically; returns its path. ``report.html`` (:mod:`stylemotion.viewer.report`) shows the
+    plus ``meta``) atomically; returns its path. ``report.html`` (:mod:`stylemotion.evaluation.html_report`) shows the
     tables, the figures and, when ``samples`` maps ``<primitive> <model>`` to its MotionSamples, a few of
     them in the viewer."""
     out = check_new_output(out, force)
@@ -44,7 +44,7 @@ def write_report(results: dict[str, Any], out: str | os.PathLike, force: bool = 
         write_json(tmp / "report.json", results)
         text = format_markdown(results, figures, tables)
         (tmp / "report.md").write_text(text)
-        from stylemotion.viewer.report import write_report_html  # the viewer imports this package's markdown
+        from stylemotion.evaluation.html_report import write_report_html  # Python-Markdown, only when writing
 
         write_report_html(tmp, text, figures, samples)
     return out

@@ -25,15 +25,16 @@ from omegaconf import DictConfig, OmegaConf
 
 from stylemotion.config import build_settings
 from stylemotion.datasets import build_dataset
+from stylemotion.evaluation.html_report import SAMPLES_PER_MODEL
 from stylemotion.evaluation.pipeline import evaluate_models
 from stylemotion.evaluation.report import write_report
 from stylemotion.evaluation.settings import EvalSettings
-from stylemotion.evaluation.sources import EvalModel, check_one_autoencoder, load_model
+from stylemotion.evaluation.sources import check_one_autoencoder
 from stylemotion.io.outputs import check_new_output
 from stylemotion.models.autoencoder import IncompatibleModelError, MotionAutoencoder
 from stylemotion.models.checkpoints import autoencoder_info, find_checkpoints, load_autoencoder
+from stylemotion.models.loading import EvalModel, load_model
 from stylemotion.provenance import provenance
-from stylemotion.viewer.report import SAMPLES_PER_MODEL
 
 log = logging.getLogger(__name__)
 

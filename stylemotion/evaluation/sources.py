@@ -5,30 +5,24 @@ the trained :class:`~stylemotion.models.vae.PrimitiveVAE` and
 :class:`~stylemotion.models.cvae.StyleCVAE` are sources, and so is :class:`RealClipSource`
 (real clips drawn with replacement: an "oracle model" for tests and reference rows).
 :class:`EvalModel` wraps a source with the primitive it models, the style it targets and the style
-example it was conditioned on; :func:`load_model` makes one from a checkpoint.
+example it was conditioned on; :func:`load_model` makes one from a checkpoint. Those three and
+:data:`NEUTRAL` live with the models (:mod:`stylemotion.models.loading`, the one loading path) and are
+named here too, as the evaluation's inputs.
 """
 
 from __future__ import annotations
 
 from collections import defaultdict
 from collections.abc import Sequence
-from dataclasses import dataclass, field
-from pathlib import Path
-from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
 import torch
 
 from stylemotion.io.errors import UserInputError
 from stylemotion.models.autoencoder import IncompatibleModelError
-from stylemotion.models.checkpoints import load_generative
-from stylemotion.models.cvae import StyleCVAE
-from stylemotion.models.zero_shot import ZeroShotStyleVAE
+from stylemotion.models.loading import EvalModel
 from stylemotion.primitives import Clip, time_normalize
 from stylemotion.sampling import MotionSamples, pad_motions
-
-#: Row name of the neutral model (the thesis' "neutral"), trained on the neutral style's clips.
-NEUTRAL = "neutral"
 
 
 class MixedAutoencodersError(IncompatibleModelError):
@@ -37,88 +31,6 @@ class MixedAutoencodersError(IncompatibleModelError):
 
 class MissingExampleError(UserInputError, ValueError):
     """A style model's example clip cannot be found (or does not match) in the evaluation data."""
-
-
-@runtime_checkable
-class SampleSource(Protocol):
-    """Anything that draws motions of one primitive."""
-
-    def sample(self, n: int, seed: int | None = None) -> MotionSamples:  # pragma: no cover - protocol
-        """``n`` motions (see :class:`stylemotion.sampling.MotionSamples`), reproducible for a seed."""
-        ...
-
-
-@dataclass
-class EvalModel:
-    """A generative model under evaluation.
-
-    Attributes:
-        name: its row in the tables: ``neutral`` for the plain VAE, else its style.
-        primitive: ``<action>_<primitive>``, e.g. ``walk_leftStance``.
-        style: the data's style label it should produce (the neutral style for ``neutral``).
-        source: draws its samples.
-        examples: the style example clips it was conditioned on (records with ``take``, ``start``,
-            ``stop``, ``encoded_frames``, … as saved by :mod:`stylemotion.datamodules.features`); empty for
-            the neutral model.
-        autoencoder: the autoencoder it was trained on (``path``, ``fingerprint``, …), or None.
-        checkpoint: its checkpoint path, or None.
-        timeline_frames: the primitive's canonical length, frames.
-        target_gram: ``(C, C)`` the model's own record of ``Gram(Φ(example))``, or None.
-        dataset: name of the dataset it was trained on, or None.
-        example_length: how its examples were encoded: ``canonical`` (resampled to the timeline,
-            the default) or ``natural`` (as recorded).
-    """
-
-    name: str
-    primitive: str
-    style: str
-    source: SampleSource
-    examples: list[dict[str, Any]] = field(default_factory=list)
-    autoencoder: dict[str, Any] | None = None
-    checkpoint: str | None = None
-    timeline_frames: int | None = None
-    target_gram: torch.Tensor | None = None
-    dataset: str | None = None
-    example_length: str | None = "canonical"
-
-    @property
-    def label(self) -> str:
-        return f"{self.primitive}/{self.name}"
-
-
-def load_model(path: str | Path, neutral_style: str = "normal", autoencoder=None) -> EvalModel:
-    """An :class:`EvalModel` from a PrimitiveVAE or StyleCVAE checkpoint (loaded on the CPU, eval mode).
-
-    Args:
-        path: the checkpoint.
-        neutral_style: data style of the neutral model when its spec names several content styles.
-        autoencoder: an already loaded autoencoder to attach (must be the model's own: same weights);
-            None takes the one embedded in the checkpoint (or recorded) on first use.
-
-    Raises:
-        FileNotFoundError, IncompatibleModelError: no file, or not a trained primitive model
-        (:func:`stylemotion.models.checkpoints.load_generative` reads it).
-    """
-    model = load_generative(path, autoencoder)
-    if isinstance(model, ZeroShotStyleVAE):
-        raise IncompatibleModelError(f"{path} is a zero-shot style network: it samples only given a style example "
-                                     "(bind one with model.bind_example(...), or evaluate it with "
-                                     "scripts/zero_shot_loso.py)")
-    spec = model.spec
-    styled = isinstance(model, StyleCVAE)
-    if styled:
-        name = style = str(spec["style"])
-    else:
-        contents = list(spec.get("content_styles") or [neutral_style])
-        name, style = NEUTRAL, contents[0] if len(contents) == 1 else neutral_style
-    return EvalModel(name=name, primitive=str(spec["primitive"]), style=style, source=model,
-                     examples=[dict(e) for e in spec.get("style_examples") or []] if styled else [],
-                     autoencoder=dict(spec["autoencoder"]), checkpoint=str(path),
-                     timeline_frames=int(spec["timeline_frames"]),
-                     # a centred style term keeps a covariance, not the thesis' Gram that Table 5.1 recomputes
-                     target_gram=(model.style_gram.detach().clone()
-                                  if styled and not model.hparams.get("style_centred", False) else None),
-                     dataset=spec.get("dataset"), example_length=spec.get("example_length") or "canonical")
 
 
 def check_one_autoencoder(models: Sequence[EvalModel], fingerprint: str | None = None) -> str | None:

@@ -47,7 +47,8 @@ EMBEDDED_AUTOENCODER = "autoencoder"
 AUTOENCODER_KEYS = ("hidden_units", "kernel_size", "representation", "fps")
 #: Kinds of checkpoint (see :func:`checkpoint_kind`).
 KINDS = ("autoencoder", "vae", "cvae", "zero_shot")
-#: Kinds of generative model (their checkpoints embed the autoencoder; :func:`load_generative` loads them).
+#: Kinds of generative model (their checkpoints embed the autoencoder;
+#: :func:`stylemotion.models.loading.load_generative` loads them).
 GENERATIVE_KINDS = ("vae", "cvae", "zero_shot")
 
 
@@ -95,19 +96,6 @@ def checkpoint_kind(hparams: Mapping[str, Any]) -> str | None:
     if all(k in hparams for k in AUTOENCODER_KEYS):
         return "autoencoder"
     return None
-
-
-def model_class(kind: str) -> type[pl.LightningModule]:
-    """The LightningModule class of a checkpoint kind (see :data:`KINDS`)."""
-    from stylemotion.models.cvae import StyleCVAE  # the model modules import this one
-    from stylemotion.models.vae import PrimitiveVAE
-    from stylemotion.models.zero_shot import ZeroShotStyleVAE
-
-    classes = {"autoencoder": MotionAutoencoder, "vae": PrimitiveVAE, "cvae": StyleCVAE,
-               "zero_shot": ZeroShotStyleVAE}
-    if kind not in classes:
-        raise ValueError(f"unknown checkpoint kind {kind!r}; kinds: {list(KINDS)}")
-    return classes[kind]
 
 
 def is_model_checkpoint(path: str | os.PathLike) -> bool:
@@ -294,35 +282,6 @@ def resolve_autoencoder(info: Mapping[str, Any], record: Mapping[str, Any] | Non
         "its checkpoint embeds none (written before autoencoders were embedded)"
         + (f"; tried {'; '.join(tried)}" if tried else "; no autoencoder path is recorded")
         + ". Pass it with model.attach_autoencoder(<autoencoder best.ckpt>) or autoencoder_ckpt=…")
-
-
-# -- generative models
-
-
-def load_generative(path: str | os.PathLike, autoencoder: MotionAutoencoder | None = None) -> pl.LightningModule:
-    """A trained :class:`~stylemotion.models.vae.PrimitiveVAE`, :class:`~stylemotion.models.cvae.StyleCVAE`
-    or :class:`~stylemotion.models.zero_shot.ZeroShotStyleVAE` (class from its hyperparameters), eval mode, CPU.
-
-    Args:
-        path: its checkpoint (``~`` expanded).
-        autoencoder: an already loaded autoencoder to attach (must be the model's own: same
-            weights); None resolves it on first use (see :func:`resolve_autoencoder`).
-
-    Raises:
-        FileNotFoundError, IncompatibleModelError: no file, or not a trained primitive model.
-    """
-    path = Path(path).expanduser()
-    checkpoint = read_checkpoint(path, "model checkpoint")
-    hparams = checkpoint.get("hyper_parameters") or {}
-    kind = checkpoint_kind(hparams)
-    if kind not in GENERATIVE_KINDS:
-        raise IncompatibleModelError(f"{path} is not a trained PrimitiveVAE/StyleCVAE/ZeroShotStyleVAE checkpoint "
-                                     f"(no data spec in its hyperparameters; it has {sorted(hparams)[:12]})")
-    model = restore(model_class(kind), checkpoint, str(path))
-    model.checkpoint_file = str(path.resolve())
-    if autoencoder is not None:
-        model.attach_autoencoder(autoencoder)
-    return model
 
 
 def find_checkpoints(patterns: Sequence[str] | str) -> list[Path]:

@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import logging
 import warnings
-from collections.abc import Mapping, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
@@ -33,7 +33,6 @@ import torch
 from scipy.optimize import least_squares
 from scipy.spatial.transform import Rotation
 
-from stylemotion.config import ConfigError
 from stylemotion.geometry import rotate_yaw_xz, wrap_angle
 from stylemotion.morphable.bounds import MAX_EVALUATIONS, best_code
 from stylemotion.morphable.constraints import KeyframeConstraint, constraint_errors
@@ -179,8 +178,8 @@ class MorphablePrimitive:
 
     With several variants (e.g. the turn variants of a stance, :mod:`.variants`) each step first chooses one by
     the look-ahead of §4.5.1 (:mod:`.lookahead`, over ``settings.lookahead_steps`` steps and the variants of the
-    nodes that follow, see :func:`link_graph`), then searches its code. ``last_variant`` names the variant of
-    the last step searched; :meth:`decode_latent` decodes with it."""
+    nodes that follow, see :func:`stylemotion.synthesis.morphable_graph.link_graph`), then searches its code.
+    ``last_variant`` names the variant of the last step searched; :meth:`decode_latent` decodes with it."""
 
     def __init__(self, model: MorphableModel | Sequence[MorphableModel], settings: MapSettings | None = None,
                  names: Sequence[str] | None = None):
@@ -196,7 +195,7 @@ class MorphablePrimitive:
         self.fps = self.model.fps
         self.timeline_frames = self.model.length
         self.last_variant = names[0]
-        self.following: list[MorphablePrimitive] = []  # the nodes of the next steps (link_graph)
+        self.following: list[MorphablePrimitive] = []  # the nodes of the next steps (synthesis.morphable_graph)
         self._mean_steps = None
 
     def eval(self) -> MorphablePrimitive:
@@ -250,24 +249,6 @@ class MorphablePrimitive:
         return _map_step(self.variants[self.last_variant], goal, follow, self.settings)
 
 
-def link_graph(graph) -> None:
-    """Tell every Morphable Graph node of ``graph`` which nodes take the steps after it (alternating stances,
-    as the controller walks), for the look-ahead."""
-    from stylemotion.synthesis.controller import LOOKAHEAD_TARGETS
-    from stylemotion.synthesis.graph import TRANSITIONS
-
-    for name, node in graph.models.items():
-        if not isinstance(node, MorphablePrimitive):
-            continue
-        node.following, current = [], name
-        for _ in range(LOOKAHEAD_TARGETS):  # as many nodes as the controller hands on targets of later steps
-            nxt = [p for p in TRANSITIONS[current] if p in graph.models and not p.startswith("end")]
-            if not nxt or not isinstance(graph.models[nxt[0]], MorphablePrimitive):
-                break
-            current = nxt[0]
-            node.following.append(graph.models[current])
-
-
 def _variant_names(models: Sequence[MorphableModel]) -> list[str]:
     names = []
     for i, m in enumerate(models):
@@ -313,40 +294,3 @@ def _map_step(model: MorphableModel, goal, follow, settings: MapSettings
     if goal.previous_pose is not None:
         terms["pose"], terms["speed"] = float((r[3:-1] ** 2).sum()), float(r[-1] ** 2)
     return torch.from_numpy(best.astype(np.float32)), float(found.cost), min(final, found.cost), terms
-
-
-def load_morphable_graph(models: Mapping[str, str | Path | Sequence[str | Path]], action: str = "walk",
-                         settings: MapSettings | None = None):
-    """A :class:`~stylemotion.synthesis.graph.MotionGraph` of Morphable Graph primitives from
-    ``{primitive: model file or run folder, or a list of them}`` (``walk_leftStance`` or ``leftStance``); a list
-    gives the primitive's variants (e.g. its turn variants), chosen per step by look-ahead."""
-    from stylemotion.synthesis.graph import MotionGraph, _short
-
-    if not models:
-        raise ConfigError("model=morphable needs +models.walk_leftStance=<run folder or model.npz> "
-                          "+models.walk_rightStance=<…>")
-    loaded, sources = {}, {}
-    for key, paths in sorted(models.items()):
-        primitive = _short(str(key), action)
-        paths = [paths] if isinstance(paths, (str, Path)) else list(paths)
-        if not paths:
-            raise ConfigError(f"models.{key} is an empty list; give a run folder or model.npz (or several)")
-        variants = []
-        for path in paths:
-            try:
-                model = MorphableModel.load(path)
-            except (OSError, ValueError, KeyError) as err:
-                raise ConfigError(f"models.{key}={path}: {err}") from err
-            have = f"{model.meta.get('action')}_{model.meta.get('primitive')}"
-            if have != f"{action}_{primitive}":
-                raise ConfigError(f"models.{key}={path} holds a {have} model, not {action}_{primitive}")
-            variants.append(model)
-        try:
-            loaded[primitive] = MorphablePrimitive(variants, settings)
-        except ValueError as err:
-            raise ConfigError(f"models.{key}: {err}") from err
-        sources[primitive] = ", ".join(str(m.meta["path"]) for m in variants)
-    styles = {m.meta.get("style") for node in loaded.values() for m in node.variants.values()}
-    graph = MotionGraph(action=action, style="/".join(sorted(str(s) for s in styles)), models=loaded, sources=sources)
-    link_graph(graph)
-    return graph

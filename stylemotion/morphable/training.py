@@ -34,7 +34,7 @@ from stylemotion.morphable.arm import (
 from stylemotion.morphable.model import FitSettings, MorphableModel, fit_primitive, reconstruction_error
 from stylemotion.morphable.variants import TURN_THRESHOLD_DEG, select_turn, variant_name
 from stylemotion.primitives import parse_primitive
-from stylemotion.training import _record_start
+from stylemotion.training import record_start
 
 log = logging.getLogger(__name__)
 
@@ -51,7 +51,7 @@ def run(cfg: DictConfig) -> dict[str, Any]:
     set_torch_threads(cfg.get("threads"))
     began = time.perf_counter()
     action, primitive = _parse(str(cfg.primitive))
-    _record_start(output_dir, cfg, None)
+    record_start(output_dir, cfg, None)
     atomic_write_bytes(output_dir / "config_resolved.yaml", OmegaConf.to_yaml(cfg, resolve=True).encode())
     styles = None if cfg.get("style") in (None, "all") else [str(cfg.style)]
     if primitive in ARM_PRIMITIVES:

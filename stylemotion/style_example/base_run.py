@@ -16,9 +16,9 @@ from typing import Any
 
 from omegaconf import DictConfig, open_dict
 
-from stylemotion.evaluation.sources import NEUTRAL, EvalModel, load_model
 from stylemotion.finished_run import FinishedRun, read_json_object
 from stylemotion.io.outputs import safe_name
+from stylemotion.models.loading import NEUTRAL, EvalModel, load_model
 from stylemotion.primitives import parse_primitive
 from stylemotion.reproduction import stage_train_config
 from stylemotion.style_example.example import StyleExampleError

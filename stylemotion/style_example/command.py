@@ -41,11 +41,11 @@ from omegaconf import DictConfig, OmegaConf
 from stylemotion.config import ConfigError, config_dir, positive_int
 from stylemotion.datasets import TakeSet, build_dataset
 from stylemotion.datasets.loading import ConversionSettings
-from stylemotion.evaluation.sources import EvalModel, load_model
 from stylemotion.io.atomic import atomic_folder
 from stylemotion.io.jsonfile import plain, write_json
 from stylemotion.io.outputs import check_new_output, inside
 from stylemotion.models.checkpoints import autoencoder_info, load_autoencoder
+from stylemotion.models.loading import EvalModel, load_model
 from stylemotion.primitives import Clip, parse_primitive, segment_action
 from stylemotion.provenance import provenance
 from stylemotion.skeleton import CANONICAL_JOINTS

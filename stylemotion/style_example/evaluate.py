@@ -24,14 +24,16 @@ from typing import Any
 import torch
 
 from stylemotion.datasets import TakeSet
-from stylemotion.evaluation.markdown import DEFINITIONS, _md_table, fmt, pct
-from stylemotion.evaluation.metrics import FootSkating, foot_skating, pooled_skating
+from stylemotion.evaluation.markdown import DEFINITIONS, fmt, pct
 from stylemotion.evaluation.pipeline import example_column_gram, real_side
 from stylemotion.evaluation.settings import EvalSettings
-from stylemotion.evaluation.sources import NEUTRAL, EvalModel, check_one_autoencoder, motions_from_clips
+from stylemotion.evaluation.sources import check_one_autoencoder, motions_from_clips
 from stylemotion.evaluation.tables import VARIANCE_KEYS, VARIANCE_UNITS, distance_table, variance_stats
+from stylemotion.io.markdown import md_table
+from stylemotion.models.loading import NEUTRAL, EvalModel
 from stylemotion.primitives import Clip, Segmentation
 from stylemotion.sampling import MotionSamples
+from stylemotion.skating import FootSkating, foot_skating, pooled_skating
 
 #: Variation figures of the report, in table order.
 VARIATION_KEYS = (*VARIANCE_KEYS, "pose_across_sd")
@@ -119,14 +121,14 @@ def _models_section(results: dict[str, Any]) -> list[str]:
     network = results.get("network")
     if network is None:
         return ["Models (trained as the run's CVAE stage of the primitive, conditioned on the example's clips):", "",
-                _md_table(["primitive", "checkpoint", "example clips (frames of the file)"],
+                md_table(["primitive", "checkpoint", "example clips (frames of the file)"],
                           [[p, f"`{m['checkpoint']}`", _clips(m)] for p, m in results["models"].items()]), ""]
     origin = (f"trained here ({network['epochs']} epochs; give `network=<this folder>/network` "
               "to later `stylemotion-style method=zero_shot` calls to reuse it)" if network["trained_here"]
               else f"taken from `{network['given']}`, not trained again")
     return [f"Models: the zero-shot network of each primitive, {origin}, bound to the example's clips — no model was "
             "trained for this style:", "",
-            _md_table(["primitive", "network checkpoint", "trained on styles", "example clips (frames of the file)"],
+            md_table(["primitive", "network checkpoint", "trained on styles", "example clips (frames of the file)"],
                       [[p, f"`{m['checkpoint']}`", ", ".join(network["trained_styles"][p]), _clips(m)]
                        for p, m in results["models"].items()]), ""]
 
@@ -172,7 +174,7 @@ def markdown(results: dict[str, Any]) -> str:
             "(lower = closer to that style); the run's columns as in its report, and the new example.", ""]
     for p, row in results["table_5_1_row"].items():
         low = min(row.values())
-        out += [f"**{p}**", "", _md_table(["model \\ example", *row],
+        out += [f"**{p}**", "", md_table(["model \\ example", *row],
                                           [[name] + [f"**{fmt(v)}**" if v == low else fmt(v) for v in row.values()]]),
                 ""]
         nearest = results["nearest_existing_style"][p]
@@ -196,7 +198,7 @@ def markdown(results: dict[str, Any]) -> str:
             sk = skating.get(kind)
             body.append([kind] + [fmt(None if v is None else v[k]) for k in VARIATION_KEYS]
                         + [pct(sk["ratio"]) if sk else "–", pct(sk["no_plant_share"]) if sk else "–"])
-        out += [f"**{p}**", "", _md_table(["motions", *VARIATION_KEYS, "foot skating", "stance foot never planted"],
+        out += [f"**{p}**", "", md_table(["motions", *VARIATION_KEYS, "foot skating", "stance foot never planted"],
                                           body), ""]
     pooled = results["foot_skating_pooled"]
     out += [f"Foot skating pooled over primitives: samples {pct(pooled['samples'])}, example clips "

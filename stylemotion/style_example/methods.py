@@ -14,7 +14,7 @@ from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-from stylemotion.evaluation.sources import EvalModel
+from stylemotion.models.loading import EvalModel
 from stylemotion.primitives import Clip
 
 Say = Callable[[str], None]

@@ -33,11 +33,11 @@ from omegaconf import Container, DictConfig, OmegaConf, open_dict
 
 from stylemotion.config import ConfigError, positive_int
 from stylemotion.datamodules.features import describe_clip
-from stylemotion.evaluation.sources import EvalModel
 from stylemotion.evaluation_zero_shot import network_train_config
 from stylemotion.io.outputs import inside
 from stylemotion.models.autoencoder import IncompatibleModelError
-from stylemotion.models.checkpoints import checkpoint_hparams, fingerprint, load_autoencoder, load_generative
+from stylemotion.models.checkpoints import checkpoint_hparams, fingerprint, load_autoencoder
+from stylemotion.models.loading import EvalModel, load_generative
 from stylemotion.models.zero_shot import ZeroShotStyleVAE
 from stylemotion.primitives import Clip
 from stylemotion.style_example.base_run import SourceRun, train_config

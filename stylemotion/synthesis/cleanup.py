@@ -18,9 +18,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from stylemotion.contacts import FOOT_POINTS, contact_intervals, foot_contacts, horizontal_speed
+from stylemotion.contacts import contact_intervals, foot_contacts, horizontal_speed
 from stylemotion.geometry import two_bone_ik
-from stylemotion.skeleton import JOINT_INDEX, NUM_JOINTS
+from stylemotion.skeleton import FOOT_POINTS, JOINT_INDEX, NUM_JOINTS
 
 #: Closest a solved leg comes to fully straight or fully folded: the hip–ankle distance stays this
 #: far inside ``[|thigh − shin|, thigh + shin]``, metres.

@@ -42,12 +42,12 @@ from omegaconf import DictConfig, OmegaConf
 
 from stylemotion.config import ConfigError
 from stylemotion.datasets.loading import ConversionSettings, load_canonical_positions
-from stylemotion.evaluation.sources import NEUTRAL
 from stylemotion.export import write_motion_bvh
 from stylemotion.io.atomic import atomic_folder
 from stylemotion.io.jsonfile import write_json
 from stylemotion.io.outputs import check_new_output
 from stylemotion.io.sources import FileSource
+from stylemotion.models.loading import NEUTRAL
 from stylemotion.provenance import provenance
 from stylemotion.skeleton import CANONICAL_JOINTS
 from stylemotion.synthesis.cleanup import clean_foot_skating
@@ -144,7 +144,7 @@ def generate(cfg: DictConfig | Mapping[str, Any], command: str = "") -> dict[str
     kind = str((cfg.get("model") or {}).get("family", "?"))  # model=morphable; none: the VAEs
     kind = "vae" if not cfg.get("model") else kind
     if kind == "morphable":
-        from stylemotion.morphable.synthesis import MapSettings, load_morphable_graph
+        from stylemotion.synthesis.morphable_graph import MapSettings, load_morphable_graph
 
         try:
             map_settings = MapSettings(**(cfg.get("morphable") or {}))

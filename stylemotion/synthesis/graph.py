@@ -33,10 +33,10 @@ from typing import Any
 import numpy as np
 import torch
 
-from stylemotion.evaluation.sources import NEUTRAL, load_model
 from stylemotion.io.errors import UserInputError
 from stylemotion.models.autoencoder import IncompatibleModelError
-from stylemotion.models.checkpoints import load_autoencoder, load_generative
+from stylemotion.models.checkpoints import load_autoencoder
+from stylemotion.models.loading import NEUTRAL, load_generative, load_model
 from stylemotion.models.vae import PrimitiveVAE
 from stylemotion.models.zero_shot import BoundExample, ZeroShotStyleVAE
 from stylemotion.primitives import PRIMITIVES, check_primitive
@@ -311,11 +311,11 @@ def load_graph(style: str, run: str | Path | None = None, models: Mapping[str, s
     """
     wanted = NEUTRAL if style in (NEUTRAL, neutral_style) else style
     if models:
-        chosen: dict[str, dict[str, Any]] = {_short(k, action): {"path": str(v)} for k, v in models.items()}
+        chosen: dict[str, dict[str, Any]] = {short_primitive(k, action): {"path": str(v)} for k, v in models.items()}
     elif run is not None:
         meta = report_meta(run)
         entries = [e for e in available_models(run, meta) if e["primitive"].startswith(f"{action}_")]
-        chosen = {_short(e["primitive"], action): e for e in entries if e["name"] == wanted}
+        chosen = {short_primitive(e["primitive"], action): e for e in entries if e["name"] == wanted}
         if not chosen:
             have = sorted({e["name"] for e in entries})
             raise UnknownStyleError(f"style {style!r} has no {action} model in {run}; styles there: {have} "
@@ -338,6 +338,6 @@ def load_graph(style: str, run: str | Path | None = None, models: Mapping[str, s
     return MotionGraph(action=action, style=wanted, models=loaded, sources=paths)
 
 
-def _short(primitive: str, action: str) -> str:
+def short_primitive(primitive: str, action: str) -> str:
     """``walk_leftStance`` (or ``leftStance``) → ``leftStance``, checked."""
     return check_primitive(primitive.split("_", 1)[1] if primitive.startswith(f"{action}_") else primitive)

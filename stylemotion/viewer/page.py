@@ -24,11 +24,10 @@ from typing import Any
 
 import numpy as np
 
-from stylemotion.contacts import FOOT_POINTS
 from stylemotion.io.atomic import atomic_folder
 from stylemotion.io.errors import UserInputError
 from stylemotion.io.outputs import check_new_output
-from stylemotion.skeleton import CANONICAL_JOINTS, CANONICAL_PARENTS
+from stylemotion.skeleton import CANONICAL_JOINTS, CANONICAL_PARENTS, FOOT_POINTS
 from stylemotion.viewer.motions import ViewerMotion
 
 #: Colours of the groups (styles), in order of first appearance (matplotlib's tab10).

@@ -240,7 +240,7 @@ class SampleAnimation(pl.Callback):
                      if getattr(cb, "monitor", None) and getattr(cb, "best_model_path", "")), "")
         model = pl_module
         if best:
-            from stylemotion.models.checkpoints import load_generative  # viz does not need the models otherwise
+            from stylemotion.models.loading import load_generative  # viz does not need the models otherwise
 
             model = load_generative(best, autoencoder=pl_module.autoencoder.cpu())
         model.eval()

@@ -17,17 +17,11 @@ from stylemotion.evaluation.pipeline import evaluate_models
 from stylemotion.evaluation.reference import primitive_data
 from stylemotion.evaluation.report import write_report
 from stylemotion.evaluation.settings import ClassifierSettings, EvalSettings, SampleCounts
-from stylemotion.evaluation.sources import (
-    NEUTRAL,
-    EvalModel,
-    MissingExampleError,
-    MixedAutoencodersError,
-    RealClipSource,
-    SampleSource,
-)
+from stylemotion.evaluation.sources import MissingExampleError, MixedAutoencodersError, RealClipSource
 from stylemotion.evaluation.tables import variance_stats
 from stylemotion.io.outputs import OutputExistsError
 from stylemotion.models.checkpoints import autoencoder_info, load_autoencoder
+from stylemotion.models.loading import NEUTRAL, EvalModel, SampleSource
 
 torch.set_num_threads(1)
 SETTINGS = EvalSettings(samples=SampleCounts(table_5_1=120, variance=200, metrics=120),

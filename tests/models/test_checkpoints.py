@@ -18,7 +18,6 @@ from vae_fixtures import TINY_DATA, feature_module, fit, tiny_autoencoder_ckpt
 
 import stylemotion
 from stylemotion.evaluation.run import run_evaluation
-from stylemotion.evaluation.sources import load_model
 from stylemotion.models import checkpoints
 from stylemotion.models.autoencoder import IncompatibleModelError
 from stylemotion.models.checkpoints import (
@@ -28,9 +27,9 @@ from stylemotion.models.checkpoints import (
     fingerprint,
     is_model_checkpoint,
     load_autoencoder,
-    load_generative,
     read_checkpoint,
 )
+from stylemotion.models.loading import load_generative, load_model
 from stylemotion.models.vae import PrimitiveVAE
 from stylemotion.synthesis import load_graph
 

@@ -14,7 +14,6 @@ from vae_fixtures import TINY_DATA, feature_module, fit, tiny_autoencoder_ckpt, 
 from stylemotion.datamodules.multistyle import MultiStyleDataModule
 from stylemotion.evaluation.pipeline import evaluate_models
 from stylemotion.evaluation.settings import ClassifierSettings, EvalSettings, SampleCounts
-from stylemotion.evaluation.sources import EvalModel, SampleSource, load_model
 from stylemotion.evaluation.tables import style_distances
 from stylemotion.models.autoencoder import IncompatibleModelError
 from stylemotion.models.checkpoints import (
@@ -23,8 +22,8 @@ from stylemotion.models.checkpoints import (
     fingerprint,
     is_model_checkpoint,
     load_autoencoder,
-    load_generative,
 )
+from stylemotion.models.loading import EvalModel, SampleSource, load_generative, load_model
 from stylemotion.models.style import gram
 from stylemotion.models.zero_shot import ZeroShotStyleVAE
 

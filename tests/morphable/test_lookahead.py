@@ -13,9 +13,10 @@ from stylemotion.config import ConfigError
 from stylemotion.geometry import rotate_yaw_xz
 from stylemotion.morphable import FitSettings, fit_primitive
 from stylemotion.morphable.lookahead import MeanStep, choose, mean_step, step_states
-from stylemotion.morphable.synthesis import MapSettings, MorphablePrimitive, load_morphable_graph
+from stylemotion.morphable.synthesis import MapSettings, MorphablePrimitive
 from stylemotion.morphable.variants import clip_turn_deg, select_turn, variant_name
 from stylemotion.synthesis import follow_path
+from stylemotion.synthesis.morphable_graph import load_morphable_graph
 from stylemotion.synthesis.path import GroundPath
 
 STRAIGHT = MeanStep("straight", np.array([0.0, 0.6]), 0.0)

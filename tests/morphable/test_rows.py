@@ -16,8 +16,9 @@ from stylemotion.evaluation.markdown import format_markdown
 from stylemotion.evaluation.pipeline import evaluate_models
 from stylemotion.evaluation.reference import primitive_data
 from stylemotion.evaluation.settings import ClassifierSettings, EvalSettings, SampleCounts
-from stylemotion.evaluation.sources import NEUTRAL, EvalModel, RealClipSource
+from stylemotion.evaluation.sources import RealClipSource
 from stylemotion.models.checkpoints import autoencoder_info, load_autoencoder
+from stylemotion.models.loading import NEUTRAL, EvalModel
 from stylemotion.morphable.rows import ROW, neutral_models
 from stylemotion.reproduction import StageConflictError
 from stylemotion.sampling import MotionSamples

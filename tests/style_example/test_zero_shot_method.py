@@ -16,7 +16,7 @@ import yaml
 from style_fixtures import NETWORK_EPOCHS, SAMPLES, example_bvh, tiny_run, tiny_zero_shot_style
 
 from stylemotion.config import ConfigError
-from stylemotion.models.checkpoints import load_generative
+from stylemotion.models.loading import load_generative
 from stylemotion.models.zero_shot import BoundExample, ZeroShotStyleVAE
 from stylemotion.style_example import StyleExampleError, add_style
 from stylemotion.style_example.evaluate import variation

@@ -1,0 +1,147 @@
+"""The one loading path of a trained model: a checkpoint → the model its hyperparameters name.
+
+:func:`load_generative` rebuilds a :class:`~stylemotion.models.vae.PrimitiveVAE`,
+:class:`~stylemotion.models.cvae.StyleCVAE` or :class:`~stylemotion.models.zero_shot.ZeroShotStyleVAE`
+from its checkpoint (read, and its autoencoder resolved, by :mod:`stylemotion.models.checkpoints`, the
+checkpoint records, which import no model class). :func:`load_model` wraps a PrimitiveVAE or StyleCVAE in
+an :class:`EvalModel`: the primitive it models, the style it targets (:data:`NEUTRAL` for the plain VAE)
+and the style examples it was conditioned on, as evaluation, synthesis and new styles use it.
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Protocol, runtime_checkable
+
+import lightning.pytorch as pl
+import torch
+
+from stylemotion.models.autoencoder import IncompatibleModelError, MotionAutoencoder
+from stylemotion.models.checkpoints import GENERATIVE_KINDS, KINDS, checkpoint_kind, read_checkpoint, restore
+from stylemotion.models.cvae import StyleCVAE
+from stylemotion.models.vae import PrimitiveVAE
+from stylemotion.models.zero_shot import ZeroShotStyleVAE
+from stylemotion.sampling import MotionSamples
+
+
+def model_class(kind: str) -> type[pl.LightningModule]:
+    """The LightningModule class of a checkpoint kind (see :data:`KINDS`)."""
+    classes = {"autoencoder": MotionAutoencoder, "vae": PrimitiveVAE, "cvae": StyleCVAE,
+               "zero_shot": ZeroShotStyleVAE}
+    if kind not in classes:
+        raise ValueError(f"unknown checkpoint kind {kind!r}; kinds: {list(KINDS)}")
+    return classes[kind]
+
+
+def load_generative(path: str | os.PathLike, autoencoder: MotionAutoencoder | None = None) -> pl.LightningModule:
+    """A trained :class:`~stylemotion.models.vae.PrimitiveVAE`, :class:`~stylemotion.models.cvae.StyleCVAE`
+    or :class:`~stylemotion.models.zero_shot.ZeroShotStyleVAE` (class from its hyperparameters), eval mode, CPU.
+
+    Args:
+        path: its checkpoint (``~`` expanded).
+        autoencoder: an already loaded autoencoder to attach (must be the model's own: same
+            weights); None resolves it on first use (see :func:`~stylemotion.models.checkpoints.resolve_autoencoder`).
+
+    Raises:
+        FileNotFoundError, IncompatibleModelError: no file, or not a trained primitive model.
+    """
+    path = Path(path).expanduser()
+    checkpoint = read_checkpoint(path, "model checkpoint")
+    hparams = checkpoint.get("hyper_parameters") or {}
+    kind = checkpoint_kind(hparams)
+    if kind not in GENERATIVE_KINDS:
+        raise IncompatibleModelError(f"{path} is not a trained PrimitiveVAE/StyleCVAE/ZeroShotStyleVAE checkpoint "
+                                     f"(no data spec in its hyperparameters; it has {sorted(hparams)[:12]})")
+    model = restore(model_class(kind), checkpoint, str(path))
+    model.checkpoint_file = str(path.resolve())
+    if autoencoder is not None:
+        model.attach_autoencoder(autoencoder)
+    return model
+
+
+#: Row name of the neutral model (the thesis' "neutral"), trained on the neutral style's clips.
+NEUTRAL = "neutral"
+
+
+@runtime_checkable
+class SampleSource(Protocol):
+    """Anything that draws motions of one primitive."""
+
+    def sample(self, n: int, seed: int | None = None) -> MotionSamples:  # pragma: no cover - protocol
+        """``n`` motions (see :class:`stylemotion.sampling.MotionSamples`), reproducible for a seed."""
+        ...
+
+
+@dataclass
+class EvalModel:
+    """A generative model under evaluation.
+
+    Attributes:
+        name: its row in the tables: ``neutral`` for the plain VAE, else its style.
+        primitive: ``<action>_<primitive>``, e.g. ``walk_leftStance``.
+        style: the data's style label it should produce (the neutral style for ``neutral``).
+        source: draws its samples.
+        examples: the style example clips it was conditioned on (records with ``take``, ``start``,
+            ``stop``, ``encoded_frames``, … as saved by :mod:`stylemotion.datamodules.features`); empty for
+            the neutral model.
+        autoencoder: the autoencoder it was trained on (``path``, ``fingerprint``, …), or None.
+        checkpoint: its checkpoint path, or None.
+        timeline_frames: the primitive's canonical length, frames.
+        target_gram: ``(C, C)`` the model's own record of ``Gram(Φ(example))``, or None.
+        dataset: name of the dataset it was trained on, or None.
+        example_length: how its examples were encoded: ``canonical`` (resampled to the timeline,
+            the default) or ``natural`` (as recorded).
+    """
+
+    name: str
+    primitive: str
+    style: str
+    source: SampleSource
+    examples: list[dict[str, Any]] = field(default_factory=list)
+    autoencoder: dict[str, Any] | None = None
+    checkpoint: str | None = None
+    timeline_frames: int | None = None
+    target_gram: torch.Tensor | None = None
+    dataset: str | None = None
+    example_length: str | None = "canonical"
+
+    @property
+    def label(self) -> str:
+        return f"{self.primitive}/{self.name}"
+
+
+def load_model(path: str | Path, neutral_style: str = "normal", autoencoder=None) -> EvalModel:
+    """An :class:`EvalModel` from a PrimitiveVAE or StyleCVAE checkpoint (loaded on the CPU, eval mode).
+
+    Args:
+        path: the checkpoint.
+        neutral_style: data style of the neutral model when its spec names several content styles.
+        autoencoder: an already loaded autoencoder to attach (must be the model's own: same weights);
+            None takes the one embedded in the checkpoint (or recorded) on first use.
+
+    Raises:
+        FileNotFoundError, IncompatibleModelError: no file, or not a trained primitive model
+        (:func:`load_generative` reads it).
+    """
+    model = load_generative(path, autoencoder)
+    if isinstance(model, ZeroShotStyleVAE):
+        raise IncompatibleModelError(f"{path} is a zero-shot style network: it samples only given a style example "
+                                     "(bind one with model.bind_example(...), or evaluate it with "
+                                     "scripts/zero_shot_loso.py)")
+    spec = model.spec
+    styled = isinstance(model, StyleCVAE)
+    if styled:
+        name = style = str(spec["style"])
+    else:
+        contents = list(spec.get("content_styles") or [neutral_style])
+        name, style = NEUTRAL, contents[0] if len(contents) == 1 else neutral_style
+    return EvalModel(name=name, primitive=str(spec["primitive"]), style=style, source=model,
+                     examples=[dict(e) for e in spec.get("style_examples") or []] if styled else [],
+                     autoencoder=dict(spec["autoencoder"]), checkpoint=str(path),
+                     timeline_frames=int(spec["timeline_frames"]),
+                     # a centred style term keeps a covariance, not the thesis' Gram that Table 5.1 recomputes
+                     target_gram=(model.style_gram.detach().clone()
+                                  if styled and not model.hparams.get("style_centred", False) else None),
+                     dataset=spec.get("dataset"), example_length=spec.get("example_length") or "canonical")
