@@ -54,6 +54,7 @@ from omegaconf import OmegaConf
 from stylemotion.config import CONFIG_DIR
 from stylemotion.datamodules.clips import ClipDataModule
 from stylemotion.evaluation.tables import variance_stats
+from stylemotion.models.sampling import pad_motions
 from stylemotion.morphable import FitSettings, MorphableModel, fit_primitive
 from stylemotion.morphable.bspline import SplineBasis
 from stylemotion.morphable.constraints import KeyframeConstraint, objective
@@ -67,8 +68,7 @@ from stylemotion.morphable.model import (
 )
 from stylemotion.morphable.tree import SpaceTree, brute_force
 from stylemotion.morphable.variants import variant_name
-from stylemotion.primitives import parse_primitive, time_normalize
-from stylemotion.sampling import pad_motions
+from stylemotion.primitives.segmentation import parse_primitive, time_normalize
 from stylemotion.skeleton import CANONICAL_JOINTS
 from stylemotion.synthesis.controller import SharpTurnWarning
 from stylemotion.synthesis.generate import generate
@@ -341,9 +341,9 @@ def part_vae(b: Bench, run_folder: Path, k: int | None, iterations: int) -> None
     import torch
 
     from stylemotion.datamodules.features import encode_frames
-    from stylemotion.finished_run import FinishedRun, read_json_object
     from stylemotion.models.loading import load_generative
-    from stylemotion.sampling import decode_features
+    from stylemotion.models.sampling import decode_features
+    from stylemotion.training.run_folder import FinishedRun, read_json_object
 
     primitive = "walk_leftStance"
     run = FinishedRun(run_folder, read_json_object(run_folder / "reproduce.json", "reproduce.json"), {})
@@ -453,8 +453,8 @@ def part_arm(b: Bench, content: str, iterations: int, k: int | None = None, targ
 def part_rows(b: Bench, run_folder: Path) -> None:
     """Tables 5.1–5.3 of a finished run's models with the Morphable Graph's stance models as extra rows."""
     from stylemotion.evaluation.run import run_evaluation
-    from stylemotion.finished_run import FinishedRun, read_json_object
     from stylemotion.morphable.rows import ROW
+    from stylemotion.training.run_folder import FinishedRun, read_json_object
 
     run = FinishedRun(run_folder, read_json_object(run_folder / "reproduce.json", "reproduce.json"),
                       read_json_object(run_folder / "report" / "report.json", "report"))

@@ -35,7 +35,7 @@ from omegaconf import OmegaConf
 
 from stylemotion.config import config_dir
 from stylemotion.models.autoencoder import local_mpjpe, mpjpe
-from stylemotion.training import build
+from stylemotion.training.fit import build
 
 
 def cpu_name() -> str:

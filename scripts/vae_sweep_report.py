@@ -34,9 +34,9 @@ from stylemotion.datamodules.features import FeatureDataModule
 from stylemotion.datasets import build_dataset
 from stylemotion.models.cvae import StyleCVAE
 from stylemotion.models.loading import load_generative
+from stylemotion.models.sampling import decode_features, masked_mpjpe
 from stylemotion.models.style import feature_style_distance, gram
 from stylemotion.models.vae import PrimitiveVAE
-from stylemotion.sampling import decode_features, masked_mpjpe
 
 
 def runs_of(sweep: Path | None) -> list[Path]:

@@ -6,7 +6,7 @@
     python scripts/zero_shot_loso.py --run runs/reproduce/synthetic --out /tmp/zs2 --checkpoints /tmp/zs  # no training
 
 Writes ``<out>/zero_shot.json``, ``<out>/zero_shot.md`` and the networks' training folders
-``<out>/models/<primitive>_without_<style>/`` (see :mod:`stylemotion.evaluation_zero_shot`).
+``<out>/models/<primitive>_without_<style>/`` (see :mod:`stylemotion.evaluation.zero_shot`).
 """
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ import argparse
 import logging
 import sys
 
-from stylemotion.evaluation_zero_shot import leave_one_style_out
+from stylemotion.evaluation.zero_shot import leave_one_style_out
 from stylemotion.io.outputs import OutputExistsError
 
 

@@ -5,7 +5,7 @@ per pytest process.
 The run is ``stylemotion-reproduce`` on tiny synthetic data (straight walks of normal, elderly and youthful;
 CVAEs of elderly only, both stance primitives so that a walk can be generated), every stage a few seconds,
 the stages one after the other in this process (``workers=1``). The example is a synthetic *exhausted* walk
-(a style the run's data does not have) written as BVH with :func:`stylemotion.export.write_motion_bvh`.
+(a style the run's data does not have) written as BVH with :func:`stylemotion.io.export.write_motion_bvh`.
 """
 
 from __future__ import annotations
@@ -18,8 +18,8 @@ from hydra import compose, initialize_config_dir
 from stylemotion.cli.schemas import register_schemas
 from stylemotion.config import CONFIG_DIR
 from stylemotion.datasets.synthetic import generate_take
-from stylemotion.export import write_motion_bvh
-from stylemotion.reproduction import reproduce
+from stylemotion.io.export import write_motion_bvh
+from stylemotion.training.reproduction import reproduce
 
 register_schemas()  # the configs composed here take structured schemas (stylemotion.cli.schemas)
 

@@ -9,7 +9,7 @@ import pytest
 import yaml
 from conftest import BANDAI_MEMBERS, OTHER_SKELETONS
 
-from stylemotion.canonical import (
+from stylemotion.datasets.canonical import (
     UNIT_SCALES,
     JointMap,
     builtin_joint_maps,

@@ -15,7 +15,7 @@ from stylemotion.cli.schemas import register_schemas, register_schemas_for
 from stylemotion.config import CONFIG_DIR, ConfigError, build_settings
 from stylemotion.evaluation.run import settings_from_config
 from stylemotion.evaluation.settings import EvalSettings, SampleCounts
-from stylemotion.primitives import SegmentSettings
+from stylemotion.primitives.segmentation import SegmentSettings
 from stylemotion.synthesis.controller import FollowSettings
 
 register_schemas()  # the configs composed here take structured schemas (stylemotion.cli.schemas)

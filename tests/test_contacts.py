@@ -5,7 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from stylemotion.contacts import (
+from stylemotion.datasets.synthetic import CONTENTS, STYLES, generate_take
+from stylemotion.primitives.contacts import (
     ContactSettings,
     _fill_low_gaps,
     contact_intervals,
@@ -14,7 +15,6 @@ from stylemotion.contacts import (
     leg_length,
     planted_point_speed,
 )
-from stylemotion.datasets.synthetic import CONTENTS, STYLES, generate_take
 
 
 def _interval_errors(truth: np.ndarray, detected: np.ndarray) -> list[tuple[int, int]]:

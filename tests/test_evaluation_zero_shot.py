@@ -14,7 +14,7 @@ from omegaconf import OmegaConf
 
 from stylemotion.cli.schemas import register_schemas
 from stylemotion.config import CONFIG_DIR
-from stylemotion.evaluation_zero_shot import (
+from stylemotion.evaluation.zero_shot import (
     ZeroShotRunError,
     leave_one_style_out,
     load_left_out,
@@ -25,7 +25,7 @@ from stylemotion.evaluation_zero_shot import (
 from stylemotion.io.outputs import OutputExistsError
 from stylemotion.models.checkpoints import fingerprint, load_autoencoder
 from stylemotion.models.loading import load_generative
-from stylemotion.reproduction import reproduce
+from stylemotion.training.reproduction import reproduce
 
 register_schemas()  # the configs composed here take structured schemas (stylemotion.cli.schemas)
 

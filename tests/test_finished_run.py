@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 from stylemotion.config import ConfigError
-from stylemotion.finished_run import FinishedRun, read_json_object
+from stylemotion.training.run_folder import FinishedRun, read_json_object
 
 
 class RunError(ValueError):

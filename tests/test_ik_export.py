@@ -1,4 +1,4 @@
-"""Rotations fitted to joint positions (stylemotion.ik) and BVH export (stylemotion.export)."""
+"""Rotations fitted to joint positions (stylemotion.ik) and BVH export (stylemotion.io.export)."""
 
 from __future__ import annotations
 
@@ -9,11 +9,11 @@ import pytest
 from conftest import BANDAI_MEMBERS
 from scipy.spatial.transform import Rotation
 
-from stylemotion.canonical import detect_unit_scale, resolve_joint_map
+from stylemotion.datasets.canonical import detect_unit_scale, resolve_joint_map
 from stylemotion.datasets.loading import ConversionSettings, load_canonical_positions
-from stylemotion.export import positions_to_motion, write_motion_bvh
 from stylemotion.ik import fit_rotations, rest_offsets
 from stylemotion.io.bvh import read_bvh
+from stylemotion.io.export import positions_to_motion, write_motion_bvh
 from stylemotion.io.sources import FileSource
 from stylemotion.skeleton import CANONICAL_JOINTS, CANONICAL_PARENTS, JOINT_INDEX, bone_lengths, forward_kinematics
 

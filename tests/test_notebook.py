@@ -11,7 +11,7 @@ from hydra import compose, initialize_config_dir
 from nbclient import NotebookClient
 
 from stylemotion.config import config_dir
-from stylemotion.training import run
+from stylemotion.training.fit import run
 
 NOTEBOOK = Path(__file__).resolve().parents[1] / "notebooks" / "01_autoencoder.ipynb"
 

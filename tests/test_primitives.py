@@ -11,7 +11,7 @@ import pytest
 from stylemotion.datasets import Take, TakeSet, load_dataset
 from stylemotion.datasets.synthetic import STYLES, SyntheticTake, generate_take
 from stylemotion.geometry import rotate_yaw
-from stylemotion.primitives import (
+from stylemotion.primitives.segmentation import (
     PRIMITIVES,
     STANCE_FOOT,
     Segmentation,

@@ -9,7 +9,7 @@ import pytest
 import torch
 from conftest import BANDAI_MEMBERS
 
-from stylemotion.canonical import to_canonical_positions
+from stylemotion.datasets.canonical import to_canonical_positions
 from stylemotion.geometry import rotation_y
 from stylemotion.io.bvh import parse_bvh, read_bvh
 from stylemotion.representation import (

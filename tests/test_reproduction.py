@@ -23,8 +23,8 @@ from stylemotion.evaluation.run import run_evaluation
 from stylemotion.evaluation.sources import MissingExampleError, MixedAutoencodersError
 from stylemotion.io.outputs import OutputExistsError
 from stylemotion.models.vae import PrimitiveVAE
-from stylemotion.reproduction import Reproduction, StageConflictError, choose_budget
-from stylemotion.reproduction import reproduce as run_reproduction
+from stylemotion.training.reproduction import Reproduction, StageConflictError, choose_budget
+from stylemotion.training.reproduction import reproduce as run_reproduction
 
 register_schemas()  # the configs composed here take structured schemas (stylemotion.cli.schemas)
 
@@ -302,7 +302,7 @@ def write_user_mocap(folder: Path) -> None:
     """The tiny synthetic takes as ``<style>_<take>.bvh`` files."""
     from vae_fixtures import tiny_takeset
 
-    from stylemotion.export import write_motion_bvh
+    from stylemotion.io.export import write_motion_bvh
 
     folder.mkdir(parents=True)
     for take in tiny_takeset().takes:
@@ -373,7 +373,7 @@ def test_an_unknown_executor_is_refused_before_any_work(tmp_path: Path) -> None:
 def test_slurm_executor_submits_the_configured_job(tmp_path: Path, monkeypatch) -> None:
     """executor=slurm: the sbatch script submitit writes carries the config's partition and resources
     (``sbatch``/``srun`` are stand-ins here: no cluster)."""
-    from stylemotion.reproduction import submitit_executor
+    from stylemotion.training.reproduction import submitit_executor
 
     bin_dir = tmp_path / "bin"
     bin_dir.mkdir()

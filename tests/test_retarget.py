@@ -1,4 +1,4 @@
-"""Retargeting canonical positions to other bone lengths (stylemotion.retarget)."""
+"""Retargeting canonical positions to other bone lengths (stylemotion.bones)."""
 
 from __future__ import annotations
 
@@ -6,10 +6,7 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from stylemotion.contacts import leg_length as contacts_leg_length
-from stylemotion.contacts import planted_point_speed
-from stylemotion.datasets.synthetic import generate_take
-from stylemotion.retarget import (
+from stylemotion.bones import (
     BONE_JOINTS,
     BONE_NAMES,
     NUM_BONES,
@@ -18,6 +15,9 @@ from stylemotion.retarget import (
     retarget_positions,
     target_bone_lengths,
 )
+from stylemotion.datasets.synthetic import generate_take
+from stylemotion.primitives.contacts import leg_length as contacts_leg_length
+from stylemotion.primitives.contacts import planted_point_speed
 from stylemotion.skeleton import (
     CANONICAL_PARENTS,
     FOOT_POINTS,

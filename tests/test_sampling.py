@@ -14,10 +14,10 @@ import torch
 from PIL import Image
 from vae_fixtures import feature_module, fit, tiny_autoencoder_ckpt
 
+from stylemotion.models.sampling import decode_features, masked_mpjpe
 from stylemotion.models.vae import PrimitiveVAE
-from stylemotion.primitives import restore_duration
+from stylemotion.primitives.segmentation import restore_duration
 from stylemotion.representation import frames_to_positions
-from stylemotion.sampling import decode_features, masked_mpjpe
 from stylemotion.viz.animation import render_samples
 
 torch.set_num_threads(1)

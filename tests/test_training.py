@@ -1,4 +1,4 @@
-""":mod:`stylemotion.training`: a finished run is never overwritten, ``force`` and ``ckpt_path=auto``,
+""":mod:`stylemotion.training.fit`: a finished run is never overwritten, ``force`` and ``ckpt_path=auto``,
 unique run ids, bad values refused before any work, checkpointing that leaves the numbers alone, and
 what a run records about itself (run.json, metrics.json, TensorBoard hyperparameters and learning rate).
 
@@ -21,7 +21,7 @@ from tensorboard.backend.event_processing.event_accumulator import EventAccumula
 import stylemotion
 from stylemotion.config import ConfigError, config_dir, unique_id
 from stylemotion.io.outputs import OutputExistsError
-from stylemotion.training import prepare_output, resolve_ckpt_path, run
+from stylemotion.training.fit import prepare_output, resolve_ckpt_path, run
 
 TINY = ["experiment=smoke", "data=synthetic", "data.takes_per_pair=3", "data.duration_s=4.0",
         "data.styles=[normal,elderly]", "data.contents=[walk,run]"]

@@ -15,7 +15,7 @@ import pytest
 from conftest import running_in_ci
 
 from stylemotion.datasets.synthetic import generate_take
-from stylemotion.sampling import MotionSamples
+from stylemotion.models.sampling import MotionSamples
 from stylemotion.viewer.browser import CHROMIUM_ARGS, chromium_path
 
 

@@ -4,7 +4,7 @@
     stylemotion-reproduce data=bandai 'data.contents=[walk,walk-turn-left,walk-turn-right]'
     stylemotion-reproduce data=bandai ... out=runs/reproduce/bandai_2   # a second, independent run
 
-The work is :func:`stylemotion.reproduction.reproduce`; its module doc describes the stages.
+The work is :func:`stylemotion.training.reproduction.reproduce`; its module doc describes the stages.
 """
 
 from __future__ import annotations
@@ -19,7 +19,7 @@ log = logging.getLogger(__name__)
 
 
 def reproduce(cfg: DictConfig, command: str) -> None:
-    from stylemotion.reproduction import reproduce
+    from stylemotion.training.reproduction import reproduce
 
     reproduce(cfg, say=log.info)  # the console and <out>/hydra/<time>/reproduce.log
 

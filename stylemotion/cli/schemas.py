@@ -1,7 +1,7 @@
 """The settings dataclasses the packaged YAML takes as Hydra structured configs (group ``schema``).
 
 Settings defaults live once, in the dataclasses that use them: ``segment`` =
-:class:`~stylemotion.primitives.SegmentSettings`, ``evaluation`` =
+:class:`~stylemotion.primitives.segmentation.SegmentSettings`, ``evaluation`` =
 :class:`~stylemotion.evaluation.settings.EvalSettings`, ``follow`` =
 :class:`~stylemotion.synthesis.controller.FollowSettings`. The YAML files take them in their defaults
 lists (``- schema@segment: segment``) instead of repeating their values; keys and types are checked by
@@ -20,7 +20,7 @@ from collections.abc import Callable
 
 
 def _segment() -> type:
-    from stylemotion.primitives import SegmentSettings
+    from stylemotion.primitives.segmentation import SegmentSettings
 
     return SegmentSettings
 

@@ -4,7 +4,7 @@
     stylemotion-segment data=bandai 'data.contents=[walk,walk-turn-left,walk-turn-right,run]' \\
         out=reports/segmentation/bandai
 
-The work and the folder's contents: :mod:`stylemotion.segmentation_report`.
+The work and the folder's contents: :mod:`stylemotion.primitives.report`.
 """
 
 from __future__ import annotations
@@ -20,7 +20,7 @@ log = logging.getLogger(__name__)
 
 
 def segment(cfg: DictConfig, command: str) -> None:
-    from stylemotion.segmentation_report import summary_lines, write_report
+    from stylemotion.primitives.report import summary_lines, write_report
 
     report = write_report(cfg, Path(cfg.out), bool(cfg.force), command)
     for line in summary_lines(report, Path(cfg.out)):

@@ -24,7 +24,7 @@ def train(cfg: DictConfig, command: str) -> float | None:
     if cfg.get("runner"):  # a model family fitted without Lightning (e.g. experiment=morphable_graph)
         runner = importlib.import_module(str(cfg.runner))
         return runner.objective(runner.run(cfg)["metrics"])
-    from stylemotion.training import objective, run
+    from stylemotion.training.fit import objective, run
 
     result = run(cfg)
     return objective(result["metrics"], cfg)

@@ -1,6 +1,6 @@
 """Motion primitive clips as a Lightning DataModule, and one style example clip per style.
 
-The takes of a dataset are segmented (:func:`stylemotion.primitives.segment_takes`) and the clips
+The takes of a dataset are segmented (:func:`stylemotion.primitives.segmentation.segment_takes`) and the clips
 of one action, some primitives and some styles are served time-normalized to one canonical length
 (thesis §4.4.1, §5.3). The split is the dataset's seeded split by take
 (:meth:`stylemotion.datasets.TakeSet.split` with the data config's ``split`` settings), so a clip
@@ -12,7 +12,7 @@ Items are dicts:
 * ``frames``: ``(length, 66)`` float32 raw frames, time-normalized (velocity channels per second);
 * ``duration_s``: the clip's real duration, seconds (to play it back at ``(length-1)/duration_s`` fps);
 * ``style``: index into :attr:`ClipDataModule.style_names`;
-* ``primitive``: index into :data:`stylemotion.primitives.PRIMITIVES`.
+* ``primitive``: index into :data:`stylemotion.primitives.segmentation.PRIMITIVES`.
 
 Style examples (the thesis conditions each style model on a single clip): for each style one clip
 of ``example.primitive`` (default: the first selected primitive), cut from takes of
@@ -42,7 +42,7 @@ from torch.utils.data import Dataset
 from stylemotion.datamodules.base import SplitDataModule
 from stylemotion.datasets import TakeSet
 from stylemotion.io.errors import UserInputError
-from stylemotion.primitives import (
+from stylemotion.primitives.segmentation import (
     PRIMITIVES,
     Clip,
     Segmentation,
@@ -101,15 +101,15 @@ class ClipDataModule(SplitDataModule):
         data: a ``data`` config node as a plain mapping (``name``, loader options, ``split``);
             see ``configs/data/``. Ignored when ``takeset`` is given.
         takeset: an already built :class:`TakeSet` (Python use; not saved in checkpoints).
-        action: ``walk`` or ``run`` (see :data:`stylemotion.primitives.ACTIONS`).
-        primitives: primitives to serve (names from :data:`~stylemotion.primitives.PRIMITIVES`).
+        action: ``walk`` or ``run`` (see :data:`stylemotion.primitives.segmentation.ACTIONS`).
+        primitives: primitives to serve (names from :data:`~stylemotion.primitives.segmentation.PRIMITIVES`).
         styles: styles to serve; None = every style of the dataset.
         timeline: ``"median"`` (the median length of the selected train clips, all selected
             primitives together) or a fixed number of frames.
         example: how style examples are picked (see the module docstring); missing keys take
             the defaults ``pick=median, content=<action>, split=all``.
         example_styles: styles that need an example; None = every style of the dataset.
-        segment: :class:`~stylemotion.primitives.SegmentSettings` values (``contacts`` as a dict).
+        segment: :class:`~stylemotion.primitives.segmentation.SegmentSettings` values (``contacts`` as a dict).
         batch_size: training batch size (clips).
         eval_batch_size: validation/test batch size; None = ``batch_size``.
         num_workers: DataLoader worker processes.

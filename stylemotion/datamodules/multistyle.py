@@ -51,7 +51,7 @@ from stylemotion.datamodules.features import (
 from stylemotion.datasets import TakeSet
 from stylemotion.models.autoencoder import MotionAutoencoder
 from stylemotion.models.checkpoints import load_autoencoder
-from stylemotion.primitives import Clip, parse_primitive
+from stylemotion.primitives.segmentation import Clip, parse_primitive
 
 log = logging.getLogger(__name__)
 

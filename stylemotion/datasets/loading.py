@@ -30,8 +30,8 @@ from typing import Any
 
 import numpy as np
 
-from stylemotion.canonical import DEFAULT_MAX_FRAMES, to_canonical_positions
 from stylemotion.datasets.base import Take, TakeSet
+from stylemotion.datasets.canonical import DEFAULT_MAX_FRAMES, to_canonical_positions
 from stylemotion.io.bvh import DEFAULT_MAX_JOINT_FRAMES, parse_bvh
 from stylemotion.io.errors import MotionDataError, MotionDataWarning
 from stylemotion.io.outputs import safe_name
@@ -77,7 +77,7 @@ def check_flag(value: Any, key: str) -> bool:
 
 @dataclass(frozen=True)
 class ConversionSettings:
-    """How files become canonical positions (see :func:`stylemotion.canonical.to_canonical_positions`).
+    """How files become canonical positions (see :func:`stylemotion.datasets.canonical.to_canonical_positions`).
 
     Attributes:
         fps: target frame rate.

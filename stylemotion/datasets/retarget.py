@@ -4,7 +4,7 @@
 (:func:`retarget_takeset`, applied by :func:`stylemotion.datasets.load_dataset` to every dataset
 kind after conversion); ``null`` keeps each recording's own bones. :func:`actor_groups` finds the
 takes recorded on the same skeleton (bone lengths within a tolerance), so that a result can be
-reported within each group. Transform and units: :mod:`stylemotion.retarget`.
+reported within each group. Transform and units: :mod:`stylemotion.bones`.
 """
 
 from __future__ import annotations
@@ -16,8 +16,8 @@ from typing import Any
 import numpy as np
 from scipy.cluster.hierarchy import fcluster, linkage
 
+from stylemotion.bones import BONE_NAMES, median_bone_lengths, retarget_positions, target_bone_lengths
 from stylemotion.datasets.base import Take, TakeSet
-from stylemotion.retarget import BONE_NAMES, median_bone_lengths, retarget_positions, target_bone_lengths
 
 #: Default tolerance of :func:`actor_groups`: two takes share a skeleton when no bone differs by more, metres.
 ACTOR_TOLERANCE_M = 0.001
@@ -41,8 +41,8 @@ def skeleton_record(style: str | None, takes: int, lengths: np.ndarray) -> dict[
 def retarget_takeset(takeset: TakeSet, style: str) -> TakeSet:
     """Every take of ``takeset`` on the median bone lengths of the takes of ``style``.
 
-    The target is :func:`stylemotion.retarget.target_bone_lengths` of those takes; each take goes
-    through :func:`stylemotion.retarget.retarget_positions`. The result records the target in
+    The target is :func:`stylemotion.bones.target_bone_lengths` of those takes; each take goes
+    through :func:`stylemotion.bones.retarget_positions`. The result records the target in
     ``TakeSet.retarget`` (``style``, ``takes``, ``bone_lengths_m`` by bone).
 
     ``style=None`` returns ``takeset`` itself (the original bones).
@@ -88,7 +88,7 @@ class ActorGroups:
 def actor_groups(takes: Sequence[Take], tolerance_m: float = ACTOR_TOLERANCE_M) -> ActorGroups:
     """Group takes by actor, i.e. by skeleton: takes whose median bone lengths agree within a tolerance.
 
-    Two takes are linked when every bone's median length (:func:`stylemotion.retarget.median_bone_lengths`)
+    Two takes are linked when every bone's median length (:func:`stylemotion.bones.median_bone_lengths`)
     differs by at most ``tolerance_m``; a group is a connected set of linked takes (single linkage,
     so the result does not depend on the order of ``takes``). Group ids count from 0 in the order of
     each group's first take by name. A style recorded by two actors appears in both groups.

@@ -22,6 +22,7 @@ from typing import Any, Protocol
 
 import numpy as np
 
+from stylemotion.bones import BONE_NAMES, retarget_positions, target_bone_lengths
 from stylemotion.datasets.base import Take, TakeSet
 from stylemotion.datasets.loading import ConversionSettings, convert_motion
 from stylemotion.datasets.retarget import skeleton_record
@@ -29,7 +30,6 @@ from stylemotion.io.bvh import parse_bvh
 from stylemotion.io.errors import MotionDataError, UserInputError
 from stylemotion.io.outputs import safe_name
 from stylemotion.io.sources import FileSource
-from stylemotion.retarget import BONE_NAMES, retarget_positions, target_bone_lengths
 
 #: A frame range after the file: ``:<start>-<end>``, whatever the two parts hold (checked afterwards).
 _RANGE = re.compile(r"^(?P<path>.*[^:]):(?P<range>[^:/\\]*-[^:/\\]*)$")
@@ -40,7 +40,7 @@ class UserMotionError(UserInputError, ValueError):
 
 
 class FrameSpan(Protocol):
-    """Frames ``start:stop`` of a converted motion (a :class:`stylemotion.primitives.Clip`, for one)."""
+    """Frames ``start:stop`` of a converted motion (a :class:`stylemotion.primitives.segmentation.Clip`, for one)."""
 
     start: int
     stop: int
@@ -173,7 +173,7 @@ def convert_example(spec: ExampleSpec, settings: ConversionSettings) -> Converte
 
 
 def on_run_skeleton(example: ConvertedExample, takeset: TakeSet, neutral_style: str = "normal") -> ConvertedExample:
-    """The example on the run's skeleton, by :func:`stylemotion.retarget.retarget_positions`: the bone
+    """The example on the run's skeleton, by :func:`stylemotion.bones.retarget_positions`: the bone
     lengths ``takeset.retarget`` records (``data.retarget``), else the median bones of the takes of
     ``neutral_style`` (every takeset's fallback; all takes if it has none of that style).
 

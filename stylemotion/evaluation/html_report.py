@@ -59,7 +59,7 @@ def _to_html(text: str) -> str:
 
 def viewer_motions(samples: Mapping[str, Any], per_model: int = SAMPLES_PER_MODEL) -> list[ViewerMotion]:
     """The first ``per_model`` samples of each model; ``samples`` maps a label to
-    :class:`~stylemotion.sampling.MotionSamples`."""
+    :class:`~stylemotion.models.sampling.MotionSamples`."""
     motions: list[ViewerMotion] = []
     for label, s in samples.items():
         motions += samples_to_motions(s.positions.numpy(), s.num_frames.numpy().tolist(), float(s.fps), label,

@@ -65,8 +65,8 @@ DEFINITIONS = {
                "classifier's PCA feature space. References: neutral-model samples vs the same clips; real floor = "
                "train-split vs val+test clips of the style.",
     "diversity": "mean Euclidean distance between all pairs of motions in the classifier's feature space.",
-    "foot_skating": "share of contact foot-frames (stylemotion.contacts.foot_contacts, resting heights of real "
-                    "train takes) whose planted-point speed (slower of heel and ball) exceeds skate_speed_mps; "
+    "foot_skating": "share of contact foot-frames (stylemotion.primitives.contacts.foot_contacts, resting heights of "
+                    "real train takes) whose planted-point speed (slower of heel and ball) exceeds skate_speed_mps; "
                     "contact_share, no_plant_share (stance foot never in contact) and planted_mid_mps (stance "
                     "foot speed over the middle half) catch feet that slide too fast to be detected as contact.",
     "nearest_training": "RMS joint distance (root-local poses on the canonical timeline, metres) from each motion "

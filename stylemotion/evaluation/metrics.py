@@ -1,12 +1,12 @@
 """Metrics the thesis lacks: Fréchet distance, diversity, foot skating, nearest-training-clip distance.
 
-Foot skating is measured below the evaluation, in :mod:`stylemotion.skating` (synthesis checks its own
+Foot skating is measured below the evaluation, in :mod:`stylemotion.primitives.skating` (synthesis checks its own
 walks with it too); its names are kept here with the other metrics.
 
 Each function states its definition; the report repeats it. Features are rows of a ``(n, d)``
 array (e.g. the style classifier's feature space, :mod:`stylemotion.evaluation.classifier`); motions
 are padded ``(n, frames, 21, 3)`` positions in metres with ``num_frames`` valid frames each, as in
-:class:`stylemotion.sampling.MotionSamples`.
+:class:`stylemotion.models.sampling.MotionSamples`.
 """
 
 from __future__ import annotations
@@ -15,8 +15,8 @@ import numpy as np
 from scipy import linalg
 from scipy.spatial.distance import pdist
 
+from stylemotion.primitives.skating import SKATE_SPEED_MPS, FootSkating, foot_skating, pooled_skating
 from stylemotion.representation import FRAME_DIM, JOINT_DIMS
-from stylemotion.skating import SKATE_SPEED_MPS, FootSkating, foot_skating, pooled_skating
 
 __all__ = ["SKATE_SPEED_MPS", "FootSkating", "diversity", "foot_skating", "frechet_distance", "nearest_distances",
            "pooled_skating", "pose_sequences"]

@@ -55,9 +55,9 @@ from stylemotion.evaluation.sources import MissingExampleError, check_one_autoen
 from stylemotion.evaluation.tables import diagonal_minima, distance_table, example_gram, mean_motion, variance_stats
 from stylemotion.models.autoencoder import local_mpjpe, mpjpe
 from stylemotion.models.loading import NEUTRAL, EvalModel
+from stylemotion.models.sampling import MotionSamples
 from stylemotion.models.style import mean_gram
-from stylemotion.primitives import Segmentation, parse_primitive, segment_action, time_normalize
-from stylemotion.sampling import MotionSamples
+from stylemotion.primitives.segmentation import Segmentation, parse_primitive, segment_action, time_normalize
 
 log = logging.getLogger(__name__)
 
@@ -256,7 +256,8 @@ def real_side(primitive: str, models: Sequence[EvalModel], takeset: TakeSet, set
     """Split the (segmented) data for ``primitive``, fit the style classifier, gather the ground truths.
 
     ``segmentation``: the primitive's action already segmented with ``settings.segment``
-    (:func:`stylemotion.primitives.segment_action`), shared by the primitives of one evaluation; None segments here.
+    (:func:`stylemotion.primitives.segmentation.segment_action`), shared by the primitives of one evaluation;
+    None segments here.
 
     Raises:
         MissingExampleError: a model's style is not in the data, or its example clip is missing.

@@ -21,12 +21,12 @@ from typing import Any
 
 import numpy as np
 
-from stylemotion.contacts import foot_signals
 from stylemotion.datamodules.clips import ClipDataModule
 from stylemotion.datasets import TakeSet
 from stylemotion.evaluation.sources import MissingExampleError
 from stylemotion.models.loading import EvalModel
-from stylemotion.primitives import (
+from stylemotion.primitives.contacts import foot_signals
+from stylemotion.primitives.segmentation import (
     STANCE_FOOT,
     Clip,
     Segmentation,
@@ -118,7 +118,7 @@ def primitive_data(takeset: TakeSet, primitive: str, length: int, neutral_style:
         segment: segmentation overrides (as for training).
         split: split settings (as for training; the data config's ``split``).
         segmentation: the action's takes already segmented with ``segment``
-            (:func:`stylemotion.primitives.segment_action`); None segments them here.
+            (:func:`stylemotion.primitives.segmentation.segment_action`); None segments them here.
     """
     action, name = parse_primitive(primitive)
     module = ClipDataModule(takeset=takeset, action=action, primitives=[name], styles=None, timeline=int(length),

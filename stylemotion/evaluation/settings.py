@@ -9,8 +9,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from stylemotion.primitives import SegmentSettings
-from stylemotion.skating import SKATE_SPEED_MPS
+from stylemotion.primitives.segmentation import SegmentSettings
+from stylemotion.primitives.skating import SKATE_SPEED_MPS
 
 
 @dataclass

@@ -1,6 +1,6 @@
 """What the evaluation evaluates: anything that samples motions of a primitive, plus what it targets.
 
-A :class:`SampleSource` has ``sample(n, seed) -> MotionSamples`` (:mod:`stylemotion.sampling`):
+A :class:`SampleSource` has ``sample(n, seed) -> MotionSamples`` (:mod:`stylemotion.models.sampling`):
 the trained :class:`~stylemotion.models.vae.PrimitiveVAE` and
 :class:`~stylemotion.models.cvae.StyleCVAE` are sources, and so is :class:`RealClipSource`
 (real clips drawn with replacement: an "oracle model" for tests and reference rows).
@@ -21,8 +21,8 @@ import torch
 from stylemotion.io.errors import UserInputError
 from stylemotion.models.autoencoder import IncompatibleModelError
 from stylemotion.models.loading import EvalModel
-from stylemotion.primitives import Clip, time_normalize
-from stylemotion.sampling import MotionSamples, pad_motions
+from stylemotion.models.sampling import MotionSamples, pad_motions
+from stylemotion.primitives.segmentation import Clip, time_normalize
 
 
 class MixedAutoencodersError(IncompatibleModelError):

@@ -21,9 +21,9 @@ import torch
 from stylemotion.models.autoencoder import IncompatibleModelError, MotionAutoencoder
 from stylemotion.models.checkpoints import GENERATIVE_KINDS, KINDS, checkpoint_kind, read_checkpoint, restore
 from stylemotion.models.cvae import StyleCVAE
+from stylemotion.models.sampling import MotionSamples
 from stylemotion.models.vae import PrimitiveVAE
 from stylemotion.models.zero_shot import ZeroShotStyleVAE
-from stylemotion.sampling import MotionSamples
 
 
 def model_class(kind: str) -> type[pl.LightningModule]:
@@ -70,7 +70,7 @@ class SampleSource(Protocol):
     """Anything that draws motions of one primitive."""
 
     def sample(self, n: int, seed: int | None = None) -> MotionSamples:  # pragma: no cover - protocol
-        """``n`` motions (see :class:`stylemotion.sampling.MotionSamples`), reproducible for a seed."""
+        """``n`` motions (see :class:`stylemotion.models.sampling.MotionSamples`), reproducible for a seed."""
         ...
 
 

@@ -16,7 +16,7 @@ standardized log-duration. ``‖·‖²_w`` weighs the duration value by ``durat
 feature value by 1. Samples thus carry their own durations, correlated with the motion.
 
 Sampling (:meth:`PrimitiveVAE.sample`) decodes ``z ~ N(0, I)`` to features and a duration, and
-:func:`stylemotion.sampling.decode_features` turns them into motions (autoencoder decoder, duration
+:func:`stylemotion.models.sampling.decode_features` turns them into motions (autoencoder decoder, duration
 restored, root integrated). The autoencoder is not part of this module's state (not a submodule,
 not in ``state_dict``), but every checkpoint embeds it beside the state dict (its hyperparameters
 and weights, :func:`stylemotion.models.checkpoints.autoencoder_record`), so a checkpoint samples
@@ -51,7 +51,7 @@ from stylemotion.models.checkpoints import (
     load_autoencoder,
     resolve_autoencoder,
 )
-from stylemotion.sampling import DEFAULT_CHUNK, MotionSamples, decode_features, masked_mpjpe
+from stylemotion.models.sampling import DEFAULT_CHUNK, MotionSamples, decode_features, masked_mpjpe
 
 log = logging.getLogger(__name__)
 

@@ -67,10 +67,10 @@ import torch
 from torch import nn
 
 from stylemotion.models.cvae import STYLE_LATENTS
+from stylemotion.models.sampling import DEFAULT_CHUNK, MotionSamples, decode_features, masked_mpjpe
 from stylemotion.models.style import feature_style_distance, mean_gram
 from stylemotion.models.vae import MLPVAE, PrimitiveVAE, kl_divergence, prior_draws, reconstruction_loss
-from stylemotion.primitives import time_normalize
-from stylemotion.sampling import DEFAULT_CHUNK, MotionSamples, decode_features, masked_mpjpe
+from stylemotion.primitives.segmentation import time_normalize
 
 
 class ConditionalMLPVAE(MLPVAE):
@@ -234,7 +234,7 @@ class ZeroShotStyleVAE(PrimitiveVAE):
 
         Args:
             example: features ``(C, T')`` or ``(n, C, T')``, a list of such tensors, or clips (anything
-                with ``frames`` ``(frames, 66)``, e.g. :class:`~stylemotion.primitives.Clip`), one or a
+                with ``frames`` ``(frames, 66)``, e.g. :class:`~stylemotion.primitives.segmentation.Clip`), one or a
                 list: resampled to the canonical timeline and encoded by the autoencoder, as the
                 training clips were.
 

@@ -1,7 +1,7 @@
 """Arm motion primitives: a raise-up or wave take cut into ``raise``, ``wave`` and ``lower`` clips (for the Morphable
 Graph's arm primitive, Du Fig. 3.9/3.10 and §4.5.3's "hand reaching a target at the end of an arm primitive").
 
-:mod:`stylemotion.primitives` cuts walks and runs at foot contacts; arm takes (Bandai's ``raise-up-*-hand``
+:mod:`stylemotion.primitives.segmentation` cuts walks and runs at foot contacts; arm takes (Bandai's ``raise-up-*-hand``
 and ``wave-*-hand``: rest, raise, hold or wave, lower, rest) have no steps. Here the *active* hands are those
 whose height (Y, metres) varies by at least ``min_raise_m`` over the take; ``h(t)`` is their mean height and
 ``s(t)`` the largest of their speeds (m/s). With ``lo``/``hi`` the lowest/highest ``h``, the take is cut at
@@ -33,8 +33,8 @@ the top), ``f = threshold``:
   two extremes minus the lowest ``w`` between them, m) is below ``min_wave_m`` or that is shorter than
   ``min_frames`` is rejected alone.
 
-Clips are :class:`stylemotion.primitives.Clip` (frames of the source range, so positions start at the origin
-facing +Z like every clip) with ``action`` = the take's content (e.g. ``raise-up-left-hand``: one primitive
+Clips are :class:`stylemotion.primitives.segmentation.Clip` (frames of the source range, so positions start at the
+origin facing +Z like every clip) with ``action`` = the take's content (e.g. ``raise-up-left-hand``: one primitive
 per content, hands never mixed) and ``primitive`` = ``raise``, ``wave`` or ``lower``. A take without an
 active hand, that does not come back down, or whose clip would be shorter than ``min_frames`` gives a
 rejection reason instead. Asking a ``raise-up-*`` content for ``wave`` is an error.
@@ -48,10 +48,10 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.signal import find_peaks
 
-from stylemotion.contacts import foot_contacts
 from stylemotion.datasets.base import Take
 from stylemotion.geometry import direction_yaw, facing_direction, rotate_yaw
-from stylemotion.primitives import Clip
+from stylemotion.primitives.contacts import foot_contacts
+from stylemotion.primitives.segmentation import Clip
 from stylemotion.representation import ROOT_JOINT, facing_yaw
 from stylemotion.skeleton import CANONICAL_JOINTS
 

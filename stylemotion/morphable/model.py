@@ -1,5 +1,5 @@
 """A motion primitive of the Morphable Graph (Du §3.3, §4.4.1): spline functions, time warping, (S)FPCA
-latent space and a Gaussian mixture; sampling into :class:`~stylemotion.sampling.MotionSamples`.
+latent space and a Gaussian mixture; sampling into :class:`~stylemotion.models.sampling.MotionSamples`.
 
 Fitting (:func:`fit_primitive`), for the clips of one primitive:
 
@@ -31,15 +31,15 @@ import numpy as np
 import torch
 
 from stylemotion.io.atomic import atomic_write_bytes
+from stylemotion.models.sampling import MotionSamples, pad_motions
 from stylemotion.morphable.bspline import SplineBasis
 from stylemotion.morphable.channels import Channels
 from stylemotion.morphable.fpca import FunctionalPCA, fit_reduction
 from stylemotion.morphable.gmm import LatentGMM, fit_gmm
 from stylemotion.morphable.tree import TREE_SAMPLES, SpaceTree
 from stylemotion.morphable.warping import canonical_times, dtw_warp, monotone, resample
-from stylemotion.primitives import Clip, canonical_timelines, time_normalize
+from stylemotion.primitives.segmentation import Clip, canonical_timelines, time_normalize
 from stylemotion.representation import JOINT_DIMS, positions_to_frames
-from stylemotion.sampling import MotionSamples, pad_motions
 
 log = logging.getLogger(__name__)
 #: What a tree's splits may cluster (:meth:`MorphableModel.build_tree`).

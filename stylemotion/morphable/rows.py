@@ -20,7 +20,7 @@ from stylemotion.config import ConfigError
 from stylemotion.datamodules.clips import ClipDataModule
 from stylemotion.datasets import data_config_key
 from stylemotion.morphable.model import FitSettings, MorphableModel, fit_primitive
-from stylemotion.primitives import parse_primitive
+from stylemotion.primitives.segmentation import parse_primitive
 
 #: Row name of the Morphable Graph's neutral model in Tables 5.1–5.3.
 ROW = "morphable"

@@ -33,8 +33,8 @@ from stylemotion.morphable.arm import (
 )
 from stylemotion.morphable.model import FitSettings, MorphableModel, fit_primitive, reconstruction_error
 from stylemotion.morphable.variants import TURN_THRESHOLD_DEG, select_turn, variant_name
-from stylemotion.primitives import parse_primitive
-from stylemotion.training import record_start
+from stylemotion.primitives.segmentation import parse_primitive
+from stylemotion.training.fit import record_start
 
 log = logging.getLogger(__name__)
 

@@ -18,7 +18,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from stylemotion.primitives import Clip
+from stylemotion.primitives.segmentation import Clip
 from stylemotion.representation import YAW_RATE_DIM
 
 #: Turn variants (None: every clip).

@@ -13,7 +13,7 @@ The folder ``out`` (refused when it exists unless ``force``; built beside it and
 
 * ``motion.npz``: ``positions`` ``(frames, 21, 3)`` float32 metres in the markers' world frame, ``joint_names``,
   ``fps`` — as ``stylemotion-convert`` writes;
-* ``motion.bvh``: the same through :func:`stylemotion.export.write_motion_bvh`;
+* ``motion.bvh``: the same through :func:`stylemotion.io.export.write_motion_bvh`;
 * ``motion.gif``: the stick figure along its ground track (unless ``gif=false``);
 * ``summary.json``: the settings, the markers' source and filled gaps, frames/s, the database, provenance and,
   when the input was a complete motion, the mean/max per-joint error in cm (also of the nearest-neighbour

@@ -43,9 +43,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from stylemotion.contacts import foot_contacts
 from stylemotion.geometry import rotate_yaw, wrap_angle
 from stylemotion.io.errors import UserInputError
+from stylemotion.primitives.contacts import foot_contacts
 from stylemotion.reconstruct.texture import MotionTexturer
 from stylemotion.representation import facing_yaw
 from stylemotion.search.database import MotionDatabase

@@ -38,7 +38,7 @@ def write_motion_folder(out: str | os.PathLike, force: bool, positions: np.ndarr
         np.savez(buffer, positions=np.asarray(positions, dtype=np.float32), joint_names=np.array(CANONICAL_JOINTS),
                  fps=np.float64(fps))
         atomic_write_bytes(inside(tmp, "motion.npz"), buffer.getvalue())
-        from stylemotion.export import write_motion_bvh
+        from stylemotion.io.export import write_motion_bvh
 
         write_motion_bvh(positions, inside(tmp, "motion.bvh"), fps)
         if gif:

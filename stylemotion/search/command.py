@@ -244,7 +244,7 @@ def _exports(folder: Path, q: Query, result: SearchResult, index: FrameIndex, bv
     written = ["distance_matrix.png"] if result.matches else []
     for stem, positions in motions:
         if bvh:
-            from stylemotion.export import write_motion_bvh
+            from stylemotion.io.export import write_motion_bvh
 
             write_motion_bvh(positions, inside(folder, "bvh", f"{stem}.bvh"), fps)
             written.append(f"bvh/{stem}.bvh")

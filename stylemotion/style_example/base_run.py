@@ -4,7 +4,7 @@ From its folder: ``reproduce.json`` (every stage finished, with the Hydra overri
 training stages were composed from), ``report/report.json`` (the data config, the seed, the
 evaluation settings, the models it evaluated). A new style's models are trained with the train
 config of the run's CVAE stage of the same primitive (:func:`train_config`, through
-:func:`stylemotion.reproduction.stage_train_config`, the function the run's own stages went
+:func:`stylemotion.training.reproduction.stage_train_config`, the function the run's own stages went
 through): same overrides (experiment, budget epochs, ``model.style_weight``, …), data, seed and
 autoencoder; only the style and the output folder differ.
 """
@@ -16,14 +16,14 @@ from typing import Any
 
 from omegaconf import DictConfig, open_dict
 
-from stylemotion.finished_run import FinishedRun, read_json_object
 from stylemotion.io.outputs import safe_name
 from stylemotion.models.loading import NEUTRAL, EvalModel, load_model
-from stylemotion.primitives import parse_primitive
-from stylemotion.reproduction import stage_train_config
+from stylemotion.primitives.segmentation import parse_primitive
 from stylemotion.style_example.example import StyleExampleError
 from stylemotion.synthesis.graph import STYLE_FOLDER_KIND as STYLE_KIND
 from stylemotion.synthesis.graph import available_models
+from stylemotion.training.reproduction import stage_train_config
+from stylemotion.training.run_folder import FinishedRun, read_json_object
 
 #: Stage statuses of a finished stage in ``reproduce.json``.
 FINISHED = ("trained", "reused", "resumed")
@@ -34,7 +34,7 @@ class NameTakenError(StyleExampleError):
 
 
 class SourceRun(FinishedRun):
-    """A finished reproduce run (see the module doc and :class:`stylemotion.finished_run.FinishedRun`);
+    """A finished reproduce run (see the module doc and :class:`stylemotion.training.run_folder.FinishedRun`);
     build it with :func:`load_run`."""
 
     @property

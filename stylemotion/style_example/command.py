@@ -46,7 +46,7 @@ from stylemotion.io.jsonfile import plain, write_json
 from stylemotion.io.outputs import check_new_output, inside
 from stylemotion.models.checkpoints import autoencoder_info, load_autoencoder
 from stylemotion.models.loading import EvalModel, load_model
-from stylemotion.primitives import Clip, parse_primitive, segment_action
+from stylemotion.primitives.segmentation import Clip, parse_primitive, segment_action
 from stylemotion.provenance import provenance
 from stylemotion.skeleton import CANONICAL_JOINTS
 from stylemotion.style_example.base_run import STYLE_KIND, SourceRun, check_name, load_run, run_action, train_config
@@ -101,7 +101,7 @@ def train_cvae(run: SourceRun, name: str, example: ConvertedExample, cut: CutExa
                progress: Progress, say: Say, threads: Any = None) -> dict[str, Path]:
     """A :class:`~stylemotion.models.cvae.StyleCVAE` per primitive, trained as the run's CVAE stage of that
     primitive (:func:`.base_run.train_config`) on the example's clips; returns primitive → checkpoint."""
-    from stylemotion.training import run as train_run
+    from stylemotion.training.fit import run as train_run
 
     checkpoints = {}
     for primitive, clips in cut.used.items():

@@ -31,9 +31,9 @@ from stylemotion.evaluation.sources import check_one_autoencoder, motions_from_c
 from stylemotion.evaluation.tables import VARIANCE_KEYS, VARIANCE_UNITS, distance_table, variance_stats
 from stylemotion.io.markdown import md_table
 from stylemotion.models.loading import NEUTRAL, EvalModel
-from stylemotion.primitives import Clip, Segmentation
-from stylemotion.sampling import MotionSamples
-from stylemotion.skating import FootSkating, foot_skating, pooled_skating
+from stylemotion.models.sampling import MotionSamples
+from stylemotion.primitives.segmentation import Clip, Segmentation
+from stylemotion.primitives.skating import FootSkating, foot_skating, pooled_skating
 
 #: Variation figures of the report, in table order.
 VARIATION_KEYS = (*VARIANCE_KEYS, "pose_across_sd")

@@ -2,7 +2,7 @@
 canonical positions, on the run's skeleton), then cut into the primitives of a run.
 
 The converted take is labelled with the new style's name and the run's action and cut by
-:func:`stylemotion.primitives.segment_action` with the run's segmentation settings.
+:func:`stylemotion.primitives.segmentation.segment_action` with the run's segmentation settings.
 """
 
 from __future__ import annotations
@@ -19,7 +19,7 @@ from stylemotion.datasets.user_motion import (
     on_run_skeleton,
     parse_example,
 )
-from stylemotion.primitives import Clip, Segmentation, SegmentSettings, parse_primitive, segment_action
+from stylemotion.primitives.segmentation import Clip, Segmentation, SegmentSettings, parse_primitive, segment_action
 
 __all__ = ["EXAMPLE_FILE", "MAX_REASONS", "ConvertedExample", "CutExample", "ExampleSpec", "StyleExampleError",
            "convert_example", "cut_example", "on_run_skeleton", "parse_example"]

@@ -15,7 +15,7 @@ from pathlib import Path
 from typing import Any
 
 from stylemotion.models.loading import EvalModel
-from stylemotion.primitives import Clip
+from stylemotion.primitives.segmentation import Clip
 
 Say = Callable[[str], None]
 

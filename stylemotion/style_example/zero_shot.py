@@ -33,13 +33,13 @@ from omegaconf import Container, DictConfig, OmegaConf, open_dict
 
 from stylemotion.config import ConfigError, positive_int
 from stylemotion.datamodules.features import describe_clip
-from stylemotion.evaluation_zero_shot import network_train_config
+from stylemotion.evaluation.zero_shot import network_train_config
 from stylemotion.io.outputs import inside
 from stylemotion.models.autoencoder import IncompatibleModelError
 from stylemotion.models.checkpoints import checkpoint_hparams, fingerprint, load_autoencoder
 from stylemotion.models.loading import EvalModel, load_generative
 from stylemotion.models.zero_shot import ZeroShotStyleVAE
-from stylemotion.primitives import Clip
+from stylemotion.primitives.segmentation import Clip
 from stylemotion.style_example.base_run import SourceRun, train_config
 from stylemotion.style_example.example import EXAMPLE_FILE, StyleExampleError
 from stylemotion.style_example.methods import Method, Say, recorded_path
@@ -79,7 +79,7 @@ def network_config(run: SourceRun, primitive: str, folder: Path, epochs: int | N
 def train_networks(run: SourceRun, primitives: Sequence[str], folder: Path, epochs: int | None, progress: Say,
                    say: Say, threads: Any = None) -> dict[str, Path]:
     """Train the network of each primitive into ``folder/network/<primitive>/``; primitive → best checkpoint."""
-    from stylemotion.training import run as train_run
+    from stylemotion.training.fit import run as train_run
 
     checkpoints = {}
     for primitive in primitives:

@@ -1,8 +1,8 @@
 """Foot-skating clean-up of synthesized positions: hold planted feet still, re-solve the knees.
 
-Contacts come from the one detector, :func:`stylemotion.contacts.foot_contacts`. During each
+Contacts come from the one detector, :func:`stylemotion.primitives.contacts.foot_contacts`. During each
 contact interval of a foot, the horizontal drift of its *planted point* — per frame the slower of
-heel (``Foot_*``) and ball (``Toes_*``), as in :func:`stylemotion.contacts.planted_point_speed` — is
+heel (``Foot_*``) and ball (``Toes_*``), as in :func:`stylemotion.primitives.contacts.planted_point_speed` — is
 accumulated and subtracted from the whole foot (heel and ball move together, so the foot keeps its
 shape and its roll from heel to ball). When the foot lifts off, the accumulated correction is
 released over ``release_frames`` frames of the swing (smoothstep), so the foot rejoins its own
@@ -18,8 +18,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from stylemotion.contacts import contact_intervals, foot_contacts, horizontal_speed
 from stylemotion.geometry import two_bone_ik
+from stylemotion.primitives.contacts import contact_intervals, foot_contacts, horizontal_speed
 from stylemotion.skeleton import FOOT_POINTS, JOINT_INDEX, NUM_JOINTS
 
 #: Closest a solved leg comes to fully straight or fully folded: the hip–ankle distance stays this

@@ -19,7 +19,7 @@ it exists, unless ``force=true``; the folder appears complete or not at all):
   ``fps``, ``path`` (n, 2) x/z metres, ``junctions`` (keyframe index of each transition),
   ``joint_names``;
 * ``motion.bvh``: the canonical skeleton with rotations fitted to the positions
-  (:mod:`stylemotion.export`);
+  (:mod:`stylemotion.io.export`);
 * ``motion.gif`` (and ``motion.mp4`` with ``outputs.mp4=true``, by imageio-ffmpeg's ffmpeg): the stick figure
   on the path;
 * ``summary.json``: :func:`stylemotion.synthesis.quality.walk_figures`, the BVH round trip error,
@@ -42,8 +42,8 @@ from omegaconf import DictConfig, OmegaConf
 
 from stylemotion.config import ConfigError
 from stylemotion.datasets.loading import ConversionSettings, load_canonical_positions
-from stylemotion.export import write_motion_bvh
 from stylemotion.io.atomic import atomic_folder
+from stylemotion.io.export import write_motion_bvh
 from stylemotion.io.jsonfile import write_json
 from stylemotion.io.outputs import check_new_output
 from stylemotion.io.sources import FileSource
@@ -83,10 +83,10 @@ def bvh_round_trip_error(bvh: Path, positions: np.ndarray, fps: float) -> tuple[
 
 def rigid_bones(positions: np.ndarray) -> tuple[np.ndarray, dict[str, float]]:
     """``positions`` ``(frames, 21, 3)`` with every bone at its median length (directions kept, placed from the
-    root outwards: :func:`stylemotion.retarget.retarget_positions`), and what that changed: the largest relative
+    root outwards: :func:`stylemotion.bones.retarget_positions`), and what that changed: the largest relative
     spread of a bone's length before (``(max − min) / median``) and the mean and largest joint shift (m). The
     decoder's positions stretch bones from frame to frame, which no skeleton of a BVH file can follow."""
-    from stylemotion.retarget import BONE_JOINTS, median_bone_lengths, retarget_positions
+    from stylemotion.bones import BONE_JOINTS, median_bone_lengths, retarget_positions
     from stylemotion.skeleton import bone_lengths
 
     lengths = bone_lengths(np.asarray(positions, dtype=np.float64))[:, list(BONE_JOINTS)]

@@ -1,6 +1,6 @@
 """The motion graph of one action and one style (thesis §4.5, §5.4.4): primitives and their transitions.
 
-Nodes are the six primitives of :mod:`stylemotion.primitives` that have a trained model; edges
+Nodes are the six primitives of :mod:`stylemotion.primitives.segmentation` that have a trained model; edges
 follow the foot that carries the body. A clip that ends at the transfer onto the **right** foot
 (``leftStance``, ``beginLeftStance``) is followed by a clip in which the right foot is planted
 (``rightStance`` or ``endRightStance``), and mirrored for the left foot::
@@ -39,7 +39,7 @@ from stylemotion.models.checkpoints import load_autoencoder
 from stylemotion.models.loading import NEUTRAL, load_generative, load_model
 from stylemotion.models.vae import PrimitiveVAE
 from stylemotion.models.zero_shot import BoundExample, ZeroShotStyleVAE
-from stylemotion.primitives import PRIMITIVES, check_primitive
+from stylemotion.primitives.segmentation import PRIMITIVES, check_primitive
 from stylemotion.representation import positions_to_frames
 
 #: Successors of each primitive (by planted foot: a clip ending on foot f is followed by one planted on f).

@@ -5,7 +5,7 @@
   from the last root position to the path's end point.
 * **Duration and speed**: seconds, walked distance (length of the root track, m) and mean speed
   (distance / duration, m/s).
-* **Foot skating**: :func:`stylemotion.skating.foot_skating` on the whole motion, with
+* **Foot skating**: :func:`stylemotion.primitives.skating.foot_skating` on the whole motion, with
   the resting foot heights of the motion itself (as for a real take); compare with the same ratio
   of real clips of the style (``stylemotion-reproduce``'s ``report.json``, ``foot_skating_real``).
   Measured on the motion as given (after :mod:`stylemotion.synthesis.cleanup` if it was applied).
@@ -20,8 +20,8 @@ from typing import Any
 
 import numpy as np
 
-from stylemotion.contacts import foot_signals
-from stylemotion.skating import foot_skating
+from stylemotion.primitives.contacts import foot_signals
+from stylemotion.primitives.skating import foot_skating
 from stylemotion.synthesis.controller import SynthesizedMotion
 from stylemotion.synthesis.stitching import transition_speed_ratio
 

@@ -1,7 +1,7 @@
 """Joining primitive clips into one motion at their shared contact keyframes (thesis §4.5.3, §5.4.4).
 
 Consecutive clips share a keyframe: clip ``k`` ends and clip ``k + 1`` starts in the middle of the
-same support transfer (:mod:`stylemotion.primitives`). The motion is assembled in the 66-dim frame
+same support transfer (:mod:`stylemotion.primitives.segmentation`). The motion is assembled in the 66-dim frame
 representation, which is placement-free, and integrated once at the end
 (:func:`stylemotion.representation.frames_to_positions`), so the root path is continuous by
 construction::

@@ -10,7 +10,7 @@ Every input becomes :class:`ViewerMotion`\\ s on the canonical skeleton (metres,
 * a run folder: its ``motion.npz`` (a generated walk or a reconstruction; ``summary.json`` beside it
   names the style), else every ``samples/*.npz`` and ``example/example.npz`` below it.
 
-Foot contacts come from :func:`stylemotion.contacts.foot_contacts`, the detector the rest of the
+Foot contacts come from :func:`stylemotion.primitives.contacts.foot_contacts`, the detector the rest of the
 project uses. Bad input raises :class:`~stylemotion.io.errors.MotionDataError` naming the file and key.
 """
 
@@ -24,8 +24,8 @@ from pathlib import Path
 
 import numpy as np
 
-from stylemotion.contacts import foot_contacts
 from stylemotion.io.errors import MotionDataError
+from stylemotion.primitives.contacts import foot_contacts
 from stylemotion.skeleton import CANONICAL_JOINTS, JOINT_INDEX, NUM_JOINTS
 
 #: Files inside a run folder that hold motions, in the order they are looked for.

@@ -33,7 +33,7 @@ from matplotlib.figure import Figure
 
 from stylemotion.geometry import rotate_yaw
 from stylemotion.io.atomic import atomic_write_bytes
-from stylemotion.sampling import MotionSamples
+from stylemotion.models.sampling import MotionSamples
 from stylemotion.skeleton import CANONICAL_JOINTS, JOINT_INDEX
 from stylemotion.viz.stick import TRUNK_COLOR, StickFigure, draw_pose, project
 from stylemotion.viz.tensorboard import log_sample_images

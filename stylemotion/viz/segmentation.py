@@ -7,9 +7,9 @@ from pathlib import Path
 import numpy as np
 from matplotlib.figure import Figure
 
-from stylemotion.contacts import ContactSettings, foot_signals
 from stylemotion.datasets.base import Take
-from stylemotion.primitives import TakeSegmentation
+from stylemotion.primitives.contacts import ContactSettings, foot_signals
+from stylemotion.primitives.segmentation import TakeSegmentation
 from stylemotion.viz.stick import LEFT_COLOR, RIGHT_COLOR
 
 _SHORT = {"leftStance": "L", "rightStance": "R", "beginLeftStance": "bL", "beginRightStance": "bR",
@@ -23,7 +23,7 @@ def plot_take_segmentation(take: Take, seg: TakeSegmentation, path: str | Path,
 
     Args:
         take: the take (positions in metres, ``fps``).
-        seg: its segmentation (:func:`stylemotion.primitives.segment_take`).
+        seg: its segmentation (:func:`stylemotion.primitives.segmentation.segment_take`).
         path: output PNG path.
         settings: the contact settings used (for the resting heights' percentile).
 

@@ -2,7 +2,7 @@
 
 * :func:`log_sample_images`: the contact sheet of a model's samples and evenly spaced frames of their GIF
   (the sample callback calls it after training, beside the hyperparameters and the monitored metric that
-  :mod:`stylemotion.training` logs);
+  :mod:`stylemotion.training.fit` logs);
 * :func:`write_report_events`: an evaluation report's PNG figures (Table 5.1 heat maps, confusion
   matrices, variance ratios) with its settings as hyperparameters and its headline numbers as metrics, in
   an event folder of its own (``<report>/tensorboard``).

@@ -5,7 +5,7 @@ import pytest
 
 from stylemotion.annotate.command import AnnotateInputError, annotate, learn
 from stylemotion.annotate.documents import join_takes
-from stylemotion.export import write_motion_bvh
+from stylemotion.io.export import write_motion_bvh
 from stylemotion.io.outputs import OutputExistsError
 
 SYNTHETIC = {"name": "synthetic", "split": {"seed": 0, "val_fraction": 0.1, "test_fraction": 0.1}}

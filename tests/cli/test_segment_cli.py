@@ -16,8 +16,8 @@ from omegaconf import OmegaConf
 from stylemotion.cli.schemas import register_schemas
 from stylemotion.config import CONFIG_DIR
 from stylemotion.io.outputs import OutputExistsError
-from stylemotion.primitives import SegmentSettings
-from stylemotion.segmentation_report import write_report
+from stylemotion.primitives.report import write_report
+from stylemotion.primitives.segmentation import SegmentSettings
 
 register_schemas()  # the configs composed here take structured schemas (stylemotion.cli.schemas)
 

@@ -26,7 +26,7 @@ from hydra.errors import InstantiationException
 import stylemotion
 from stylemotion.config import config_dir
 from stylemotion.datamodules import EmptySplitError
-from stylemotion.training import resolve_ckpt_path, run
+from stylemotion.training.fit import resolve_ckpt_path, run
 
 #: 4 (content, style) groups × 3 takes of 4 s: one take per group in each of train/val/test.
 TINY_DATA = ["data=synthetic", "data.takes_per_pair=3", "data.duration_s=4.0", "data.styles=[normal,elderly]",

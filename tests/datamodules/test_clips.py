@@ -15,7 +15,7 @@ from stylemotion.datamodules.clips import ClipDataModule, NoClipsError
 from stylemotion.datasets import Take, TakeSet, load_dataset
 from stylemotion.datasets.registry import load_synthetic
 from stylemotion.datasets.synthetic import STYLES
-from stylemotion.primitives import PRIMITIVES
+from stylemotion.primitives.segmentation import PRIMITIVES
 
 SPLIT = {"seed": 3, "val_fraction": 0.25, "test_fraction": 0.25}
 

@@ -19,9 +19,9 @@ from stylemotion.datasets import DatasetBuildError, build_dataset, load_dataset
 from stylemotion.datasets import loading as loading_mod
 from stylemotion.datasets.loading import CacheWarning
 from stylemotion.datasets.synthetic import generate_takes
-from stylemotion.export import canonical_skeleton
 from stylemotion.io.bvh import format_bvh
 from stylemotion.io.errors import MotionDataError, MotionDataWarning
+from stylemotion.io.export import canonical_skeleton
 from stylemotion.io.outputs import safe_name
 from stylemotion.motion import Motion
 from stylemotion.skeleton import CANONICAL_PARENTS

@@ -7,9 +7,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from stylemotion.bones import BONE_NAMES, NUM_BONES, median_bone_lengths
 from stylemotion.datasets import Take, TakeSet, data_config_key, load_dataset
 from stylemotion.datasets.retarget import actor_groups, retarget_takeset
-from stylemotion.retarget import BONE_NAMES, NUM_BONES, median_bone_lengths
 from stylemotion.skeleton import CANONICAL_PARENTS, JOINT_INDEX, NUM_JOINTS, forward_kinematics
 
 SYNTHETIC = {"takes_per_pair": 2, "duration_s": 2.0, "contents": ["walk"], "styles": ["normal", "elderly", "active"]}

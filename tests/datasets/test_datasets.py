@@ -10,9 +10,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from stylemotion.canonical import to_canonical_positions
 from stylemotion.datasets import DatasetBuildError, Take, TakeSet, load_dataset
 from stylemotion.datasets import loading as loading_mod
+from stylemotion.datasets.canonical import to_canonical_positions
 from stylemotion.io.bvh import read_bvh
 from stylemotion.io.errors import MotionDataError
 

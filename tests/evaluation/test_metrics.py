@@ -24,7 +24,7 @@ from stylemotion.evaluation.tables import (
     variance_stats,
 )
 from stylemotion.models.style import gram
-from stylemotion.primitives import segment_takes
+from stylemotion.primitives.segmentation import segment_takes
 from stylemotion.representation import frames_to_positions
 from stylemotion.skeleton import JOINT_INDEX
 

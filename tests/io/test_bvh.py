@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from conftest import BANDAI_MEMBERS, OTHER_SKELETONS, line_of, tiny_bvh_text
 
-from stylemotion.canonical import detect_unit_scale, resolve_joint_map
+from stylemotion.datasets.canonical import detect_unit_scale, resolve_joint_map
 from stylemotion.io.bvh import format_bvh, parse_bvh, read_bvh, snap_fps, write_bvh
 from stylemotion.io.errors import BvhError
 

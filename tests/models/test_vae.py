@@ -18,7 +18,7 @@ from stylemotion.models.autoencoder import IncompatibleModelError, MotionAutoenc
 from stylemotion.models.checkpoints import fingerprint, load_autoencoder
 from stylemotion.models.style import feature_style_distance, gram, gram_factor, mean_gram, style_distance
 from stylemotion.models.vae import MLPVAE, PrimitiveVAE, kl_divergence, reconstruction_loss
-from stylemotion.primitives import parse_primitive
+from stylemotion.primitives.segmentation import parse_primitive
 
 torch.set_num_threads(1)
 

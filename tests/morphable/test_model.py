@@ -7,9 +7,9 @@ import pytest
 import torch
 
 from stylemotion.evaluation.tables import variance_stats
+from stylemotion.models.sampling import MotionSamples
 from stylemotion.morphable import MorphableModel
 from stylemotion.morphable.model import reconstruction_error
-from stylemotion.sampling import MotionSamples
 
 
 def test_sample_has_the_vae_structure(left_model, left_clips):

@@ -19,9 +19,9 @@ from stylemotion.evaluation.settings import ClassifierSettings, EvalSettings, Sa
 from stylemotion.evaluation.sources import RealClipSource
 from stylemotion.models.checkpoints import autoencoder_info, load_autoencoder
 from stylemotion.models.loading import NEUTRAL, EvalModel
+from stylemotion.models.sampling import MotionSamples
 from stylemotion.morphable.rows import ROW, neutral_models
-from stylemotion.reproduction import StageConflictError
-from stylemotion.sampling import MotionSamples
+from stylemotion.training.reproduction import StageConflictError
 
 torch.set_num_threads(1)
 SETTINGS = EvalSettings(samples=SampleCounts(table_5_1=60, variance=120, metrics=60),

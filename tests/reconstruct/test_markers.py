@@ -95,7 +95,7 @@ def test_missing_csv_rows_are_gaps(tmp_path):
 
 def test_bvh_through_the_project_conversion(tmp_path):
     from stylemotion.datasets.registry import load_dataset
-    from stylemotion.export import write_motion_bvh
+    from stylemotion.io.export import write_motion_bvh
 
     take = load_dataset("synthetic", takes_per_pair=1).takes[0]
     path = tmp_path / "take.bvh"

@@ -13,11 +13,11 @@ import pytest
 from conftest import tiny_bvh_text
 from style_fixtures import example_bvh
 
+from stylemotion.bones import BONE_NAMES, median_bone_lengths, target_bone_lengths
 from stylemotion.datasets.loading import ConversionSettings, load_canonical_positions
 from stylemotion.datasets.registry import load_synthetic
 from stylemotion.datasets.retarget import retarget_takeset
 from stylemotion.io.sources import FileSource
-from stylemotion.retarget import BONE_NAMES, median_bone_lengths, target_bone_lengths
 from stylemotion.style_example.example import (
     ExampleSpec,
     StyleExampleError,

@@ -7,8 +7,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from stylemotion.contacts import contact_intervals, foot_contacts, planted_point_speed
 from stylemotion.datasets.synthetic import generate_take
+from stylemotion.primitives.contacts import contact_intervals, foot_contacts, planted_point_speed
 from stylemotion.skeleton import JOINT_INDEX, NUM_JOINTS
 from stylemotion.synthesis.cleanup import REACH_MARGIN_M, clean_foot_skating, planted_drift, solve_knee
 

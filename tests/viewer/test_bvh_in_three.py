@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from stylemotion.datasets.synthetic import generate_take
-from stylemotion.export import write_motion_bvh
 from stylemotion.io.bvh import read_bvh
+from stylemotion.io.export import write_motion_bvh
 from stylemotion.skeleton import CANONICAL_JOINTS
 from stylemotion.viewer.motions import samples_to_motions
 from stylemotion.viewer.page import write_viewer

@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 from viewer_fixtures import synthetic_samples, write_take_npz
 
-from stylemotion.contacts import foot_contacts
 from stylemotion.io.errors import MotionDataError
+from stylemotion.primitives.contacts import foot_contacts
 from stylemotion.reconstruct.output import write_motion_folder
 from stylemotion.viewer.motions import read_inputs
 
@@ -27,7 +27,7 @@ def test_npz_walk_has_contacts_path_and_targets(motion_files):
 
 
 def test_bvh_file_goes_through_the_project_loader(tmp_path):
-    from stylemotion.export import write_motion_bvh
+    from stylemotion.io.export import write_motion_bvh
 
     pos = np.load(write_take_npz(tmp_path / "a.npz", "normal"))["positions"]
     write_motion_bvh(pos, tmp_path / "a.bvh", 30.0)

@@ -15,7 +15,7 @@ The file this writes:
 * the Hips OFFSET is zero, so its position channels are its global position whether a reader
   adds them to the OFFSET or replaces it.
 
-The project's loader (:func:`stylemotion.canonical.to_canonical_positions`, used by the datasets
+The project's loader (:func:`stylemotion.datasets.canonical.to_canonical_positions`, used by the datasets
 and ``stylemotion-convert``) reads it back to the same positions: the built-in ``bandai`` joint map
 is auto-detected (it names exactly these joints) and the unit is detected as metres for any
 skeleton whose head-to-hips-to-foot chain is shorter than about 6 m.

@@ -61,7 +61,7 @@ from stylemotion.evaluation.run import recorded_path, run_evaluation, summary_li
 from stylemotion.io.errors import UserInputError
 from stylemotion.io.jsonfile import write_json
 from stylemotion.io.outputs import inside, safe_name
-from stylemotion.primitives import SegmentSettings, action_of, parse_primitive, segment_takes
+from stylemotion.primitives.segmentation import SegmentSettings, action_of, parse_primitive, segment_takes
 from stylemotion.provenance import provenance
 
 log = logging.getLogger(__name__)
@@ -241,7 +241,7 @@ class Reproduction:
 
     def run_stage(self, index: int, stage: Stage) -> None:
         """Train ``stage`` in this process (or reuse/resume it)."""
-        from stylemotion.training import run as train_run
+        from stylemotion.training.fit import run as train_run
 
         resume = self.prepare_stage(index, stage)
         if resume is None:
@@ -372,7 +372,7 @@ def stage_train_config(overrides: Sequence[str], values: dict[str, Any], data_cf
 def _train_in_worker(container: dict[str, Any]) -> tuple[dict[str, Any], float]:
     """A worker process's (or submitit job's) work: :func:`stylemotion.training.run` on a resolved
     ``train`` config; returns its metrics and its training seconds (not counting the wait in the queue)."""
-    from stylemotion.training import run as train_run
+    from stylemotion.training.fit import run as train_run
 
     t0 = time.perf_counter()
     metrics = train_run(OmegaConf.create(container))["metrics"]

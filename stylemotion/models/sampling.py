@@ -25,7 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 import torch
 
-from stylemotion.primitives import restore_duration
+from stylemotion.primitives.segmentation import restore_duration
 from stylemotion.representation import FRAME_DIM, frames_to_positions
 from stylemotion.skeleton import NUM_JOINTS
 

@@ -38,7 +38,7 @@ BONE_NAMES: tuple[str, ...] = tuple(CANONICAL_JOINTS[j] for j in BONE_JOINTS)
 #: Number of bones of the canonical skeleton (20).
 NUM_BONES = len(BONE_JOINTS)
 #: Bone indices (into :data:`BONE_NAMES`) of the thigh and the shin of each leg: the hip-to-ankle
-#: chain of :func:`stylemotion.contacts.leg_length`.
+#: chain of :func:`stylemotion.primitives.contacts.leg_length`.
 _LEG_BONES = {side: (BONE_NAMES.index(f"LowerLeg_{side}"), BONE_NAMES.index(f"Foot_{side}")) for side in "LR"}
 _ROOT = JOINT_INDEX["Hips"]
 
@@ -77,7 +77,7 @@ def target_bone_lengths(takes: Iterable[np.ndarray]) -> np.ndarray:
 def leg_length(lengths: np.ndarray) -> np.ndarray:
     """Hip-to-ankle length (thigh + shin, mean of both legs) of a skeleton given by its bones.
 
-    The same chain as :func:`stylemotion.contacts.leg_length`, from bone lengths instead of positions.
+    The same chain as :func:`stylemotion.primitives.contacts.leg_length`, from bone lengths instead of positions.
 
     Args:
         lengths: ``(..., 20)`` bone lengths, metres.

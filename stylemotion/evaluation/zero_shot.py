@@ -49,7 +49,6 @@ from stylemotion.evaluation.pipeline import example_column_gram, real_side, reco
 from stylemotion.evaluation.settings import EvalSettings
 from stylemotion.evaluation.sources import check_one_autoencoder
 from stylemotion.evaluation.tables import across_sample_sd, distance_table
-from stylemotion.finished_run import FinishedRun, read_json_object
 from stylemotion.io.atomic import atomic_write_bytes
 from stylemotion.io.errors import UserInputError
 from stylemotion.io.jsonfile import write_json
@@ -57,8 +56,9 @@ from stylemotion.io.outputs import check_new_output, inside
 from stylemotion.models.checkpoints import fingerprint, load_autoencoder
 from stylemotion.models.loading import NEUTRAL, EvalModel, load_generative, load_model
 from stylemotion.models.zero_shot import ZeroShotStyleVAE
-from stylemotion.primitives import parse_primitive
+from stylemotion.primitives.segmentation import parse_primitive
 from stylemotion.provenance import provenance
+from stylemotion.training.run_folder import FinishedRun, read_json_object
 
 log = logging.getLogger(__name__)
 
@@ -76,7 +76,7 @@ class ZeroShotRunError(UserInputError, ValueError):
 
 class ReproduceRun(FinishedRun):
     """What the evaluation reads of a finished ``stylemotion-reproduce`` run (see :func:`read_run` and
-    :class:`stylemotion.finished_run.FinishedRun`): its CVAEs by primitive and style."""
+    :class:`stylemotion.training.run_folder.FinishedRun`): its CVAEs by primitive and style."""
 
     @property
     def cvaes(self) -> dict[tuple[str, str], Path]:
@@ -175,7 +175,7 @@ def train_left_out(run: ReproduceRun, primitive: str, style: str, folder: Path, 
                    overrides: Sequence[str] = (), threads: Any = None) -> tuple[Path, float]:
     """Train the zero-shot network of ``primitive`` without ``style`` into ``folder``; its best checkpoint
     and the training seconds."""
-    from stylemotion.training import run as train_run
+    from stylemotion.training.fit import run as train_run
 
     t0 = time.perf_counter()
     metrics = train_run(train_config(run, primitive, style, folder, epochs, overrides, threads))["metrics"]

@@ -1,7 +1,7 @@
 """What later tools read of a finished ``stylemotion-reproduce`` run folder: its ``reproduce.json``
 (stages, their checkpoints, overrides and values) and the ``meta`` of its ``report/report.json`` (data
 config, seed, evaluation settings). Used by ``stylemotion-style`` (:mod:`stylemotion.style_example`) and
-the leave-one-style-out evaluation (:mod:`stylemotion.evaluation_zero_shot`), which each check what
+the leave-one-style-out evaluation (:mod:`stylemotion.evaluation.zero_shot`), which each check what
 they need of it."""
 
 from __future__ import annotations

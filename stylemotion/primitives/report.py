@@ -33,7 +33,7 @@ from stylemotion.datasets import Take, TakeSet, build_dataset
 from stylemotion.io.atomic import atomic_folder
 from stylemotion.io.jsonfile import write_json
 from stylemotion.io.outputs import check_new_output, inside, safe_name
-from stylemotion.primitives import (
+from stylemotion.primitives.segmentation import (
     PRIMITIVES,
     Clip,
     Segmentation,
@@ -191,7 +191,7 @@ def format_report(report: dict[str, Any], command: str, plots: list[str], sheets
            "Definitions: a *step* is one foot's single-support phase; it is *complete* when both its support "
            "transfers (double support of a walk, flight of a run) lie in the take, and a *border* step "
            "otherwise. Coverage = clips / complete steps. Keyframes are the middle frames of the support "
-           "transfers (see stylemotion/primitives.py).", ""]
+           "transfers (see stylemotion/primitives/segmentation.py).", ""]
     out += ["## Step coverage", ""]
     out += _table(report["coverage_total"] + report["coverage_by_action"],
                   ["scope", "action", "complete_steps", "clips", "rejected_steps", "border_steps",

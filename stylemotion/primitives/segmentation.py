@@ -20,8 +20,8 @@ from typing import Any
 
 import numpy as np
 
-from stylemotion.contacts import ContactSettings, foot_contacts, leg_length, planted_point_speed
 from stylemotion.datasets.base import Take
+from stylemotion.primitives.contacts import ContactSettings, foot_contacts, leg_length, planted_point_speed
 from stylemotion.representation import FRAME_DIM, ROOT_JOINT, VELOCITY_DIMS, frames_to_positions
 
 #: The six primitives of each locomotion action (DFKI walk graph naming).
@@ -424,7 +424,7 @@ def stance_speeds(positions: np.ndarray, fps: float, stance_foot: int,
                   contacts: np.ndarray | None = None) -> dict[str, float]:
     """How still the planted foot is in a stance clip, against the swinging foot.
 
-    Speeds are of each foot's slower point (:func:`stylemotion.contacts.planted_point_speed`).
+    Speeds are of each foot's slower point (:func:`stylemotion.primitives.contacts.planted_point_speed`).
 
     Args:
         positions: ``(frames, 21, 3)`` clip positions, metres.

@@ -4,7 +4,7 @@ One definition for every caller: the evaluation's foot-skating metric
 (:mod:`stylemotion.evaluation.metrics`), synthesis's check of its own walks
 (:mod:`stylemotion.synthesis.quality`) and new styles' reports. Motions are padded
 ``(n, frames, 21, 3)`` positions in metres with ``num_frames`` valid frames each, as in
-:class:`stylemotion.sampling.MotionSamples`.
+:class:`stylemotion.models.sampling.MotionSamples`.
 """
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from stylemotion.contacts import foot_contacts, planted_point_speed
+from stylemotion.primitives.contacts import foot_contacts, planted_point_speed
 from stylemotion.skeleton import NUM_JOINTS
 
 #: Planted-point speed (m/s) above which a foot in contact counts as skating.
@@ -54,11 +54,11 @@ def foot_skating(positions: np.ndarray, num_frames: np.ndarray, fps: float, rest
                  stance_foot: int | None = None, skate_speed: float = SKATE_SPEED_MPS) -> FootSkating:
     """Foot-skating ratio: the share of foot-frames in ground contact whose foot slides.
 
-    Contacts come from THE contact detector, :func:`stylemotion.contacts.foot_contacts` (a foot is
+    Contacts come from THE contact detector, :func:`stylemotion.primitives.contacts.foot_contacts` (a foot is
     in contact while its heel or ball is low and slow, with hysteresis), judged against the resting
     heights of **real** data (``rest_heights``), so a floating foot is never in contact. A contact
     foot-frame *skates* when the foot's planted-point speed
-    (:func:`stylemotion.contacts.planted_point_speed`: the slower of heel and ball, horizontal,
+    (:func:`stylemotion.primitives.contacts.planted_point_speed`: the slower of heel and ball, horizontal,
     m/s) exceeds ``skate_speed``. Because the detector itself needs the foot to be slow, a foot
     that slides fast through a whole stance is not in contact at all: ``no_plant_share`` (stance
     foot never in contact) and ``planted_mid_mps`` (its speed over the middle half of the motion)
