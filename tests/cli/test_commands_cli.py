@@ -3,8 +3,8 @@
 ``--help`` of each Hydra command (description, main keys, examples); ``stylemotion-data`` writes its
 summary to ``prepare.log``; ``threads=abc|0|-1`` (eval, generate), ``stylemotion-convert --fps 0|nan|inf|-5``
 and convert outputs that are a folder or not ``.npz`` end in ``stylemotion-<command>: …`` without a
-traceback. The Hydra commands run as ``python -m stylemotion.cli.<module>`` in a subprocess; convert's
-``main`` runs in-process (and once as a subprocess).
+traceback. The commands' entry functions run in-process (:func:`cli_runner.run_command`); one subprocess per
+family checks that the installed console scripts start (a Hydra command's ``--help``, convert's one-line error).
 """
 
 from __future__ import annotations
@@ -15,6 +15,7 @@ import sys
 from pathlib import Path
 
 import pytest
+from cli_runner import Done, run_command
 
 from stylemotion.cli.convert import main as convert_main
 
@@ -41,7 +42,7 @@ def command(module: str, *args: str, cwd: Path, timeout: float = 120) -> subproc
                           capture_output=True, text=True, timeout=timeout)
 
 
-def one_line_error(done: subprocess.CompletedProcess, script: str) -> str:
+def one_line_error(done: subprocess.CompletedProcess | Done, script: str) -> str:
     """The message of a command that refused its input: exit status 2, one line, no traceback."""
     assert done.returncode == 2, done.stdout[-2000:] + done.stderr[-2000:]
     assert "Traceback" not in done.stderr
@@ -51,9 +52,9 @@ def one_line_error(done: subprocess.CompletedProcess, script: str) -> str:
 
 
 @pytest.mark.parametrize("module", COMMANDS)
-def test_help_describes_the_command_its_keys_and_examples(module: str, tmp_path: Path) -> None:
+def test_help_describes_the_command_its_keys_and_examples(module: str, tmp_path: Path, capsys, monkeypatch) -> None:
     script, phrase, key = COMMANDS[module]
-    done = command(module, "--help", cwd=tmp_path)
+    done = run_command(module, "--help", cwd=tmp_path, capsys=capsys, monkeypatch=monkeypatch)
     assert done.returncode == 0, done.stderr[-2000:]
     text = done.stdout
     assert text.startswith(f"{script}: ") and phrase in text
@@ -63,10 +64,21 @@ def test_help_describes_the_command_its_keys_and_examples(module: str, tmp_path:
     assert not list(tmp_path.iterdir())  # --help runs nothing
 
 
-def test_data_command_logs_its_summary_to_the_run_folder(tmp_path: Path) -> None:
+def test_an_installed_hydra_console_script_starts_and_prints_its_help(tmp_path: Path) -> None:
+    """The one subprocess of the Hydra commands: the script pip installed, not ``python -m``."""
+    script = Path(sys.executable).parent / "stylemotion-search"
+    done = subprocess.run([str(script), "--help"], cwd=tmp_path, capture_output=True, text=True, timeout=120,
+                          env={**os.environ, "PYTHONWARNINGS": "ignore"})
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert done.stdout.startswith("stylemotion-search: ") and "== Main keys ==" in done.stdout
+    assert not list(tmp_path.iterdir())
+
+
+def test_data_command_logs_its_summary_to_the_run_folder(tmp_path: Path, capsys, monkeypatch) -> None:
     out = tmp_path / "run"
-    done = command("prepare", "data.takes_per_pair=3", "data.duration_s=2.0", "data.contents=[walk]",
-                   "data.styles=[normal]", f"hydra.run.dir={out}", cwd=tmp_path)
+    done = run_command("prepare", "data.takes_per_pair=3", "data.duration_s=2.0", "data.contents=[walk]",
+                       "data.styles=[normal]", f"hydra.run.dir={out}", cwd=tmp_path, capsys=capsys,
+                       monkeypatch=monkeypatch)
     assert done.returncode == 0, done.stderr[-2000:]
     log = (out / "prepare.log").read_text()
     assert "summary written to" in log and "walk" in log and "[INFO]" in log
@@ -74,11 +86,12 @@ def test_data_command_logs_its_summary_to_the_run_folder(tmp_path: Path) -> None
 
 
 @pytest.mark.parametrize("module, threads", [("evaluate", "abc"), ("generate", "0"), ("generate", "-1")])
-def test_bad_threads_is_one_line_naming_the_key(module: str, threads: str, tmp_path: Path) -> None:
+def test_bad_threads_is_one_line_naming_the_key(module: str, threads: str, tmp_path: Path, capsys,
+                                               monkeypatch) -> None:
     script = COMMANDS[module][0]
     extra = ["checkpoints=[nothing]"] if module == "evaluate" else []
-    done = command(module, f"threads={threads}", f"out={tmp_path / 'out'}", *extra,
-                   f"hydra.run.dir={tmp_path / 'hydra'}", cwd=tmp_path)
+    done = run_command(module, f"threads={threads}", f"out={tmp_path / 'out'}", *extra,
+                       f"hydra.run.dir={tmp_path / 'hydra'}", cwd=tmp_path, capsys=capsys, monkeypatch=monkeypatch)
     value = threads if threads == "abc" else int(threads)  # as Hydra parses it
     assert one_line_error(done, script) == f"{script}: threads must be a whole number ≥ 1, got {value!r}"
     assert not (tmp_path / "out").exists()
