@@ -165,3 +165,16 @@ def line_of(text: str, needle: str, occurrence: int = 0) -> int:
     if len(hits) <= occurrence:
         raise AssertionError(f"{needle!r} occurs on {len(hits)} lines, wanted occurrence {occurrence}")
     return hits[occurrence]
+
+
+# ---------------------------------------------------------------------------------------------
+# One tiny finished stylemotion-reproduce run, trained once per test run (tests/reproduce_fixtures.py).
+
+
+@pytest.fixture(scope="session")
+def tiny_run(tmp_path_factory):
+    """The shared tiny reproduce run (:class:`reproduce_fixtures.TinyRun`); tests that change a run copy it first
+    (:func:`reproduce_fixtures.copy_run`)."""
+    from reproduce_fixtures import train_tiny_run
+
+    return train_tiny_run(tmp_path_factory.getbasetemp())

@@ -13,7 +13,9 @@ from pathlib import Path
 
 import pytest
 import torch
+from cli_runner import run_command
 from hydra import compose, initialize_config_dir
+from reproduce_fixtures import DATA, copy_run, reproduce, tiny_overrides
 from vae_fixtures import feature_module, fit, tiny_autoencoder_ckpt
 
 import stylemotion
@@ -24,50 +26,17 @@ from stylemotion.evaluation.sources import MissingExampleError, MixedAutoencoder
 from stylemotion.io.outputs import OutputExistsError
 from stylemotion.models.vae import PrimitiveVAE
 from stylemotion.training.reproduction import Reproduction, StageConflictError, choose_budget
-from stylemotion.training.reproduction import reproduce as run_reproduction
 
 register_schemas()  # the configs composed here take structured schemas (stylemotion.cli.schemas)
 
 torch.set_num_threads(1)
-QUIET = "trainer.enable_progress_bar=false,callbacks.progress_bar=null,trainer.enable_model_summary=false," \
-        "trainer.num_sanity_val_steps=0,~logger"
-# the model stages keep the configs' progress-bar callback: worker processes must drop it themselves
-QUIET_MODELS = "trainer.enable_model_summary=false,trainer.num_sanity_val_steps=0,~logger"
-DATA = ["data.takes_per_pair=6", "data.duration_s=6.0", "data.styles=[normal,elderly,youthful]", "data.contents=[walk]"]
-EVAL = ["evaluation.samples.table_5_1=100", "evaluation.samples.variance=300", "evaluation.samples.metrics=100",
-        "evaluation.classifier.components=8"]
 
 
-def stage_list(name: str, items: str) -> str:
-    """``stages.<name>=['a=1','b=2']``: a list of overrides as one override (quoted items)."""
-    return f"stages.{name}=[" + ",".join(f"'{item}'" for item in items.split(",")) + "]"
-
-
-def tiny_overrides(out: Path, vae_epochs: int = 12) -> list[str]:
-    return DATA + EVAL + [
-        f"out={out}", "threads=1", "primitives=[walk_leftStance]",
-        stage_list("autoencoder", "experiment=smoke,model.hidden_units=32,trainer.max_steps=40,trainer.max_epochs=20,"
-                                  "trainer.limit_train_batches=null,datamodule.window_frames=30,datamodule.stride=15,"
-                                  + QUIET),
-        stage_list("vae", f"experiment=primitive_vae,trainer.max_epochs={vae_epochs},datamodule.min_train_clips=8,"
-                          "callbacks.samples=null," + QUIET_MODELS),
-        stage_list("cvae", "experiment=style_cvae,trainer.max_epochs=12,datamodule.min_train_clips=8,"
-                           "callbacks.samples.num_samples=4," + QUIET_MODELS),
-    ]
-
-
-def reproduce(overrides: list[str], lines: list[str] | None = None) -> dict:
-    with initialize_config_dir(config_dir=str(CONFIG_DIR), version_base="1.3"):
-        cfg = compose(config_name="reproduce", overrides=overrides)
-        return run_reproduction(cfg, say=(lines.append if lines is not None else print))
-
-
-@pytest.fixture(scope="module")
-def reproduced(tmp_path_factory):
-    out = tmp_path_factory.mktemp("reproduce") / "run"
-    lines: list[str] = []
-    summary = reproduce(tiny_overrides(out), lines)
-    return out, summary, lines
+@pytest.fixture
+def reproduced(tiny_run):
+    """The shared tiny run (conftest.py): its folder, the summary and the lines ``reproduce`` printed. Tests that
+    change a run work on a copy (``copy_run``)."""
+    return tiny_run.folder, tiny_run.summary, tiny_run.lines
 
 
 def data_cfg() -> dict:
@@ -83,14 +52,16 @@ def eval_cfg() -> dict:
 
 def test_reproduce_runs_every_stage_into_a_report(reproduced) -> None:
     out, summary, lines = reproduced
-    assert [s["name"] for s in summary["stages"]] == ["autoencoder", "vae walk_leftStance",
-                                                      "cvae walk_leftStance/elderly", "cvae walk_leftStance/youthful"]
+    assert [s["name"] for s in summary["stages"]] == [
+        "autoencoder", "vae walk_leftStance", "vae walk_rightStance", "cvae walk_leftStance/elderly",
+        "cvae walk_leftStance/youthful", "cvae walk_rightStance/elderly", "cvae walk_rightStance/youthful"]
     assert {s["status"] for s in summary["stages"]} == {"trained"}
-    assert [line[:5] for line in lines if line.startswith("[")] == [f"[{k}/6]" for k in range(1, 7)]
+    assert [line[:5] for line in lines if line.startswith("[")] == [f"[{k}/9]" for k in range(1, 10)]
     report = json.loads((out / "report" / "report.json").read_text())
-    assert report["table_5_1"]["walk_leftStance"]["models"] == ["neutral", "elderly", "youthful"]
+    for primitive in ("walk_leftStance", "walk_rightStance"):
+        assert report["table_5_1"][primitive]["models"] == ["neutral", "elderly", "youthful"]
     assert report["style_recognition"]["classifier_heldout_accuracy"] >= 0.8  # real clips, chance 1/3
-    assert len(report["meta"]["checkpoints"]) == 3 and report["meta"]["samples"]["variance"] == 300
+    assert len(report["meta"]["checkpoints"]) == 6 and report["meta"]["samples"]["variance"] == 300
     assert (out / "cvae" / "walk_leftStance_elderly" / "samples").is_dir()  # the training stages' GIFs
     assert lines[0] == "budget: budget/synthetic"
 
@@ -117,22 +88,30 @@ def test_the_run_records_paths_relative_to_its_folder(reproduced) -> None:
 
 
 def test_parallel_stages_train_the_same_models_as_sequential_ones(reproduced, tmp_path: Path) -> None:
-    """workers=2 (the fixture: VAE and CVAEs in spawned processes) and workers=1 (all in this process)
-    give the same models: same seeds, one torch thread each."""
+    """workers=2 (the fixture: VAEs and CVAEs in spawned processes) and workers=1 (all in this process)
+    give the same models: same seeds, one torch thread each. The sequential run trains the fixture's stages of
+    one primitive and one style (the same settings): the same stages, the same Table 5.1 entries."""
     out, parallel, _ = reproduced
-    sequential = reproduce(tiny_overrides(tmp_path / "seq") + ["workers=1"], [])
-    for a, b in zip(parallel["stages"], sequential["stages"], strict=True):
-        assert a["name"] == b["name"] and a["metrics"]["global_step"] == b["metrics"]["global_step"]
+    sequential = reproduce(tiny_overrides(tmp_path / "seq") + ["workers=1", "primitives=[walk_leftStance]",
+                                                                "styles=[elderly]"], [])
+    names = ["autoencoder", "vae walk_leftStance", "cvae walk_leftStance/elderly"]
+    assert [s["name"] for s in sequential["stages"]] == names
+    assert {s["status"] for s in sequential["stages"]} == {"trained"}
+    by_name = {s["name"]: s for s in parallel["stages"]}
+    for b in sequential["stages"]:
+        a = by_name[b["name"]]
+        assert a["metrics"]["global_step"] == b["metrics"]["global_step"]
         assert a["metrics"]["test"] == pytest.approx(b["metrics"]["test"], rel=1e-5), a["name"]
-    def table(folder: Path) -> list[float]:
+
+    def table(folder: Path, models: int) -> list[float]:
         rows = json.loads((folder / "report" / "report.json").read_text())["table_5_1"]["walk_leftStance"]["distance"]
-        return [value for row in rows for value in row]
+        return [value for row in rows[:models] for value in row[:models]]
 
-    assert table(tmp_path / "seq") == pytest.approx(table(out), rel=1e-5)
+    assert table(tmp_path / "seq", 2) == pytest.approx(table(out, 2), rel=1e-5)  # neutral and elderly
 
 
-def test_rerun_reuses_finished_stages_and_resumes_an_interrupted_one(reproduced) -> None:
-    out, _, _ = reproduced
+def test_rerun_reuses_finished_stages_and_resumes_an_interrupted_one(tiny_run, tmp_path: Path) -> None:
+    out = copy_run(tiny_run, tmp_path / "run")
     interrupted = out / "cvae" / "walk_leftStance_youthful"
     (interrupted / "done.json").unlink()  # as if killed after its last checkpoint
     before = (out / "report" / "report.json").read_text()
@@ -141,7 +120,7 @@ def test_rerun_reuses_finished_stages_and_resumes_an_interrupted_one(reproduced)
                           capture_output=True, text=True, env=env, timeout=300)
     assert proc.returncode == 0, proc.stderr[-3000:]
     steps = [line for line in proc.stdout.splitlines() if line.startswith("[")]
-    assert sum(": reused " in line for line in steps) == 4, proc.stdout  # autoencoder, vae, elderly cvae, report
+    assert sum(": reused " in line for line in steps) == 7, proc.stdout  # autoencoder, 2 vaes, 3 cvaes, report
     assert f"resuming from {interrupted / 'checkpoints' / 'last.ckpt'}" in proc.stdout
     log_text = max((out / "hydra").glob("*/reproduce.log"), key=lambda f: f.stat().st_mtime).read_text()
     assert "resuming from" in log_text and "report:" in log_text  # the run folder keeps what the console showed
@@ -157,12 +136,12 @@ def test_a_moved_run_reuses_its_own_stages(reproduced, tmp_path: Path) -> None:
     lines: list[str] = []
     summary = reproduce(tiny_overrides(moved), lines)
     reused = [line for line in lines if line.startswith("[") and ": reused " in line]
-    assert len(reused) == 5 and all(str(moved) in line for line in reused), lines
+    assert len(reused) == 8 and all(str(moved) in line for line in reused), lines
     assert {s["status"] for s in summary["stages"]} == {"reused"}
 
 
-def test_changed_settings_are_refused_not_overwritten(reproduced) -> None:
-    out, _, _ = reproduced
+def test_changed_settings_are_refused_not_overwritten(tiny_run, tmp_path: Path) -> None:
+    out = copy_run(tiny_run, tmp_path / "run")
     done = (out / "vae" / "walk_leftStance" / "done.json").read_text()
     with pytest.raises(StageConflictError, match="other settings") as err:
         reproduce(tiny_overrides(out, vae_epochs=13), [])
@@ -170,20 +149,24 @@ def test_changed_settings_are_refused_not_overwritten(reproduced) -> None:
     assert (out / "vae" / "walk_leftStance" / "done.json").read_text() == done
 
 
-def test_eval_cli_writes_a_report_and_refuses_an_existing_folder(reproduced, tmp_path: Path) -> None:
+def test_eval_cli_writes_a_report_and_refuses_an_existing_folder(reproduced, tmp_path: Path, capsys,
+                                                                 monkeypatch) -> None:
+    """``stylemotion-eval`` (in-process) on the run's models of walk_leftStance: folders of checkpoints."""
     out, _, _ = reproduced
     report = tmp_path / "eval"
-    args = [sys.executable, "-m", "stylemotion.cli.evaluate", *DATA, f"checkpoints=[{out / 'vae'},{out / 'cvae'}]",
-            f"out={report}", "evaluation.samples.table_5_1=50", "evaluation.samples.variance=100",
-            "evaluation.samples.metrics=50", "evaluation.classifier.components=6", "threads=1"]
-    env = {**os.environ, "OMP_NUM_THREADS": "1"}
-    proc = subprocess.run(args, capture_output=True, text=True, cwd=tmp_path, env=env, timeout=300)
-    assert proc.returncode == 0, proc.stderr[-3000:]
-    assert "Table 5.1 walk_leftStance" in proc.stdout and (report / "report.md").is_file()
+    models = [out / "vae" / "walk_leftStance", out / "cvae" / "walk_leftStance_elderly",
+              out / "cvae" / "walk_leftStance_youthful"]
+    args = [*DATA, f"checkpoints=[{','.join(map(str, models))}]", f"out={report}",
+            "evaluation.samples.table_5_1=50", "evaluation.samples.variance=100", "evaluation.samples.metrics=50",
+            "evaluation.classifier.components=6", "threads=1"]
+    done = run_command("evaluate", *args, cwd=tmp_path, capsys=capsys, monkeypatch=monkeypatch)
+    assert done.returncode == 0, done.stderr[-3000:]
+    assert "Table 5.1 walk_leftStance" in done.stdout and (report / "report.md").is_file()
     saved = json.loads((report / "report.json").read_text())
     assert saved["meta"]["autoencoder"]["path"] == str((out / "autoencoder" / "checkpoints" / "best.ckpt").resolve())
-    proc = subprocess.run(args, capture_output=True, text=True, cwd=tmp_path, env=env, timeout=300)
-    assert proc.returncode != 0 and "already exists" in proc.stderr
+    assert saved["table_5_1"]["walk_leftStance"]["models"] == ["neutral", "elderly", "youthful"]
+    done = run_command("evaluate", *args, cwd=tmp_path, capsys=capsys, monkeypatch=monkeypatch)
+    assert done.returncode != 0 and "already exists" in done.stderr
     assert json.loads((report / "report.json").read_text()) == saved
 
 
@@ -332,8 +315,10 @@ def test_a_users_bvh_folder_end_to_end_with_stages_as_submitit_jobs(tmp_path: Pa
     monkeypatch.setenv("OMP_NUM_THREADS", "1")
     write_user_mocap(home / "mocap")
     configs = write_user_configs(tmp_path / "configs")
-    user = [f"hydra.searchpath=[file://{configs}]", "data=mine", 'data.root="~/mocap"', "executor=local", "workers=2"]
-    overrides = [o for o in tiny_overrides(home / "x") if not o.startswith(("data.", "out="))] + user
+    user = [f"hydra.searchpath=[file://{configs}]", "data=mine", 'data.root="~/mocap"', "executor=local", "workers=2",
+            "primitives=[walk_leftStance]"]
+    overrides = [o for o in tiny_overrides(home / "x")  # the user's data has no budget: the default one
+                 if not o.startswith(("data.", "out=", "primitives=", "++budget."))] + user
     out = home / "runs" / "mine"
     blocker = out / "cvae" / "walk_leftStance_youthful" / "checkpoints"
     blocker.parent.mkdir(parents=True)
