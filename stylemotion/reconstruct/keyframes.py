@@ -57,6 +57,9 @@ EFFECTORS = np.array([JOINT_INDEX[j] for j in E15_JOINTS])
 HIPS = JOINT_INDEX["Hips"]
 #: Nearest-neighbour E15 distance (metres) above which a keyframe's pose is reported as far from the database.
 FAR_KEY_M = 0.5
+#: Longest time (seconds) from the first key to the last: the motion planned between them is allocated frame by
+#: frame, so a key at a huge time is refused before anything is built (docs/reconstruct.md, "Keyframe files").
+MAX_KEYS_SPAN_S = 600.0
 
 Say = Callable[[str], None]
 
@@ -82,8 +85,8 @@ class Keyframe:
 
 
 def check_keyframes(keys: Sequence[Keyframe]) -> list[Keyframe]:
-    """The keys as given, checked: at least two, poses ``(21, 3)`` finite, times finite and strictly increasing
-    (KeyframeError naming the key otherwise)."""
+    """The keys as given, checked: at least two, poses ``(21, 3)`` finite, times finite and strictly increasing,
+    the last at most :data:`MAX_KEYS_SPAN_S` after the first (KeyframeError naming the key otherwise)."""
     keys = list(keys)
     if len(keys) < 2:
         raise KeyframeError(f"{len(keys)} keyframe(s) given; a motion needs at least 2")
@@ -98,6 +101,10 @@ def check_keyframes(keys: Sequence[Keyframe]) -> list[Keyframe]:
         if i and key.time_s <= keys[i - 1].time_s:
             raise KeyframeError(f"keyframe {i}: time {key.time_s:g} s is not after keyframe {i - 1}'s "
                                 f"{keys[i - 1].time_s:g} s (keys must be in time order)")
+        if key.time_s - keys[0].time_s > MAX_KEYS_SPAN_S:
+            raise KeyframeError(f"keyframe {i}: time {key.time_s:g} s is {key.time_s - keys[0].time_s:g} s after the "
+                                f"first key; the keys may span at most {MAX_KEYS_SPAN_S:g} s (split the motion, or "
+                                "check the time's unit: seconds)")
     return keys
 
 
