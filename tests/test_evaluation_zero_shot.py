@@ -9,11 +9,9 @@ from pathlib import Path
 
 import pytest
 import torch
-from hydra import compose, initialize_config_dir
 from omegaconf import OmegaConf
 
 from stylemotion.cli.schemas import register_schemas
-from stylemotion.config import CONFIG_DIR
 from stylemotion.evaluation.zero_shot import (
     ZeroShotRunError,
     leave_one_style_out,
@@ -25,49 +23,29 @@ from stylemotion.evaluation.zero_shot import (
 from stylemotion.io.outputs import OutputExistsError
 from stylemotion.models.checkpoints import fingerprint, load_autoencoder
 from stylemotion.models.loading import load_generative
-from stylemotion.training.reproduction import reproduce
 
 register_schemas()  # the configs composed here take structured schemas (stylemotion.cli.schemas)
 
 torch.set_num_threads(1)
 PRIMITIVE = "walk_leftStance"
-QUIET = "trainer.enable_progress_bar=false,callbacks.progress_bar=null,trainer.enable_model_summary=false," \
-        "trainer.num_sanity_val_steps=0,~logger"
 #: The networks: tiny, two epochs.
 NETWORK = ["model.hidden=[64,32]", "model.embedding_dim=8", "model.samples_per_item=4", "datamodule.min_train_clips=8",
            "trainer.enable_model_summary=false", "trainer.num_sanity_val_steps=0", "~logger"]
 
 
-def _stage(name: str, items: str) -> str:
-    return f"stages.{name}=[" + ",".join(f"'{item}'" for item in items.split(",")) + "]"
-
-
 @pytest.fixture(scope="module")
-def run(tmp_path_factory) -> Path:
-    """A finished reproduce run of walk_leftStance on straight walks of normal, elderly and youthful, CVAEs of
-    both styles (every stage a second or two)."""
-    out = tmp_path_factory.mktemp("zero_shot") / "run"
-    overrides = ["data.takes_per_pair=6", "data.duration_s=6.0", "data.styles=[normal,elderly,youthful]",
-                 "data.contents=[walk]", f"out={out}", "threads=1", "workers=1", f"primitives=[{PRIMITIVE}]",
-                 "evaluation.samples.table_5_1=40", "evaluation.samples.variance=40", "evaluation.samples.metrics=40",
-                 "evaluation.classifier.components=6",
-                 _stage("autoencoder", "experiment=smoke,model.hidden_units=32,trainer.max_steps=40,"
-                                       "trainer.max_epochs=20,trainer.limit_train_batches=null,datamodule.window_frames=30,"
-                                       "datamodule.stride=15," + QUIET),
-                 _stage("vae", "experiment=primitive_vae,trainer.max_epochs=10,datamodule.min_train_clips=8,"
-                               "callbacks.samples=null," + QUIET),
-                 _stage("cvae", "experiment=style_cvae,trainer.max_epochs=10,datamodule.min_train_clips=8,"
-                                "callbacks.samples=null,model.style_weight=20.0," + QUIET)]
-    with initialize_config_dir(config_dir=str(CONFIG_DIR), version_base="1.3"):
-        reproduce(compose(config_name="reproduce", overrides=overrides), say=lambda _: None)
-    return out
+def run(tiny_run) -> Path:
+    """The shared tiny reproduce run (conftest.py): walks of normal, elderly and youthful, CVAEs of both styles for
+    both stance primitives (this evaluation takes walk_leftStance's)."""
+    return tiny_run.folder
 
 
 @pytest.mark.slow  # a reproduce run, two trainings and two evaluations: ~25 s on one busy core
 def test_leave_one_style_out_end_to_end_on_two_styles(run, tmp_path) -> None:
     out = tmp_path / "loso"
     lines: list[str] = []
-    results = leave_one_style_out(run, out, epochs=2, samples=40, overrides=NETWORK, threads=1, say=lines.append)
+    results = leave_one_style_out(run, out, primitives=[PRIMITIVE], epochs=2, samples=40, overrides=NETWORK, threads=1,
+                                  say=lines.append)
     source = read_run(run)
     styles = results["primitives"][PRIMITIVE]["styles"]
     assert list(styles) == ["elderly", "youthful"] and results["primitives"][PRIMITIVE]["columns"] == [
@@ -89,7 +67,8 @@ def test_leave_one_style_out_end_to_end_on_two_styles(run, tmp_path) -> None:
     assert f"| {PRIMITIVE} | elderly |" in markdown and "zero-shot without youthful → youthful" in markdown
     assert any("without elderly: training" in line for line in lines)
     # the trained networks reused (no training): the same numbers
-    again = leave_one_style_out(run, tmp_path / "again", samples=40, checkpoints=out, threads=1, say=lines.append)
+    again = leave_one_style_out(run, tmp_path / "again", primitives=[PRIMITIVE], samples=40, checkpoints=out, threads=1,
+                                say=lines.append)
     for style, row in again["primitives"][PRIMITIVE]["styles"].items():
         assert row["zero_shot"]["train_seconds"] is None
         assert row["zero_shot"]["table_5_1_row"] == styles[style]["zero_shot"]["table_5_1_row"]

@@ -16,7 +16,7 @@ from pathlib import Path
 
 import pytest
 from hydra import compose, initialize_config_dir
-from style_fixtures import example_bvh, tiny_run
+from style_fixtures import example_bvh
 from test_commands_cli import one_line_error
 
 from stylemotion.config import CONFIG_DIR, ConfigError
@@ -30,8 +30,8 @@ def command(module: str, *args: str, cwd: Path, timeout: float = 300) -> subproc
 
 
 @pytest.fixture(scope="session")
-def run(tmp_path_factory) -> Path:
-    return tiny_run(tmp_path_factory.getbasetemp() / "style_example")
+def run(tiny_run) -> Path:
+    return tiny_run.folder
 
 
 @pytest.mark.realdata
@@ -49,7 +49,7 @@ def test_a_style_from_a_cmu_walk_then_a_walk_in_it(run: Path, other_skeleton_pat
     assert report["example"]["file_range"] == [10, 150] and report["example"]["file_fps"] == 60.0
     for p in ("walk_leftStance", "walk_rightStance"):
         row = report["table_5_1_row"][p]
-        assert list(row) == ["neutral", "elderly", "cmu"] and all(math.isfinite(v) for v in row.values())
+        assert list(row) == ["neutral", "elderly", "youthful", "cmu"] and all(math.isfinite(v) for v in row.values())
         examples = report["models"][p]["examples"]
         assert examples and all(e["file"] == str(bvh) for e in examples)
         assert examples[0]["sha256"] == hashlib.sha256(bvh.read_bytes()).hexdigest()

@@ -94,13 +94,16 @@ def test_neutral_models_are_fitted_on_the_run_data_and_reused(tmp_path: Path) ->
 
 
 @pytest.mark.slow
-def test_reproduce_with_morphable_adds_its_rows_to_the_report(tmp_path: Path) -> None:
-    from test_reproduction import reproduce, tiny_overrides
+def test_reproduce_with_morphable_adds_its_rows_to_the_report(tiny_run, tmp_path: Path) -> None:
+    """On the shared tiny run's autoencoder and walk_leftStance VAE (a copy of those finished stages, reused)."""
+    from reproduce_fixtures import copy_run, reproduce, tiny_overrides
 
-    out = tmp_path / "run"
+    out = copy_run(tiny_run, tmp_path / "run", ("autoencoder", f"vae/{PRIMITIVE}"))
+    narrow = tiny_overrides(out) + [f"primitives=[{PRIMITIVE}]", "styles=[]"]
     lines: list[str] = []
-    summary = reproduce(tiny_overrides(out) + ["styles=[]", "morphable=true"], lines)
+    summary = reproduce(narrow + ["morphable=true"], lines)
     assert [s["kind"] for s in summary["stages"]] == ["autoencoder", "vae"]
+    assert [s["status"] for s in summary["stages"]] == ["reused", "reused"]
     assert (out / "morphable" / PRIMITIVE / "model.npz").is_file()
     report = (out / "report" / "report.md").read_text()
     assert f"*{ROW}* (extra row)" in report and f"| {ROW} |" in report
@@ -109,7 +112,7 @@ def test_reproduce_with_morphable_adds_its_rows_to_the_report(tmp_path: Path) ->
     ratio = results["variance_ratio"][PRIMITIVE][ROW]
     assert 0.5 < ratio["pose_sd"] < 1.5, ratio  # a model of the neutral clips varies about as much as they do
     # a rerun reuses the report and the models; without the switch the report is of other settings
-    reproduce(tiny_overrides(out) + ["styles=[]", "morphable=true"], lines)
+    reproduce(narrow + ["morphable=true"], lines)
     assert any("evaluation: reused" in line for line in lines)
     with pytest.raises(StageConflictError, match="other models or settings"):
-        reproduce(tiny_overrides(out) + ["styles=[]"], [])
+        reproduce(narrow, [])

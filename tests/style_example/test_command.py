@@ -15,7 +15,8 @@ import pytest
 import torch
 import yaml
 from conftest import tiny_bvh_text
-from style_fixtures import SAMPLES, example_bvh, tiny_run, tiny_style
+from reproduce_fixtures import copy_run, reproduce, tiny_overrides
+from style_fixtures import SAMPLES, example_bvh, tiny_style
 
 from stylemotion.config import ConfigError
 from stylemotion.io.outputs import OutputExistsError
@@ -28,13 +29,23 @@ PRIMITIVES = ("walk_leftStance", "walk_rightStance")
 
 
 @pytest.fixture(scope="session")
-def style_folder(tmp_path_factory) -> tuple[Path, dict]:
-    return tiny_style(tmp_path_factory.getbasetemp() / "style_example")
+def style_folder(tiny_run) -> tuple[Path, dict]:
+    return tiny_style(tiny_run.folder)
 
 
 @pytest.fixture(scope="session")
-def run(style_folder) -> Path:
-    return tiny_run(style_folder[0].parent)
+def run(tiny_run) -> Path:
+    return tiny_run.folder
+
+
+@pytest.fixture(scope="module")
+def elderly_run(tiny_run, tmp_path_factory) -> Path:
+    """The shared run with CVAEs of elderly only (its stages reused from a copy, its own report): youthful is then
+    a style of the run's data without a model."""
+    out = tmp_path_factory.mktemp("elderly_run") / "run"
+    copy_run(tiny_run, out, ("autoencoder", "vae", "cvae/walk_leftStance_elderly", "cvae/walk_rightStance_elderly"))
+    reproduce(tiny_overrides(out) + ["styles=[elderly]"], [])
+    return out
 
 
 def test_report_has_a_finite_table_5_1_row_for_every_run_column_and_the_new_example(style_folder) -> None:
@@ -45,7 +56,7 @@ def test_report_has_a_finite_table_5_1_row_for_every_run_column_and_the_new_exam
     for p in PRIMITIVES:
         columns = run_report["table_5_1"][p]["examples"]  # neutral, elderly
         row = report["table_5_1_row"][p]
-        assert list(row) == [*columns, "tired"] and columns == ["neutral", "elderly"]
+        assert list(row) == [*columns, "tired"] and columns == ["neutral", "elderly", "youthful"]
         assert all(isinstance(v, float) and math.isfinite(v) and v > 0 for v in row.values()), row
         nearest = report["nearest_existing_style"][p]
         assert row[nearest] == min(v for k, v in row.items() if k != "tired")
@@ -123,9 +134,9 @@ def _refused(tmp_path: Path, error: type[Exception], message: str, **kwargs) -> 
 
 @pytest.mark.parametrize("name, why", [("elderly", "a model of the run"), ("youthful", "a style of the run's data"),
                                        ("normal", "the run's neutral style"), ("Neutral", "a model of the run")])
-def test_a_taken_name_is_refused(run, tmp_path: Path, name: str, why: str) -> None:
+def test_a_taken_name_is_refused(elderly_run, tmp_path: Path, name: str, why: str) -> None:
     _refused(tmp_path, NameTakenError, rf"name={name} is taken: '{name.lower()}' is {why}",
-             example=str(example_bvh(tmp_path)), run=run, name=name)
+             example=str(example_bvh(tmp_path)), run=elderly_run, name=name)
 
 
 @pytest.mark.parametrize("name", ["my style", "../x", ""])
@@ -191,7 +202,7 @@ def test_a_folder_that_is_no_finished_reproduce_run_is_refused(run, style_folder
     summary["stages"][-1]["status"] = "pending"
     (copy / "reproduce.json").write_text(json.dumps(summary))
     _refused(tmp_path, StyleExampleError, r"not a finished stylemotion-reproduce run: stage\(s\) \['cvae "
-             r"walk_rightStance/elderly'\]", example=example, run=copy)
+             r"walk_rightStance/youthful'\]", example=example, run=copy)  # the last stage
 
 
 def test_an_example_far_outside_the_data_is_flagged() -> None:

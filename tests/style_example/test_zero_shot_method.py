@@ -13,7 +13,7 @@ from pathlib import Path
 import pytest
 import torch
 import yaml
-from style_fixtures import NETWORK_EPOCHS, SAMPLES, example_bvh, tiny_run, tiny_zero_shot_style
+from style_fixtures import NETWORK_EPOCHS, SAMPLES, example_bvh, tiny_zero_shot_style
 
 from stylemotion.config import ConfigError
 from stylemotion.models.loading import load_generative
@@ -30,13 +30,13 @@ SHORT = {"path": {"points": [[0, 0], [0, 2.5]], "spline": False}, "follow": {"ca
 
 
 @pytest.fixture(scope="session")
-def zero_shot(tmp_path_factory) -> tuple[Path, dict]:
-    return tiny_zero_shot_style(tmp_path_factory.getbasetemp() / "style_example")
+def zero_shot(tiny_run) -> tuple[Path, dict]:
+    return tiny_zero_shot_style(tiny_run.folder)
 
 
 @pytest.fixture(scope="session")
-def run(zero_shot) -> Path:
-    return tiny_run(zero_shot[0].parent)
+def run(tiny_run) -> Path:
+    return tiny_run.folder
 
 
 @pytest.fixture(scope="session")
@@ -61,7 +61,8 @@ def test_the_networks_are_trained_in_the_command_on_every_style_and_the_report_i
     run_report = json.loads((run / "report" / "report.json").read_text())
     for p in PRIMITIVES:
         row = report["table_5_1_row"][p]
-        assert list(row) == [*run_report["table_5_1"][p]["examples"], "weary"] == ["neutral", "elderly", "weary"]
+        assert list(row) == [*run_report["table_5_1"][p]["examples"], "weary"] == ["neutral", "elderly", "youthful",
+                                                                                                 "weary"]
         assert all(isinstance(v, float) and math.isfinite(v) and v > 0 for v in row.values()), row
         assert report["nearest_existing_style"][p] == min(("neutral", "elderly"), key=row.get)
         assert not report["example_range"][p]["out_of_range"]

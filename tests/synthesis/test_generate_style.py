@@ -22,8 +22,8 @@ SHORT = {"path": {"points": [[0, 0], [0, 2.5]], "spline": False}, "follow": {"ca
 
 
 @pytest.fixture(scope="session")
-def style_folder(tmp_path_factory) -> Path:
-    return tiny_style(tmp_path_factory.getbasetemp() / "style_example")[0]
+def style_folder(tiny_run) -> Path:
+    return tiny_style(tiny_run.folder)[0]
 
 
 def test_generate_walks_in_the_new_style_from_the_style_folder(style_folder: Path, tmp_path: Path) -> None:
@@ -43,7 +43,7 @@ def test_neutral_and_the_runs_styles_resolve_through_the_style_folder(style_fold
     for style in ("neutral", "normal", "elderly"):
         through, direct = load_graph(style, run=style_folder), load_graph(style, run=run)
         assert through.sources == direct.sources and through.style == direct.style
-    with pytest.raises(UnknownStyleError, match=r"styles there: \['elderly', 'neutral', 'tired'\]"):
+    with pytest.raises(UnknownStyleError, match=r"styles there: \['elderly', 'neutral', 'tired', 'youthful'\]"):
         load_graph("sleepy", run=style_folder)
 
 
