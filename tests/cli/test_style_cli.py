@@ -15,6 +15,7 @@ import sys
 from pathlib import Path
 
 import pytest
+from cli_runner import run_command
 from hydra import compose, initialize_config_dir
 from style_fixtures import example_bvh
 from test_commands_cli import one_line_error
@@ -62,20 +63,23 @@ def test_a_style_from_a_cmu_walk_then_a_walk_in_it(run: Path, other_skeleton_pat
     assert "cmu:" in walk.stdout and (tmp_path / "walk" / "motion.npz").is_file()
 
 
-def test_refused_input_is_one_line_and_writes_nothing(run: Path, tmp_path: Path) -> None:
-    done = command("style", f"example={example_bvh(tmp_path)}", f"run={run}", "name=elderly", f"out={tmp_path / 'out'}",
-                   cwd=tmp_path)
+def test_refused_input_is_one_line_and_writes_nothing(run: Path, tmp_path: Path, capsys, monkeypatch) -> None:
+    done = run_command("style", f"example={example_bvh(tmp_path)}", f"run={run}", "name=elderly",
+                       f"out={tmp_path / 'out'}", f"hydra.run.dir={tmp_path / 'hydra'}", cwd=tmp_path, capsys=capsys,
+                       monkeypatch=monkeypatch)
     message = one_line_error(done, "stylemotion-style")
     assert message.startswith("stylemotion-style: name=elderly is taken: 'elderly' is a model of the run")
     assert not (tmp_path / "out").exists()
 
 
-def test_a_network_that_is_no_zero_shot_network_is_one_line_and_writes_nothing(run: Path, tmp_path: Path) -> None:
+def test_a_network_that_is_no_zero_shot_network_is_one_line_and_writes_nothing(run: Path, tmp_path: Path, capsys,
+                                                                                monkeypatch) -> None:
     cvae = {p: run / "cvae" / f"{p}_elderly" / "checkpoints" / "best.ckpt" for p in ("walk_leftStance",
                                                                                    "walk_rightStance")}
     mapping = "{" + ",".join(f"{p}:'{path}'" for p, path in cvae.items()) + "}"
-    done = command("style", f"example={example_bvh(tmp_path)}", f"run={run}", "name=mine", f"out={tmp_path / 'out'}",
-                   "method=zero_shot", f"network={mapping}", cwd=tmp_path)
+    done = run_command("style", f"example={example_bvh(tmp_path)}", f"run={run}", "name=mine",
+                       f"out={tmp_path / 'out'}", "method=zero_shot", f"network={mapping}",
+                       f"hydra.run.dir={tmp_path / 'hydra'}", cwd=tmp_path, capsys=capsys, monkeypatch=monkeypatch)
     message = one_line_error(done, "stylemotion-style")
     assert message == (f"stylemotion-style: network: {cvae['walk_leftStance']} is a StyleCVAE, not a zero-shot style "
                        "network (stylemotion-train experiment=zero_shot; or network=null trains one here)")
