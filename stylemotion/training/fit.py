@@ -36,8 +36,8 @@ from omegaconf import DictConfig, OmegaConf
 from stylemotion.config import ConfigError, check_trainer_numbers, set_torch_threads
 from stylemotion.io.atomic import atomic_write_bytes
 from stylemotion.io.errors import UserInputError
-from stylemotion.io.jsonfile import write_json
-from stylemotion.io.outputs import OutputExistsError
+from stylemotion.io.jsonfile import read_json, write_json
+from stylemotion.io.outputs import OutputExistsError, UnsafePathError
 from stylemotion.provenance import provenance
 
 log = logging.getLogger(__name__)
@@ -116,6 +116,25 @@ def find_results(output_dir: Path, ckpt_dirs: Sequence[Path], log_dirs: Sequence
     }
 
 
+def check_no_links_out(output_dir: Path, ckpt_dirs: Sequence[Path], log_dirs: Sequence[Path]) -> None:
+    """Refuse a result folder below ``output_dir`` (or a file in it) that is a link leading out of ``output_dir``:
+    ``force=true`` would delete, and the run would write, the files it points to.
+
+    Raises:
+        UnsafePathError: naming the link and the folder.
+    """
+    root = output_dir.resolve()
+    for folder in (*ckpt_dirs, *log_dirs):
+        if not folder.is_relative_to(output_dir):
+            continue  # a folder configured elsewhere on purpose (e.g. callbacks.*.dirpath)
+        paths = [folder, *(sorted(folder.iterdir()) if folder.is_dir() else [])]
+        for path in paths:
+            resolved = path.resolve()
+            if resolved != root and root not in resolved.parents:
+                raise UnsafePathError(f"{path} is a link to {resolved}, outside the run folder {output_dir}: a run "
+                                      "never writes or deletes through it; remove the link or choose another folder")
+
+
 def _delete(paths: Iterable[Path], why: str) -> None:
     paths = list(paths)
     for path in paths:
@@ -134,12 +153,15 @@ def prepare_output(output_dir: Path, ckpt_path: str | None, force: bool, ckpt_di
 
     Raises:
         ConfigError: ``force=true`` together with ``ckpt_path``.
+        UnsafePathError: a result folder (or a file in it) is a link out of the run folder
+            (:func:`check_no_links_out`).
         OutputExistsError: the folder holds results and the run neither resumes nor forces.
         CheckpointNotFoundError: see :func:`resolve_ckpt_path`.
     """
     if force and ckpt_path not in NO_CHECKPOINT:
         raise ConfigError(f"force=true starts afresh (deleting {output_dir}'s checkpoints) and ckpt_path={ckpt_path} "
                           "resumes: pass one of them")
+    check_no_links_out(output_dir, ckpt_dirs, log_dirs)
     resume = resolve_ckpt_path(ckpt_path, output_dir)
     if resume is not None or getattr(rank_zero_only, "rank", 0) != 0:
         return resume
@@ -242,11 +264,12 @@ def run(cfg: DictConfig, extra_callbacks: list[pl.Callback] | None = None,
         callbacks.append(HyperparametersWithMetric(hyperparameters(cfg), str(cfg.get("monitor") or "")))
     else:  # nothing to log the learning rate to (Lightning refuses the monitor without a logger)
         callbacks = [cb for cb in callbacks if not isinstance(cb, LearningRateMonitor)]
-    record = record_start(output_dir, cfg, ckpt_path)
-    _write_text(output_dir / "config_resolved.yaml", OmegaConf.to_yaml(cfg, resolve=True))
-
     pl.seed_everything(cfg.seed, workers=True)
     datamodule, model = build(cfg, datamodule_args)
+    # a resume is checked against the configured model before the run folder is touched
+    resumed_at = check_resume_checkpoint(ckpt_path, model) if ckpt_path is not None else None
+    record = record_start(output_dir, cfg, ckpt_path)
+    _write_text(output_dir / "config_resolved.yaml", OmegaConf.to_yaml(cfg, resolve=True))
     trainer: pl.Trainer = instantiate(cfg.trainer, callbacks=callbacks, logger=loggers or False,
                                       _convert_="all")
     # Same initial weights on every rank (seeded above); from here on each rank draws its own
@@ -258,6 +281,12 @@ def run(cfg: DictConfig, extra_callbacks: list[pl.Callback] | None = None,
     if cfg.get("train", True):
         # checkpoints hold tensors and plain values only, so they load without unpickling code
         trainer.fit(model, datamodule=datamodule, ckpt_path=ckpt_path, weights_only=True)
+        finished = output_dir / "metrics.json"
+        if resumed_at is not None and trainer.global_step == resumed_at and finished.is_file():
+            log.info("%s: the run had finished at step %d and its trainer limits are reached: nothing trained, "
+                     "%s kept as it is", ckpt_path, resumed_at, finished)
+            return {"trainer": trainer, "model": model, "datamodule": datamodule,
+                    "metrics": read_json(finished, "metrics file of the finished run")}
     metrics: dict[str, Any] = {"global_step": trainer.global_step, "epoch": trainer.current_epoch,
                                "data": getattr(datamodule, "summary", None)}
     best = _best_checkpoint(trainer)
@@ -276,6 +305,49 @@ def run(cfg: DictConfig, extra_callbacks: list[pl.Callback] | None = None,
     metrics["git_commit"] = record["git_commit"]
     _write_metrics(output_dir / "metrics.json", metrics)
     return {"trainer": trainer, "model": model, "datamodule": datamodule, "metrics": metrics}
+
+
+class ResumeCheckpointError(UserInputError, ValueError):
+    """``ckpt_path`` names a file that is not a training checkpoint of the configured model."""
+
+
+def check_resume_checkpoint(ckpt_path: str, model: pl.LightningModule) -> int:
+    """The global step at which ``ckpt_path`` resumes ``model``; read (``weights_only=True``) and checked before
+    anything is written: a checkpoint of the same kind of model (``on_load_checkpoint`` accepts its
+    hyperparameters) whose weights have the model's shapes.
+
+    Raises:
+        ResumeCheckpointError: a missing, junk, cut-off or foreign file, another kind of model or other shapes,
+            naming the file.
+    """
+    from stylemotion.models.checkpoints import checkpoint_kind, read_checkpoint
+
+    where = f"ckpt_path={ckpt_path}"
+    try:
+        checkpoint = read_checkpoint(ckpt_path, "checkpoint")
+    except (FileNotFoundError, UserInputError) as exc:
+        raise ResumeCheckpointError(f"{where}: {exc}") from None
+    state, step = checkpoint.get("state_dict"), checkpoint.get("global_step")
+    if not isinstance(state, Mapping) or isinstance(step, bool) or not isinstance(step, int):
+        raise ResumeCheckpointError(f"{where}: not a Lightning training checkpoint (it has {sorted(checkpoint)[:8]}, "
+                                    "no state_dict and global_step); resume from a run's checkpoints/last.ckpt")
+    saved = checkpoint.get("hyper_parameters")
+    saved = dict(saved) if isinstance(saved, Mapping) else {}
+    kind, configured = checkpoint_kind(saved), checkpoint_kind(dict(model.hparams))
+    if kind != configured and None not in (kind, configured):
+        raise ResumeCheckpointError(f"{where}: a {kind} checkpoint, but the configured model is a {configured} "
+                                    f"({type(model).__name__}); resume it with its own experiment")
+    try:
+        model.on_load_checkpoint(dict(checkpoint))
+    except UserInputError as exc:
+        raise ResumeCheckpointError(f"{where}: {exc}") from None
+    own = model.state_dict()
+    bad = [f"{k}: checkpoint {tuple(v.shape)}, model {tuple(own[k].shape)}" for k, v in state.items()
+           if k in own and isinstance(v, torch.Tensor) and tuple(v.shape) != tuple(own[k].shape)]
+    if bad:
+        raise ResumeCheckpointError(f"{where}: its weights do not fit the configured {type(model).__name__} — "
+                                    + "; ".join(bad[:3]) + (" …" if len(bad) > 3 else ""))
+    return step
 
 
 def record_start(output_dir: Path, cfg: DictConfig, ckpt_path: str | None) -> dict[str, Any]:

@@ -1,0 +1,94 @@
+"""``stylemotion-train`` on bad input (issue 26): a resume is checked before the run folder is touched, a finished
+run resumed with nothing left to train keeps its ``metrics.json``, and nothing is written or deleted through a link
+out of the run folder."""
+
+from __future__ import annotations
+
+import shutil
+
+import pytest
+import torch
+from cli_runner import run_command
+from hydra import compose, initialize_config_dir
+
+from stylemotion.config import config_dir
+from stylemotion.io.outputs import UnsafePathError
+from stylemotion.training.fit import ResumeCheckpointError, run
+
+SMOKE = ["experiment=smoke", "data=synthetic", "data.takes_per_pair=3", "data.duration_s=4.0",
+         "data.styles=[normal,elderly]", "data.contents=[walk,run]"]
+
+
+def _cfg(*overrides: str):
+    with initialize_config_dir(config_dir(), version_base="1.3"):
+        return compose("train", overrides=[*SMOKE, *overrides])
+
+
+def _snapshot(folder):
+    return {p: (p.stat().st_mtime_ns, p.read_bytes()) for p in sorted(folder.rglob("*")) if p.is_file()}
+
+
+@pytest.fixture(scope="module")
+def finished(tmp_path_factory):
+    """A finished smoke run (seconds)."""
+    folder = tmp_path_factory.mktemp("train") / "run"
+    run(_cfg(f"output_dir={folder}"))
+    return folder
+
+
+@pytest.fixture
+def run_copy(finished, tmp_path):
+    folder = tmp_path / "run"
+    shutil.copytree(finished, folder)
+    return folder
+
+
+def test_a_mismatched_resume_is_refused_before_the_run_folder_is_touched(run_copy):
+    before = _snapshot(run_copy)
+    with pytest.raises(ResumeCheckpointError, match=r"ckpt_path=.*last\.ckpt: .*hidden_units: checkpoint 32, model 64"):
+        run(_cfg(f"output_dir={run_copy}", "ckpt_path=last", "model.hidden_units=64"))
+    assert _snapshot(run_copy) == before  # config_resolved.yaml and run.json included
+
+
+def test_junk_truncated_and_foreign_checkpoints_are_refused_by_name(run_copy, tmp_path):
+    junk = tmp_path / "junk.ckpt"
+    junk.write_bytes(b"not a checkpoint")
+    cut = tmp_path / "cut.ckpt"
+    cut.write_bytes((run_copy / "checkpoints" / "last.ckpt").read_bytes()[:4000])
+    foreign = tmp_path / "foreign.ckpt"
+    torch.save({"weights": torch.zeros(3)}, foreign)
+    before = _snapshot(run_copy)
+    for path, message in [(junk, "is not a readable checkpoint"), (cut, "is not a readable checkpoint"),
+                          (foreign, "not a Lightning training checkpoint")]:
+        with pytest.raises(ResumeCheckpointError, match=f"ckpt_path={path}: .*{message}"):
+            run(_cfg(f"output_dir={run_copy}", f"ckpt_path={path}"))
+    assert _snapshot(run_copy) == before
+
+
+def test_resuming_a_finished_run_with_nothing_to_train_keeps_its_metrics(run_copy):
+    metrics = run_copy / "metrics.json"
+    before = (metrics.stat().st_mtime_ns, metrics.read_bytes())
+    result = run(_cfg(f"output_dir={run_copy}", "ckpt_path=auto"))
+    assert (metrics.stat().st_mtime_ns, metrics.read_bytes()) == before
+    assert result["metrics"]["best_score"] is not None
+
+
+def test_force_refuses_a_checkpoint_folder_that_links_out_of_the_run(run_copy, tmp_path):
+    elsewhere = tmp_path / "elsewhere"
+    shutil.move(run_copy / "checkpoints", elsewhere)
+    (run_copy / "checkpoints").symlink_to(elsewhere, target_is_directory=True)
+    kept = _snapshot(elsewhere)
+    with pytest.raises(UnsafePathError, match=f"{run_copy / 'checkpoints'} is a link to {elsewhere}, outside"):
+        run(_cfg(f"output_dir={run_copy}", "force=true"))
+    assert _snapshot(elsewhere) == kept
+
+
+def test_the_command_refuses_a_junk_checkpoint_in_one_line(finished, tmp_path, capsys, monkeypatch):
+    junk = tmp_path / "junk.ckpt"
+    junk.write_bytes(b"\x00" * 10)
+    done = run_command("train", *SMOKE, f"hydra.run.dir={tmp_path / 'run'}", f"ckpt_path={junk}",
+                       capsys=capsys, monkeypatch=monkeypatch, cwd=tmp_path)
+    assert done.returncode == 2 and "Traceback" not in done.stderr
+    line = done.stderr.strip().splitlines()[-1]
+    assert line.startswith(f"stylemotion-train: ckpt_path={junk}: ") and "not a readable checkpoint" in line
+    assert not (tmp_path / "run" / "config_resolved.yaml").exists()
