@@ -2,8 +2,9 @@
 launchers), resume, DDP, bad config and bad values (one line naming the key).
 
 The command-line tests run ``python -m stylemotion.cli.train`` (what the ``stylemotion-train``
-console script calls) in a subprocess on a tiny synthetic dataset with the ``smoke`` preset; the
-resume and bad-value tests call :func:`stylemotion.training.run` in-process on a composed config.
+console script calls) in a subprocess on a tiny synthetic dataset with the ``smoke`` preset; refused command
+lines run the entry function in-process (:func:`cli_runner.run_command`); the resume and bad-value tests call
+:func:`stylemotion.training.run` in-process on a composed config.
 """
 
 from __future__ import annotations
@@ -20,6 +21,7 @@ import lightning.pytorch as pl
 import pytest
 import torch
 import yaml
+from cli_runner import run_command
 from hydra import compose, initialize_config_dir
 from hydra.errors import InstantiationException
 
@@ -81,18 +83,18 @@ def test_joblib_launcher_runs_the_sweep_in_parallel_processes(tmp_path):
     assert [check_run_dir(job)["model"]["pooling"] for job in jobs] == ["avg", "max"]
 
 
-def test_single_run_folder_and_unknown_key(tmp_path):
+def test_single_run_folder_and_unknown_key(tmp_path, capsys, monkeypatch):
     run_dir = tmp_path / "run"
     done = train_cli(*SMOKE, f"hydra.run.dir={run_dir}", cwd=tmp_path)
     assert done.returncode == 0, done.stderr[-4000:]
     check_run_dir(run_dir)
-    typo = train_cli(*SMOKE, "model.kernal_size=9", cwd=tmp_path)
+    typo = run_command("train", *SMOKE, "model.kernal_size=9", cwd=tmp_path, capsys=capsys, monkeypatch=monkeypatch)
     assert typo.returncode != 0
     assert "Could not override 'model.kernal_size'" in typo.stderr
     assert "Key 'kernal_size' is not in struct" in typo.stderr
 
 
-def test_run_folder_has_a_unique_id_records_itself_and_is_never_overwritten(tmp_path):
+def test_run_folder_has_a_unique_id_records_itself_and_is_never_overwritten(tmp_path, capsys, monkeypatch):
     done = train_cli(*SMOKE, cwd=tmp_path)
     assert done.returncode == 0, done.stderr[-4000:]
     (run_dir,) = (tmp_path / "runs" / "train" / "smoke").iterdir()
@@ -103,7 +105,8 @@ def test_run_folder_has_a_unique_id_records_itself_and_is_never_overwritten(tmp_
     assert f"stylemotion {stylemotion.__version__} (commit " in (run_dir / "train.log").read_text()
     kept = {p: p.read_bytes() for p in [run_dir / "metrics.json", *(run_dir / "checkpoints").glob("*.ckpt")]}
 
-    again = train_cli(*SMOKE, f"hydra.run.dir={run_dir}", cwd=tmp_path)
+    again = run_command("train", *SMOKE, f"hydra.run.dir={run_dir}", cwd=tmp_path, capsys=capsys,
+                        monkeypatch=monkeypatch)
     assert again.returncode == 2 and "Traceback" not in again.stderr
     (line,) = again.stderr.strip().splitlines()
     assert line.startswith(f"stylemotion-train: {run_dir} already holds a run's results")
@@ -116,8 +119,9 @@ def test_run_folder_has_a_unique_id_records_itself_and_is_never_overwritten(tmp_
     ("trainer.max_steps=abc", "trainer.max_steps must be a whole number ≥ -1, got 'abc'"),
     ("ckpt_path=last", "ckpt_path=last but there is no "),
 ])
-def test_bad_values_end_in_one_line_naming_the_key(override, message, tmp_path):
-    done = train_cli(*SMOKE, override, f"hydra.run.dir={tmp_path / 'run'}", cwd=tmp_path)
+def test_bad_values_end_in_one_line_naming_the_key(override, message, tmp_path, capsys, monkeypatch):
+    done = run_command("train", *SMOKE, override, f"hydra.run.dir={tmp_path / 'run'}", cwd=tmp_path, capsys=capsys,
+                       monkeypatch=monkeypatch)
     assert done.returncode == 2 and "Traceback" not in done.stderr
     (line,) = done.stderr.strip().splitlines()
     assert line.startswith(f"stylemotion-train: {message}")
