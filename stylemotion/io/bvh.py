@@ -17,8 +17,8 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from stylemotion.io.atomic import atomic_write_bytes
-from stylemotion.io.errors import BvhError, LimitError, MotionDataWarning
-from stylemotion.io.sources import check_file_size
+from stylemotion.io.errors import BvhError, LimitError, MotionDataError, MotionDataWarning
+from stylemotion.io.sources import check_file_size, regular_file_stat
 from stylemotion.motion import Motion
 from stylemotion.skeleton import Skeleton
 
@@ -420,7 +420,11 @@ def read_bvh(path: str | os.PathLike, max_file_mb: float | None = None,
     """Read one BVH file from disk (see :func:`parse_bvh`); ``max_file_mb`` caps its size."""
     path = Path(path)
     try:
-        check_file_size(path.stat().st_size, max_file_mb, str(path))
+        size = regular_file_stat(path).st_size  # a FIFO or device is refused by name, never read (it would block)
+    except MotionDataError as exc:
+        raise BvhError(str(path), exc.detail) from None
+    try:
+        check_file_size(size, max_file_mb, str(path))
         data = path.read_bytes()
     except OSError as exc:
         raise BvhError(str(path), f"cannot read file ({exc.strerror or exc})") from None

@@ -14,6 +14,7 @@ from __future__ import annotations
 import json
 import math
 import os
+import stat
 from collections.abc import Mapping
 from pathlib import Path, PurePath
 from typing import Any
@@ -73,11 +74,13 @@ def read_json(path: str | os.PathLike, what: str = "JSON file") -> Any:
     """The value in the JSON file ``path``.
 
     Raises:
-        JsonFileError: the file is missing, unreadable, not UTF-8 or not valid JSON (e.g. cut off), naming
-            ``what``, the file and the line and column where parsing stopped.
+        JsonFileError: the file is missing, not a regular file (a FIFO, a folder), unreadable, not UTF-8 or not
+            valid JSON (e.g. cut off), naming ``what``, the file and the line and column where parsing stopped.
     """
     path = Path(path)
     try:
+        if not stat.S_ISREG(os.stat(path).st_mode):  # a FIFO or device would block or never end
+            raise JsonFileError(f"{path}: not a regular file; give the {what} itself")
         text = path.read_text(encoding="utf-8")
     except FileNotFoundError:
         raise JsonFileError(f"{path}: no such {what}") from None

@@ -11,6 +11,7 @@ from __future__ import annotations
 import fnmatch
 import hashlib
 import os
+import stat
 import zipfile
 import zlib
 from dataclasses import dataclass
@@ -30,6 +31,32 @@ def check_file_size(num_bytes: int, max_file_mb: float | None, source: str) -> N
     if max_file_mb is not None and num_bytes > max_file_mb * 1e6:
         raise LimitError(source, f"file is {num_bytes / 1e6:.1f} MB (uncompressed), more than the limit "
                          f"data.max_file_mb={max_file_mb:g} (raise it for larger files)")
+
+
+def regular_file_stat(path: str | os.PathLike, source: str | None = None) -> os.stat_result:
+    """``os.stat`` of ``path`` (links followed) if it is a regular file.
+
+    A FIFO, socket or device would block a reader or never end, a folder is no file: each is refused by name
+    before it is opened.
+
+    Raises:
+        MotionDataError: no such file, a link that loops or leads nowhere, or not a regular file (naming
+            ``source``, default the path, and what it is).
+    """
+    name = str(source if source is not None else path)
+    try:
+        st = os.stat(path)
+    except OSError as exc:
+        if os.path.islink(path):
+            raise MotionDataError(name, f"a link that cannot be followed ({exc.strerror or exc}); give the file "
+                                  "itself") from None
+        raise MotionDataError(name, f"cannot read file ({exc.strerror or exc})") from None
+    if not stat.S_ISREG(st.st_mode):
+        kind = ("a folder" if stat.S_ISDIR(st.st_mode) else "a FIFO (named pipe)" if stat.S_ISFIFO(st.st_mode)
+                else "a socket" if stat.S_ISSOCK(st.st_mode) else "a device" if stat.S_ISCHR(st.st_mode)
+                or stat.S_ISBLK(st.st_mode) else "not a regular file")
+        raise MotionDataError(name, f"{kind}, not a regular file: give a file (a pipe or device would never end)")
+    return st
 
 
 def _stamp(path: str) -> tuple[int, ...]:
@@ -65,6 +92,7 @@ def _zip(path: str, fresh: bool = False) -> zipfile.ZipFile:
     cached = _OPEN_ZIPS.get(key)
     if cached is not None and not fresh:
         return cached[1]
+    regular_file_stat(path)
     try:
         stamp = _stamp(path)
     except OSError as exc:
@@ -98,12 +126,14 @@ class FileSource:
         return PurePosixPath(self.member).stem if self.member is not None else Path(self.path).stem
 
     def size(self) -> int:
-        """Size in bytes (uncompressed, from the zip's central directory for a member)."""
+        """Size in bytes (uncompressed, from the zip's central directory for a member).
+
+        Raises:
+            MotionDataError: a missing file, a looping link, or no regular file (a FIFO, a device: refused
+                before it is opened, :func:`regular_file_stat`), naming it.
+        """
         if self.member is None:
-            try:
-                return os.stat(self.path).st_size
-            except OSError as exc:
-                raise MotionDataError(self.name, f"cannot read file ({exc.strerror or exc})") from None
+            return regular_file_stat(self.path, self.name).st_size
         try:
             return _zip(self.path).getinfo(self.member).file_size
         except KeyError:
@@ -118,7 +148,7 @@ class FileSource:
             try:
                 with open(self.path, "rb") as fh:
                     data = fh.read(size + 1 if cap is None else min(size + 1, cap))
-                    if len(data) > size:  # grew since, or no regular file (size 0): read on, bounded
+                    if len(data) > size:  # grew since: read on, bounded
                         data += fh.read() if cap is None else fh.read(cap - len(data))
             except OSError as exc:
                 raise MotionDataError(self.name, f"cannot read file ({exc.strerror or exc})") from None
@@ -143,6 +173,7 @@ class FileSource:
                 raise MotionDataError(self.name, "no such member in the archive") from None
             return f"{info.CRC:08x}:{info.file_size}"
         try:
+            regular_file_stat(self.path, self.name)
             stamp = _stamp(self.path)
             if max_file_mb is not None and stamp[0] > max_file_mb * 1e6:
                 return f"{stamp[0]}:over-limit"
@@ -169,12 +200,18 @@ class FileSource:
 def list_sources(root: str | os.PathLike, pattern: str = "*.bvh") -> list[FileSource]:
     """All files matching ``pattern`` under ``root`` (a file, a folder or a ``.zip``), sorted.
 
+    In a folder, every entry matching ``pattern`` that is not a folder is listed, a FIFO or a looping link
+    included: reading it then fails by name (:func:`regular_file_stat`), so the data set lists it as broken or
+    skipped instead of dropping it silently.
+
     Raises:
         MotionDataError: if ``root`` does not exist or holds no matching file.
     """
     root = Path(root)
     if not root.exists():
         raise MotionDataError(str(root), "no such file or folder")
+    if not root.is_dir():
+        regular_file_stat(root)
     if root.is_file() and root.suffix.lower() == ".zip":
         members = sorted(m for m in _zip(str(root), fresh=True).namelist()
                          if not m.endswith("/") and fnmatch.fnmatch(PurePosixPath(m).name, pattern))
@@ -182,7 +219,7 @@ def list_sources(root: str | os.PathLike, pattern: str = "*.bvh") -> list[FileSo
     elif root.is_file():
         sources = [FileSource(str(root))]
     else:
-        sources = [FileSource(str(p)) for p in sorted(root.rglob(pattern)) if p.is_file()]
+        sources = [FileSource(str(p)) for p in sorted(root.rglob(pattern)) if not p.is_dir()]
     if not sources:
         raise MotionDataError(str(root), f"no files matching {pattern!r}")
     return sources
