@@ -144,10 +144,12 @@ class Reproduction:
     def plan(self, styles: Sequence[str]) -> None:
         """The training stages for the primitives and ``styles`` (called by :meth:`data_stage`)."""
         stages_cfg = self.cfg.stages
+        # budget.stage_samples false: no sample GIF per VAE/CVAE stage (the report shows samples)
+        no_gif = [] if self.cfg.budget.stage_samples else ["callbacks.samples=null"]
         ae = Stage("autoencoder", "autoencoder", self.out / "autoencoder", list(stages_cfg.autoencoder))
         self.stages = [ae]
         for p in self.primitives:
-            self.stages.append(Stage("vae", f"vae {p}", self.out / "vae" / p, list(stages_cfg.vae),
+            self.stages.append(Stage("vae", f"vae {p}", self.out / "vae" / p, list(stages_cfg.vae) + no_gif,
                                      {"primitive": p}, ae))
         folders: dict[Path, str] = {}
         for p in self.primitives:
@@ -157,7 +159,7 @@ class Reproduction:
                     raise ValueError(f"style labels {folders[folder]!r} and {s!r} would share the folder {folder}; "
                                      "rename one in the data's labels")
                 folders[folder] = s
-                self.stages.append(Stage("cvae", f"cvae {p}/{s}", folder, list(stages_cfg.cvae),
+                self.stages.append(Stage("cvae", f"cvae {p}/{s}", folder, list(stages_cfg.cvae) + no_gif,
                                          {"primitive": p, "style": s}, ae))
 
     def data_stage(self) -> None:
