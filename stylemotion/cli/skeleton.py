@@ -7,7 +7,8 @@ point. Both
 * turn a :class:`~stylemotion.io.errors.UserInputError` (a bad value, file, folder or checkpoint, or an
   existing output) into ONE line ``stylemotion-<command>: <message>`` on stderr and exit status 2
   (:data:`EXIT_BAD_INPUT`);
-* turn Ctrl-C into one line and exit status 130 (:data:`EXIT_INTERRUPTED`); outputs are written
+* turn Ctrl-C — and SIGTERM (``kill``, ``timeout``, a scheduler's preemption), which it raises as Ctrl-C so that
+  the same clean-up runs — into one line and exit status 130 (:data:`EXIT_INTERRUPTED`); outputs are written
   atomically (:mod:`stylemotion.io.atomic`), so an interrupted command leaves nothing half-written;
 * show the full traceback instead when asked: ``STYLEMOTION_DEBUG=1`` or ``HYDRA_FULL_ERROR=1``;
 * hand the work the command line as typed (:func:`command_line`), which it records in its provenance.
@@ -20,7 +21,9 @@ from __future__ import annotations
 
 import functools
 import os
+import signal
 import sys
+import threading
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from typing import Any
@@ -68,6 +71,17 @@ def one_line_errors(command: str) -> Iterator[None]:
         raise SystemExit(EXIT_INTERRUPTED) from None
 
 
+def _interrupt(signum: int, frame: Any) -> None:
+    raise KeyboardInterrupt
+
+
+def stop_on_sigterm() -> None:
+    """Raise SIGTERM in the main thread as :class:`KeyboardInterrupt` (module docstring); elsewhere (a command
+    run from another thread) signals cannot be handled and nothing changes."""
+    if threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGTERM, _interrupt)
+
+
 def hydra_command(command: str, config_name: str, work: Callable[[Any, str], Any]) -> Callable[[], None]:
     """The console-script entry point of a Hydra command.
 
@@ -90,6 +104,7 @@ def hydra_command(command: str, config_name: str, work: Callable[[Any, str], Any
         from stylemotion.cli.schemas import register_schemas_for
         from stylemotion.config import CONFIG_PACKAGE
 
+        stop_on_sigterm()
         with one_line_errors(command):
             register_schemas_for(config_name)
             hydra.main(config_path=CONFIG_PACKAGE, config_name=config_name, version_base="1.3")(task)()
@@ -107,6 +122,7 @@ def argparse_command(command: str, work: Callable[[Sequence[str] | None], int]) 
 
     @functools.wraps(work)
     def main(argv: Sequence[str] | None = None) -> int:
+        stop_on_sigterm()
         try:
             with one_line_errors(command):
                 return work(argv)

@@ -398,10 +398,19 @@ def _pool_results(jobs: Sequence[tuple[Stage, bool, dict[str, Any]]], workers: i
     """Run the jobs in ``workers`` spawned processes; yield each as it finishes."""
     if not jobs:
         return
-    with ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("spawn")) as pool:
+    pool = ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("spawn"))
+    try:
         pending = {pool.submit(_train_in_worker, container): (stage, resume) for stage, resume, container in jobs}
         for future in as_completed(pending):
             yield (*pending[future], future.result)
+    except BaseException:
+        # Ctrl-C or SIGTERM (cli.skeleton): stop the stages still training instead of leaving them running
+        # without a parent. Python < 3.14 has no public way to end a pool's workers.
+        for process in list((pool._processes or {}).values()):
+            process.terminate()
+        pool.shutdown(wait=False, cancel_futures=True)
+        raise
+    pool.shutdown()
 
 
 def submitit_executor(node: Any, folder: Path, engine: str, name: str = "stylemotion") -> Any:

@@ -58,3 +58,20 @@ def test_argparse_commands_return_their_status(capsys: pytest.CaptureFixture) ->
 
 def test_command_line_is_the_command_and_its_arguments() -> None:
     assert command_line("stylemotion-z", ["a=1", "b=two words"]) == "stylemotion-z a=1 b=two words"
+
+
+def test_sigterm_is_raised_as_ctrl_c_so_the_same_clean_up_runs(capsys: pytest.CaptureFixture) -> None:
+    import os
+    import signal
+
+    from stylemotion.cli.skeleton import stop_on_sigterm
+
+    previous = signal.getsignal(signal.SIGTERM)
+    try:
+        stop_on_sigterm()
+        with pytest.raises(SystemExit) as caught, one_line_errors("stylemotion-x"):
+            os.kill(os.getpid(), signal.SIGTERM)
+        assert caught.value.code == EXIT_INTERRUPTED
+        assert capsys.readouterr().err.startswith("stylemotion-x: interrupted")
+    finally:
+        signal.signal(signal.SIGTERM, previous)
