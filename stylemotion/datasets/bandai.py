@@ -112,6 +112,10 @@ def load_bandai(
     """
     check_workers(workers)
     root = Path(root).expanduser()
+    if not root.exists():
+        raise MotionDataError(str(root), "no such file or folder: data.root is the Bandai data set's folder or its "
+                              "data.zip (docs/data.md)")
+    sources = list_sources(root, "*.bvh")  # a damaged zip is named before its label tables are looked for
     content_table, style_table = find_label_tables(root if root.is_dir() else root.parent, label_dir)
     for key, wanted, table in (("content", contents, content_table), ("style", styles, style_table)):
         unknown = sorted(set(wanted or []) - set(table))
@@ -120,7 +124,7 @@ def load_bandai(
     settings = settings or ConversionSettings()
     specs: list[TakeSpec] = []
     failures: list[tuple[str, str]] = []
-    for source in list_sources(root, "*.bvh"):
+    for source in sources:
         try:
             labels = bandai_labels(source, content_table, style_table, settings.max_file_mb)
             name = safe_name(source.stem, f"take name of {source.name}")

@@ -14,6 +14,7 @@ from typing import Any
 
 import numpy as np
 
+from stylemotion.config import ConfigError
 from stylemotion.representation import positions_to_frames
 
 
@@ -108,7 +109,7 @@ class TakeSet:
         ``round(n·fraction)`` to val and test, at least one each when n ≥ 3).
         """
         if not 0 <= val_fraction < 1 or not 0 <= test_fraction < 1 or val_fraction + test_fraction >= 1:
-            raise ValueError(f"split fractions must be in [0, 1) and sum below 1, got val={val_fraction}, "
+            raise ConfigError(f"data.split: fractions must be in [0, 1) and sum below 1, got val={val_fraction}, "
                              f"test={test_fraction}")
         rng = np.random.default_rng(seed)
         groups: dict[tuple[str, ...], list[Take]] = {}

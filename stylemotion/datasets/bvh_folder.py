@@ -14,6 +14,7 @@ import os
 import re
 from pathlib import Path, PurePosixPath
 
+from stylemotion.config import ConfigError
 from stylemotion.datasets.base import TakeSet
 from stylemotion.datasets.loading import (
     ConversionSettings,
@@ -94,7 +95,7 @@ def _compile(pattern: str) -> re.Pattern[str]:
     try:
         return re.compile(pattern)
     except re.error as exc:
-        raise ValueError(f"data.pattern {pattern!r} is not a valid regular expression ({exc})") from None
+        raise ConfigError(f"data.pattern {pattern!r} is not a valid regular expression ({exc})") from None
 
 
 def load_bvh_folder(
@@ -131,7 +132,7 @@ def load_bvh_folder(
     base = {"content": "unknown", "style": "unknown", **(default_labels or {})}
     bad = unsafe_label(base)
     if bad is not None:
-        raise ValueError(f"data.default_labels: {_unsafe_message(*bad)}")
+        raise ConfigError(f"data.default_labels: {_unsafe_message(*bad)}")
     table = read_label_csv(labels_csv) if labels_csv else None
     regex = _compile(pattern) if pattern and table is None else None
     specs: list[TakeSpec] = []

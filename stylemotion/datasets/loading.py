@@ -30,6 +30,7 @@ from typing import Any
 
 import numpy as np
 
+from stylemotion.config import ConfigError
 from stylemotion.datasets.base import Take, TakeSet
 from stylemotion.datasets.canonical import DEFAULT_MAX_FRAMES, to_canonical_positions
 from stylemotion.io.bvh import DEFAULT_MAX_JOINT_FRAMES, parse_bvh
@@ -52,26 +53,27 @@ class CacheWarning(UserWarning):
     """A cache entry could not be used or written; the dataset is rebuilt (the message names it)."""
 
 
-def _positive(value: Any, key: str, integer: bool, allow_none: bool = True) -> None:
-    """Raise ValueError naming ``key`` unless ``value`` is a positive finite number (or None)."""
+def check_positive(value: Any, key: str, integer: bool, allow_none: bool = True) -> None:
+    """Raise :class:`~stylemotion.config.ConfigError` naming ``key`` unless ``value`` is a positive finite number
+    (or None)."""
     if value is None and allow_none:
         return
     kind = numbers.Integral if integer else numbers.Real
     if isinstance(value, bool) or not isinstance(value, kind) or not np.isfinite(value) or value <= 0:
         what = "a whole number ≥ 1" if integer else "a positive finite number"
-        raise ValueError(f"{key} must be {what}{' or null' if allow_none else ''}, got {value!r}")
+        raise ConfigError(f"{key} must be {what}{' or null' if allow_none else ''}, got {value!r}")
 
 
 def check_workers(workers: Any) -> int | None:
     """``workers`` as an int ≥ 1 or None (all cores); ValueError naming ``data.workers`` otherwise."""
-    _positive(workers, "data.workers (processes; null = all cores)", integer=True)
+    check_positive(workers, "data.workers (processes; null = all cores)", integer=True)
     return None if workers is None else int(workers)
 
 
 def check_flag(value: Any, key: str) -> bool:
     """``value`` if it is a bool; ValueError naming ``key`` otherwise (``'abc'`` is not true)."""
     if not isinstance(value, (bool, np.bool_)):
-        raise ValueError(f"{key} must be true or false, got {value!r}")
+        raise ConfigError(f"{key} must be true or false, got {value!r}")
     return bool(value)
 
 
@@ -100,10 +102,10 @@ class ConversionSettings:
 
     def __post_init__(self) -> None:
         """ValueError naming the ``data.`` key of a bad frame rate or limit."""
-        _positive(self.fps, "data.fps", integer=False, allow_none=False)
-        _positive(self.max_file_mb, "data.max_file_mb", integer=False)
-        _positive(self.max_frames, "data.max_frames", integer=True)
-        _positive(self.max_joint_frames, "data.max_joint_frames", integer=True)
+        check_positive(self.fps, "data.fps", integer=False, allow_none=False)
+        check_positive(self.max_file_mb, "data.max_file_mb", integer=False)
+        check_positive(self.max_frames, "data.max_frames", integer=True)
+        check_positive(self.max_joint_frames, "data.max_joint_frames", integer=True)
         # unit_scale and up_axis are checked per file by to_canonical_positions (MotionDataError).
 
     def as_key(self) -> dict[str, Any]:

@@ -9,8 +9,17 @@ from typing import Any
 from stylemotion.datasets.bandai import load_bandai
 from stylemotion.datasets.base import Take, TakeSet
 from stylemotion.datasets.bvh_folder import load_bvh_folder
-from stylemotion.datasets.loading import ConversionSettings
+from stylemotion.datasets.loading import ConversionSettings, check_positive
 from stylemotion.datasets.retarget import check_retarget, retarget_takeset
+from stylemotion.io.errors import UserInputError
+
+
+class DatasetOptionError(UserInputError, KeyError):
+    """An unknown data set or option of a ``data`` config; the message names it and the valid ones."""
+
+    def __str__(self) -> str:  # a KeyError's str() is its repr: show the message as it is
+        return str(self.args[0]) if self.args else ""
+
 
 DatasetLoader = Callable[..., TakeSet]
 DATASETS: dict[str, DatasetLoader] = {}
@@ -48,6 +57,9 @@ def load_synthetic(
     """The procedural stylized-locomotion dataset (see :mod:`stylemotion.datasets.synthetic`)."""
     from stylemotion.datasets.synthetic import generate_takes
 
+    check_positive(takes_per_pair, "data.takes_per_pair", integer=True, allow_none=False)
+    check_positive(fps, "data.fps", integer=False, allow_none=False)
+    check_positive(duration_s, "data.duration_s", integer=False, allow_none=False)
     generated = generate_takes(takes_per_pair=takes_per_pair, seed=seed, fps=fps, duration_s=duration_s,
                                styles=styles, contents=contents)
     takes = [Take(g.name, g.positions, g.fps, dict(g.labels), source=f"synthetic(seed={seed})")
@@ -66,7 +78,7 @@ def load_dataset(name: str, **options: Any) -> TakeSet:
     the converted takes and their cache do not depend on it.
     """
     if name not in DATASETS:
-        raise KeyError(f"unknown dataset {name!r}; registered: {sorted(DATASETS)}")
+        raise DatasetOptionError(f"unknown dataset {name!r}; registered: {sorted(DATASETS)}")
     loader = DATASETS[name]
     params = inspect.signature(loader).parameters
     retarget = check_retarget(options.pop("retarget", None))
@@ -77,7 +89,7 @@ def load_dataset(name: str, **options: Any) -> TakeSet:
     if unknown:
         valid = sorted(set(params) - {"settings"} | set(_TAKESET_KEYS)
                        | (set(_CONVERSION_KEYS) if "settings" in params else set()))
-        raise KeyError(f"dataset {name!r} has no option(s) {unknown}; valid options: {valid}")
+        raise DatasetOptionError(f"dataset {name!r} has no option(s) {unknown}; valid options: {valid}")
     return retarget_takeset(loader(**options), retarget)
 
 
@@ -85,7 +97,7 @@ def build_dataset(cfg: Mapping[str, Any]) -> TakeSet:
     """Build the dataset described by a ``data`` config node (``name`` plus options)."""
     options = {k: _plain(v) for k, v in dict(cfg).items() if k not in _MODULE_KEYS}
     if "name" not in cfg:
-        raise KeyError(f"data config needs a 'name' (one of {sorted(DATASETS)})")
+        raise DatasetOptionError(f"data config needs a 'name' (one of {sorted(DATASETS)})")
     return load_dataset(str(cfg["name"]), **options)
 
 

@@ -17,6 +17,7 @@ import numpy as np
 from scipy.cluster.hierarchy import fcluster, linkage
 
 from stylemotion.bones import BONE_NAMES, median_bone_lengths, retarget_positions, target_bone_lengths
+from stylemotion.config import ConfigError
 from stylemotion.datasets.base import Take, TakeSet
 
 #: Default tolerance of :func:`actor_groups`: two takes share a skeleton when no bone differs by more, metres.
@@ -27,7 +28,7 @@ def check_retarget(value: Any) -> str | None:
     """``data.retarget`` as a style name or None; ValueError naming the key for anything else."""
     if value is None or (isinstance(value, str) and value.strip()):
         return value
-    raise ValueError(f"data.retarget must be a style name (every take gets the median bone lengths of that "
+    raise ConfigError(f"data.retarget must be a style name (every take gets the median bone lengths of that "
                      f"style's takes) or null (each take keeps its own bones), got {value!r}")
 
 
@@ -56,7 +57,7 @@ def retarget_takeset(takeset: TakeSet, style: str) -> TakeSet:
     styles = takeset.label_values("style")
     examples = takeset.filter(style=style)
     if not examples:
-        raise ValueError(f"data.retarget={style!r} is not a style of dataset {takeset.name!r}; its styles are "
+        raise ConfigError(f"data.retarget={style!r} is not a style of dataset {takeset.name!r}; its styles are "
                          f"{styles} (data.styles must keep the target style; null keeps each take's own bones)")
     target = target_bone_lengths(t.positions for t in examples)
     takes = []
@@ -64,7 +65,7 @@ def retarget_takeset(takeset: TakeSet, style: str) -> TakeSet:
         try:
             positions = retarget_positions(take.positions, target)
         except ValueError as exc:
-            raise ValueError(f"data.retarget={style!r}: take {take.name!r} ({take.source}): {exc}") from None
+            raise ConfigError(f"data.retarget={style!r}: take {take.name!r} ({take.source}): {exc}") from None
         takes.append(Take(take.name, positions, take.fps, dict(take.labels), take.source))
     record = skeleton_record(style, len(examples), target)
     return replace(takeset, takes=takes, retarget=record)

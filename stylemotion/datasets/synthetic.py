@@ -38,6 +38,7 @@ import numpy as np
 from scipy.interpolate import CubicSpline
 from scipy.special import logsumexp
 
+from stylemotion.config import ConfigError
 from stylemotion.geometry import (
     facing_direction,
     left_direction,
@@ -264,7 +265,7 @@ def _rng(seed: int, content: str, style: str, index: int) -> np.random.Generator
 
 def _check(value: str, valid: tuple[str, ...], what: str) -> None:
     if value not in valid:
-        raise ValueError(f"unknown {what} {value!r}; valid {what}s: {', '.join(valid)}")
+        raise ConfigError(f"data.{what}s: unknown {what} {value!r}; valid {what}s: {', '.join(valid)}")
 
 
 def _gait_for(style: str, content: str, rng: np.random.Generator) -> _Gait:
@@ -583,7 +584,8 @@ def generate_take(
     _check(style, STYLES, "style")
     num_frames = int(round(duration_s * fps))
     if num_frames < 2:
-        raise ValueError(f"a take needs at least 2 frames, got duration {duration_s} s at {fps} fps")
+        raise ConfigError(f"data.fps, data.duration_s: a take needs at least 2 frames, got duration {duration_s} s at "
+                          f"{fps} fps")
     rng = _rng(seed, content, style, index)
     gait = _gait_for(style, content, rng)
     heading = _heading_for(content, duration_s, rng)
