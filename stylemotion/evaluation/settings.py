@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+from stylemotion.config import ConfigError
 from stylemotion.primitives.segmentation import SegmentSettings
 from stylemotion.primitives.skating import SKATE_SPEED_MPS
 
@@ -84,5 +85,7 @@ class EvalSettings:
 
     def __post_init__(self) -> None:
         counts = self.samples
-        if min(counts.table_5_1, counts.variance, counts.metrics) < 2:
-            raise ValueError(f"every evaluation.samples count must be ≥ 2, got {counts}")
+        for name in ("table_5_1", "variance", "metrics"):
+            value = getattr(counts, name)
+            if value < 2:
+                raise ConfigError(f"evaluation.samples.{name} must be at least 2 (samples per model), got {value}")

@@ -52,6 +52,10 @@ KINDS = ("autoencoder", "vae", "cvae", "zero_shot")
 GENERATIVE_KINDS = ("vae", "cvae", "zero_shot")
 
 
+class MissingCheckpointError(UserInputError, FileNotFoundError):
+    """A checkpoint path that names no file (or no regular file: a folder, a FIFO); the message names it."""
+
+
 class MissingAutoencoderError(UserInputError, FileNotFoundError):
     """A generative model's autoencoder is neither embedded in its checkpoint nor found on disk."""
 
@@ -63,18 +67,21 @@ def read_checkpoint(path: str | os.PathLike, what: str = "checkpoint") -> dict[s
     """The checkpoint dict at ``path`` (``~`` expanded), read on the CPU with ``weights_only=True``.
 
     Raises:
-        FileNotFoundError: no such file (``what`` names it in the message).
+        MissingCheckpointError: no such file, or no regular file (``what`` names it in the message).
         IncompatibleModelError: not a readable checkpoint (not a torch file, or objects other
             than tensors and plain values).
     """
     path = Path(path).expanduser()
     if not path.is_file():
-        raise FileNotFoundError(f"{what} {str(path)!r} does not exist")
+        raise MissingCheckpointError(f"{what} {str(path)!r} " + ("is not a regular file" if path.exists()
+                                                                 else "does not exist"))
     try:
         checkpoint = torch.load(path, map_location="cpu", weights_only=True)
     except Exception as exc:  # noqa: BLE001 - zip, pickle and weights_only errors alike: not ours to read
+        detail = str(exc).splitlines()[0].split(". ")[0] if str(exc) else ""  # torch's first sentence only
         raise IncompatibleModelError(f"{path} is not a readable checkpoint of plain values and tensors "
-                                     f"({type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else ''})") from exc
+                                     f"({type(exc).__name__}: {detail}); it is damaged, cut off or another kind of "
+                                     "file") from exc
     if not isinstance(checkpoint, dict):
         raise IncompatibleModelError(f"{path} holds a {type(checkpoint).__name__}, not a checkpoint dict")
     return checkpoint
@@ -193,7 +200,7 @@ def load_autoencoder(path: str | os.PathLike, expected: Mapping[str, Any] | None
     """
     path = Path(path).expanduser()
     if not path.is_file():
-        raise FileNotFoundError(f"autoencoder checkpoint {str(path)!r} does not exist; train one with "
+        raise MissingCheckpointError(f"autoencoder checkpoint {str(path)!r} does not exist; train one with "
                                 "'stylemotion-train experiment=autoencoder data=...' and pass its "
                                 "checkpoints/best.ckpt as autoencoder_ckpt=...")
     checkpoint = read_checkpoint(path, "autoencoder checkpoint")
@@ -305,7 +312,7 @@ def find_checkpoints(patterns: Sequence[str] | str) -> list[Path]:
         else:
             hits = sorted(Path(p) for p in glob.glob(str(path), recursive=True))
         if not hits:
-            raise FileNotFoundError(f"no checkpoint matches {pattern!r} (a file, a glob pattern, or a folder holding "
-                                    "**/checkpoints/best.ckpt of a PrimitiveVAE/StyleCVAE)")
+            raise MissingCheckpointError(f"no checkpoint matches {pattern!r} (a file, a glob pattern, or a folder "
+                                         "holding **/checkpoints/best.ckpt of a PrimitiveVAE/StyleCVAE)")
         found += [h for h in hits if h not in found]
     return found
