@@ -42,6 +42,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import torch
 
+from stylemotion.config import ConfigError
 from stylemotion.geometry import wrap_angle_torch
 from stylemotion.representation import JOINT_DIMS, VELOCITY_DIMS, frames_to_positions, integrate_root
 from stylemotion.skeleton import NUM_JOINTS
@@ -93,11 +94,12 @@ class FollowSettings:
     max_steps: int = 500
 
     def __post_init__(self) -> None:
-        if self.candidates < 1 or self.iterations < 0 or self.max_steps < 1 or self.blend_frames < 0:
-            raise ValueError(f"need candidates ≥ 1, iterations ≥ 0, blend_frames ≥ 0, max_steps ≥ 1: {self}")
+        for name, least in (("candidates", 1), ("iterations", 0), ("max_steps", 1), ("blend_frames", 0)):
+            if not getattr(self, name) >= least:
+                raise ConfigError(f"follow.{name} must be at least {least}, got {getattr(self, name)}")
         for name in ("position_scale_m", "heading_scale_rad", "pose_scale_m", "speed_scale_mps"):
             if not getattr(self, name) > 0:
-                raise ValueError(f"{name} must be positive, got {getattr(self, name)}")
+                raise ConfigError(f"follow.{name} must be positive, got {getattr(self, name)}")
 
 
 @dataclass

@@ -29,8 +29,8 @@ it exists, unless ``force=true``; the folder appears complete or not at all):
 from __future__ import annotations
 
 import io
-import json
 import logging
+import math
 import time
 from collections.abc import Mapping
 from dataclasses import asdict, replace
@@ -44,7 +44,7 @@ from stylemotion.config import ConfigError
 from stylemotion.datasets.loading import ConversionSettings, load_canonical_positions
 from stylemotion.io.atomic import atomic_folder
 from stylemotion.io.export import write_motion_bvh
-from stylemotion.io.jsonfile import write_json
+from stylemotion.io.jsonfile import read_json, write_json
 from stylemotion.io.outputs import check_new_output
 from stylemotion.io.sources import FileSource
 from stylemotion.models.loading import NEUTRAL
@@ -105,12 +105,12 @@ def real_foot_skating(run: str | Path | None, style: str) -> float | None:
     if meta is not None:
         if style != meta.get("name"):
             return real_foot_skating(extended_run(run, meta), style)
-        value = json.loads((Path(run).expanduser() / "report.json").read_text()).get("foot_skating_pooled", {})
+        value = read_json(Path(run).expanduser() / "report.json", "style report").get("foot_skating_pooled", {})
         return None if value.get("example") is None else float(value["example"])
     report = Path(run) / "report" / "report.json" if run else None
     if report is None or not report.is_file():
         return None
-    value = json.loads(report.read_text()).get("foot_skating_real", {}).get(style)
+    value = read_json(report, "run report").get("foot_skating_real", {}).get(style)
     return None if value is None else float(value)
 
 
@@ -141,6 +141,7 @@ def generate(cfg: DictConfig | Mapping[str, Any], command: str = "") -> dict[str
     out = check_new_output(cfg["out"], force)
     started = time.perf_counter()
     path = path_from_config(cfg.get("path") or {})
+    settings = FollowSettings(**(cfg.get("follow") or {}))  # bad follow.* values are refused before loading
     kind = str((cfg.get("model") or {}).get("family", "?"))  # model=morphable; none: the VAEs
     kind = "vae" if not cfg.get("model") else kind
     if kind == "morphable":
@@ -158,7 +159,6 @@ def generate(cfg: DictConfig | Mapping[str, Any], command: str = "") -> dict[str
     else:
         raise ConfigError("stylemotion-generate takes model=morphable (the Morphable Graph) or no model= (the VAEs); "
                           f"the chosen model config has family {kind!r}")
-    settings = FollowSettings(**(cfg.get("follow") or {}))
     motion = follow_path(graph, path, seed=int(cfg.get("seed", 0)), settings=settings)
     rigid = None
     if cfg.get("rigid_bones", True):
@@ -187,6 +187,11 @@ def generate(cfg: DictConfig | Mapping[str, Any], command: str = "") -> dict[str
     return summary
 
 
+def _share(value: float | None) -> str:
+    """A ratio as a percentage; "n/a (no planted foot)" when it has no value (NaN, or null when read back)."""
+    return "n/a (no planted foot)" if value is None or not math.isfinite(value) else f"{value:.1%}"
+
+
 def summary_lines(summary: Mapping[str, Any]) -> list[str]:
     """A few lines for the terminal."""
     dev, tr = summary["deviation"], summary["transitions"]
@@ -197,8 +202,8 @@ def summary_lines(summary: Mapping[str, Any]) -> list[str]:
              f"path deviation: mean {dev['mean_m']:.3f} m, max {dev['max_m']:.3f} m, final {dev['final_m']:.3f} m",
              f"transitions: peak joint speed {tr['ratio']:.2f}×, peak acceleration {tr['accel_ratio']:.2f}× the 99th "
              "percentile inside clips",
-             f"foot skating {summary['foot_skating_ratio']:.1%} (before clean-up "
-             f"{summary['foot_skating_ratio_before_cleanup']:.1%})" + real,
+             f"foot skating {_share(summary['foot_skating_ratio'])} (before clean-up "
+             f"{_share(summary['foot_skating_ratio_before_cleanup'])})" + real,
              f"synthesis {summary['synthesis_seconds']:.2f} s"]
     if "bvh_reimport_mpjpe_m" in summary:
         lines.append(f"BVH re-import MPJPE {summary['bvh_reimport_mpjpe_m'] * 100:.2f} cm")

@@ -23,7 +23,6 @@ models — neutral and the run's styles — it offers as well), or from an expli
 
 from __future__ import annotations
 
-import json
 import os
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -33,7 +32,9 @@ from typing import Any
 import numpy as np
 import torch
 
+from stylemotion.config import ConfigError
 from stylemotion.io.errors import UserInputError
+from stylemotion.io.jsonfile import read_json
 from stylemotion.models.autoencoder import IncompatibleModelError
 from stylemotion.models.checkpoints import load_autoencoder
 from stylemotion.models.loading import NEUTRAL, load_generative, load_model
@@ -55,6 +56,18 @@ TRANSITIONS: dict[str, tuple[str, ...]] = {
 PROFILE_SAMPLES = 512
 #: ``meta.kind`` in the ``report.json`` of a ``stylemotion-style`` folder.
 STYLE_FOLDER_KIND = "style"
+
+
+class RunFolderError(UserInputError, FileNotFoundError):
+    """``run=`` names no finished run (or style folder), or one whose report lacks what synthesis needs."""
+
+
+def _report_object(path: Path) -> dict:
+    """The JSON object in a run's report (a cut-off or damaged file is named, with its line)."""
+    value = read_json(path, "run report")
+    if not isinstance(value, dict):
+        raise RunFolderError(f"{path}: holds no JSON object; the run's report is damaged — rerun its evaluation")
+    return value
 
 
 class UnknownStyleError(UserInputError, KeyError):
@@ -159,7 +172,7 @@ def style_folder_meta(run: str | Path) -> dict | None:
     report = Path(run).expanduser() / "report.json"
     if not report.is_file():
         return None
-    meta = json.loads(report.read_text()).get("meta", {})
+    meta = _report_object(report).get("meta", {})
     return meta if meta.get("kind") == STYLE_FOLDER_KIND else None
 
 
@@ -175,7 +188,7 @@ def extended_run(folder: str | Path, meta: dict) -> Path:
     for candidate in candidates:
         if (candidate / "report" / "report.json").is_file():
             return candidate
-    raise FileNotFoundError(f"{folder} is a style that extends the stylemotion-reproduce run {meta.get('run')}, "
+    raise RunFolderError(f"{folder} is a style that extends the stylemotion-reproduce run {meta.get('run')}, "
                             f"which is gone (looked at {[str(c) for c in candidates]}): put the run back, or give "
                             "models={primitive: checkpoint}")
 
@@ -186,11 +199,11 @@ def report_meta(run: str | Path) -> dict:
     style = style_folder_meta(run)
     if style is not None:
         return style
-    report = Path(run) / "report" / "report.json"
+    report = Path(run).expanduser() / "report" / "report.json"
     if not report.is_file():
-        raise FileNotFoundError(f"{report} does not exist: point run= at a finished stylemotion-reproduce folder "
-                                f"(e.g. runs/reproduce/synthetic), or give models={{primitive: checkpoint}}")
-    return json.loads(report.read_text()).get("meta", {})
+        raise RunFolderError(f"run={run}: {report} does not exist: point run= at a finished stylemotion-reproduce "
+                             "folder (e.g. runs/reproduce/synthetic), or give models={primitive: checkpoint}")
+    return _report_object(report).get("meta", {})
 
 
 def available_models(run: str | Path, meta: dict | None = None) -> list[dict[str, Any]]:
@@ -204,8 +217,8 @@ def available_models(run: str | Path, meta: dict | None = None) -> list[dict[str
             extended_run(run, meta))
     entries = meta.get("checkpoints")
     if not entries:
-        raise ValueError(f"{Path(run) / 'report' / 'report.json'}: meta.checkpoints is empty; no model to "
-                         "synthesize with")
+        raise RunFolderError(f"{Path(run) / 'report' / 'report.json'}: meta.checkpoints is empty; no model to "
+                             "synthesize with")
     return [{**{k: str(e[k]) for k in ("primitive", "name", "style")}, "path": recorded(e["path"], run, meta)}
             for e in entries]
 
@@ -239,7 +252,7 @@ def load_bound_style(entry: Mapping[str, Any], autoencoder=None) -> BoundExample
                                      f"style {entry['name']} records")
     example = Path(entry["example"])
     if not example.is_file():
-        raise FileNotFoundError(f"style {entry['name']}: its example {example} is gone; the zero-shot network "
+        raise RunFolderError(f"style {entry['name']}: its example {example} is gone; the zero-shot network "
                                 "samples the style only with it")
     with np.load(example) as npz:
         frames = positions_to_frames(npz["positions"], float(npz["fps"]))[0]
@@ -321,7 +334,7 @@ def load_graph(style: str, run: str | Path | None = None, models: Mapping[str, s
             raise UnknownStyleError(f"style {style!r} has no {action} model in {run}; styles there: {have} "
                                     f"('{NEUTRAL}' = the neutral VAEs)")
     else:
-        raise ValueError("give run=<stylemotion-reproduce folder> or models={primitive: checkpoint}")
+        raise ConfigError("give run=<stylemotion-reproduce folder> or models={primitive: checkpoint}")
     paths = {p: e["path"] for p, e in chosen.items()}
     loaded: dict[str, PrimitiveVAE | BoundExample] = {}
     autoencoder = run_autoencoder(run, meta) if not models else None  # models= names its own checkpoints

@@ -9,6 +9,8 @@
   the resting foot heights of the motion itself (as for a real take); compare with the same ratio
   of real clips of the style (``stylemotion-reproduce``'s ``report.json``, ``foot_skating_real``).
   Measured on the motion as given (after :mod:`stylemotion.synthesis.cleanup` if it was applied).
+  A walk without a planted foot (no foot-frame in contact, e.g. a very short one) has no ratio: NaN here,
+  ``null`` in ``summary.json`` (:mod:`stylemotion.io.jsonfile`), "n/a" on the terminal.
 * **Transitions**: :func:`stylemotion.synthesis.stitching.transition_speed_ratio`.
 * **Latent norms**: the mean ‖z‖ of the chosen codes next to √latent_dim, the radius around which
   prior draws concentrate (how far the path pulled the codes from typical samples).
