@@ -33,7 +33,7 @@ from stylemotion.annotate.templates import TemplateInputError
 from stylemotion.config import ConfigError, positive_int
 from stylemotion.datasets import build_dataset
 from stylemotion.datasets.loading import ConversionSettings
-from stylemotion.datasets.user_motion import UserMotionError, convert_example, parse_example
+from stylemotion.datasets.user_motion import UserMotionError, conversion_keys, convert_example, parse_example
 from stylemotion.io.atomic import atomic_folder, atomic_write_bytes
 from stylemotion.io.errors import UserInputError
 from stylemotion.io.jsonfile import write_json
@@ -178,5 +178,5 @@ def annotate_from_config(cfg: DictConfig, say: Say = print, command: str = "") -
                                   keyframe_tolerance=float(keyframes.get("tolerance", 0.1)),
                                   min_run=int(plain.get("min_run", 30)))
     return annotate(str(plain["document"]), plain["templates"], plain["out"], settings=settings,
-                    conversion={key: plain.get(key) for key in ("joint_map", "unit_scale", "up_axis")},
+                    conversion=conversion_keys(plain),
                     force=force, say=say, command=command)

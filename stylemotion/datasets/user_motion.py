@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import hashlib
 import re
+from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, Protocol
@@ -30,6 +31,15 @@ from stylemotion.io.bvh import parse_bvh
 from stylemotion.io.errors import MotionDataError, UserInputError
 from stylemotion.io.outputs import safe_name
 from stylemotion.io.sources import FileSource
+
+#: The config keys that say how a user's BVH file is converted (None: detected); every command takes them.
+CONVERSION_KEYS = ("joint_map", "unit_scale", "up_axis")
+
+
+def conversion_keys(config: Mapping[str, Any]) -> dict[str, Any]:
+    """The :data:`CONVERSION_KEYS` of a command's (plain) config, each None when absent."""
+    return {key: config.get(key) for key in CONVERSION_KEYS}
+
 
 #: A frame range after the file: ``:<start>-<end>``, whatever the two parts hold (checked afterwards).
 _RANGE = re.compile(r"^(?P<path>.*[^:]):(?P<range>[^:/\\]*-[^:/\\]*)$")

@@ -34,9 +34,10 @@ from omegaconf import DictConfig
 
 from stylemotion.config import ConfigError, positive_int
 from stylemotion.datasets import TakeSet
+from stylemotion.datasets.user_motion import conversion_keys
 from stylemotion.io.outputs import check_new_output
 from stylemotion.provenance import provenance
-from stylemotion.reconstruct.inputs import command_takeset, conversion_of, database_without, joints_option, plain_config
+from stylemotion.reconstruct.inputs import command_takeset, database_without, joints_option, plain_config
 from stylemotion.reconstruct.markers import (
     DEFAULT_MARKERS,
     MarkerGapWarning,
@@ -145,5 +146,5 @@ def reconstruct_from_config(cfg: DictConfig, say: Say = print, command: str = ""
         plain["data"], plain["markers"], plain["out"], features=str(plain.get("features", "E15")),
         k=plain.get("k", 64), joints=joints, noise_mm=plain.get("noise_mm", 0.0), seed=int(plain.get("seed", 0)),
         exclude_markers_take=bool(plain.get("exclude_markers_take", True)), model=plain.get("model") or {},
-        conversion=conversion_of(plain),
+        conversion=conversion_keys(plain),
         force=bool(plain.get("force", False)), gif=bool(plain.get("gif", True)), say=say, command=command)

@@ -38,11 +38,6 @@ def plain_config(cfg: DictConfig, command: str) -> dict[str, Any]:
     return plain
 
 
-def conversion_of(plain: Mapping[str, Any]) -> dict[str, Any]:
-    """The BVH conversion keys of a command's config (``joint_map``, ``unit_scale``, ``up_axis``)."""
-    return {key: plain.get(key) for key in ("joint_map", "unit_scale", "up_axis")}
-
-
 def joints_option(plain: Mapping[str, Any], example: str) -> list[str] | None:
     """The ``joints`` key: None or a list; ConfigError with ``example`` (e.g. ``'[Hips,Foot_L]'``) otherwise."""
     joints = plain.get("joints")

@@ -38,9 +38,10 @@ from omegaconf import DictConfig
 
 from stylemotion.config import ConfigError
 from stylemotion.datasets import TakeSet
+from stylemotion.datasets.user_motion import conversion_keys
 from stylemotion.io.outputs import check_new_output
 from stylemotion.provenance import provenance
-from stylemotion.reconstruct.inputs import command_takeset, conversion_of, database_without, plain_config
+from stylemotion.reconstruct.inputs import command_takeset, database_without, plain_config
 from stylemotion.reconstruct.keyframes import (
     DynamicMotionGraph,
     FarKeyframeWarning,
@@ -220,5 +221,5 @@ def keyframes_from_config(cfg: DictConfig, say: Say = print, command: str = "") 
         raise ConfigError("keys= is empty: give a keyframe JSON file (stylemotion-keyframes --help)")
     return keyframes_command(
         plain["data"], plain["keys"], plain["out"], exclude_key_takes=bool(plain.get("exclude_key_takes", True)),
-        model=plain.get("model") or {}, conversion=conversion_of(plain),
+        model=plain.get("model") or {}, conversion=conversion_keys(plain),
         force=bool(plain.get("force", False)), gif=bool(plain.get("gif", True)), say=say, command=command)

@@ -25,9 +25,10 @@ from omegaconf import DictConfig
 
 from stylemotion.config import ConfigError
 from stylemotion.datasets import TakeSet
+from stylemotion.datasets.user_motion import conversion_keys
 from stylemotion.io.outputs import check_new_output
 from stylemotion.provenance import provenance
-from stylemotion.reconstruct.inputs import command_takeset, conversion_of, database_without, joints_option, plain_config
+from stylemotion.reconstruct.inputs import command_takeset, database_without, joints_option, plain_config
 from stylemotion.reconstruct.markers import read_markers
 from stylemotion.reconstruct.output import write_motion_folder
 from stylemotion.reconstruct.texture import LEG_JOINTS, MODES, MotionTexturer, TextureInputError, check_joints
@@ -123,5 +124,5 @@ def texture_from_config(cfg: DictConfig, say: Say = print, command: str = "") ->
     return texture_command(
         plain["data"], plain["motion"], plain["out"], mode=str(plain.get("mode", "complete")), joints=joints, k=k,
         exclude_motion_take=bool(plain.get("exclude_motion_take", True)), model=plain.get("model") or {},
-        conversion=conversion_of(plain),
+        conversion=conversion_keys(plain),
         force=bool(plain.get("force", False)), gif=bool(plain.get("gif", True)), say=say, command=command)

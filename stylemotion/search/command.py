@@ -34,7 +34,13 @@ from omegaconf import DictConfig, OmegaConf
 from stylemotion.config import ConfigError, positive_int
 from stylemotion.datasets import TakeSet, build_dataset
 from stylemotion.datasets.loading import ConversionSettings
-from stylemotion.datasets.user_motion import UserMotionError, convert_example, on_run_skeleton, parse_example
+from stylemotion.datasets.user_motion import (
+    UserMotionError,
+    conversion_keys,
+    convert_example,
+    on_run_skeleton,
+    parse_example,
+)
 from stylemotion.io.atomic import atomic_folder
 from stylemotion.io.errors import UserInputError
 from stylemotion.io.jsonfile import write_json
@@ -270,7 +276,7 @@ def search_from_config(cfg: DictConfig, say: Say = print, command: str = "") -> 
         engine=plain.get("engine", "ckdtree"), normalize=plain.get("normalize", "none"),
         exclude_query_take=bool(plain.get("exclude_query_take", True)),
         retarget_query=bool(plain.get("retarget_query", True)),
-        conversion={key: plain.get(key) for key in ("joint_map", "unit_scale", "up_axis")},
+        conversion=conversion_keys(plain),
         export_bvh=bool(export.get("bvh", False)), export_gif=bool(export.get("gif", False)),
         export_top=export.get("top", 3), figure_matches=figure.get("matches", 3),
         figure_margin_s=float(figure.get("margin_s", 1.0)), force=bool(plain.get("force", False)), say=say,

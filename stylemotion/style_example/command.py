@@ -41,6 +41,7 @@ from omegaconf import DictConfig, OmegaConf
 from stylemotion.config import ConfigError, config_dir, positive_int
 from stylemotion.datasets import TakeSet, build_dataset
 from stylemotion.datasets.loading import ConversionSettings
+from stylemotion.datasets.user_motion import CONVERSION_KEYS, conversion_keys
 from stylemotion.io.atomic import atomic_folder
 from stylemotion.io.jsonfile import plain, write_json
 from stylemotion.io.outputs import check_new_output, inside
@@ -62,9 +63,6 @@ from stylemotion.style_example.example import (
 )
 from stylemotion.style_example.methods import Method, recorded_path
 from stylemotion.style_example.zero_shot import ZeroShotMethod
-
-#: Conversion keys of the command (``stylemotion.datasets.loading.ConversionSettings`` fields).
-CONVERSION_KEYS = ("joint_map", "unit_scale", "up_axis")
 
 Say = Callable[[str], None]
 
@@ -351,6 +349,6 @@ def add_style_from_config(cfg: DictConfig | Mapping[str, Any], say: Say = print,
     return add_style(str(values["example"]), values["run"], values["name"], values["out"],
                      method=values.get("method", "cvae"), action=values.get("action"),
                      samples=values.get("samples", 1000), seed=values.get("seed"), threads=values.get("threads", 1),
-                     conversion={k: values.get(k) for k in CONVERSION_KEYS}, say=say, command=command,
+                     conversion=conversion_keys(values), say=say, command=command,
                      network=values.get("network"), network_epochs=values.get("network_epochs"))
 
