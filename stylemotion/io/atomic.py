@@ -9,6 +9,17 @@ from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
+from stylemotion.io.errors import OutputWriteError
+
+
+def _make_parent(path: Path) -> None:
+    """Create ``path``'s folder; :class:`OutputWriteError` naming it when it cannot be (read-only, a file)."""
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise OutputWriteError(f"cannot write {path}: its folder {path.parent} cannot be created "
+                               f"({exc.strerror or exc}); choose another output") from None
+
 
 def _umask() -> int:
     umask = os.umask(0)
@@ -19,8 +30,11 @@ def _umask() -> int:
 def atomic_write_bytes(path: Path, data: bytes) -> None:
     """Write ``data`` to ``path`` via a temporary file in the same folder and ``os.replace`` (with the
     permissions of a normally created file: mkstemp's are private)."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    _make_parent(path)
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    except OSError as exc:
+        raise OutputWriteError(f"cannot write {path} ({exc.strerror or exc}); choose another output") from None
     try:
         with os.fdopen(fd, "wb") as fh:
             fh.write(data)
@@ -40,8 +54,12 @@ def atomic_folder(out: Path, on_exists: Callable[[], None] | None = None) -> Ite
     temporary folder is removed and ``out`` is untouched. If ``out`` exists at swap time,
     ``on_exists`` is called first (it may raise to refuse) and the old folder is then replaced.
     """
-    out.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.", dir=out.parent))
+    _make_parent(out)
+    try:
+        tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.", dir=out.parent))
+    except OSError as exc:
+        raise OutputWriteError(f"cannot write {out}: no folder can be made in {out.parent} "
+                               f"({exc.strerror or exc}); choose another output") from None
     os.chmod(tmp, 0o777 & ~_umask())  # mkdtemp makes it private; a result folder is not
     try:
         yield tmp

@@ -33,5 +33,9 @@ class LimitError(MotionDataError):
     """An input exceeds a configured size limit (the message names the key and its value)."""
 
 
+class OutputWriteError(UserInputError, OSError):
+    """An output that cannot be written where the user asked (a read-only or missing folder); names the path."""
+
+
 class MotionDataWarning(UserWarning):
     """Input that loads but is probably wrong (axes, units of time); the message names the file."""

@@ -13,7 +13,7 @@ import re
 import unicodedata
 from pathlib import Path
 
-from stylemotion.io.errors import UserInputError
+from stylemotion.io.errors import OutputWriteError, UserInputError
 
 
 class OutputExistsError(UserInputError, FileExistsError):
@@ -31,13 +31,21 @@ MAX_NAME_LENGTH = 120
 
 
 def check_new_output(path: str | os.PathLike, force: bool = False, key: str = "out") -> Path:
-    """``path`` as a Path; :class:`OutputExistsError` naming ``key`` if it exists and ``force`` is off.
+    """``path`` as a Path; :class:`OutputExistsError` naming ``key`` if it exists and ``force`` is off,
+    :class:`~stylemotion.io.errors.OutputWriteError` if it could not be made: the nearest existing folder above it
+    is read-only (or a file).
 
     Call it before any work, and again when the result is swapped into place.
     """
     path = Path(path).expanduser()
     if path.exists() and not force:
         raise OutputExistsError(f"{path} already exists; choose another {key}=… or pass force=true to replace it")
+    ancestor = path.absolute().parent
+    while not ancestor.exists() and ancestor != ancestor.parent:
+        ancestor = ancestor.parent
+    if not ancestor.is_dir() or not os.access(ancestor, os.W_OK | os.X_OK):
+        raise OutputWriteError(f"{key}={path}: {ancestor} is " + ("not a folder" if not ancestor.is_dir() else
+                               "read-only") + f"; choose another {key}=…")
     return path
 
 

@@ -29,6 +29,7 @@ from typing import Any
 import numpy as np
 from omegaconf import DictConfig, OmegaConf
 
+from stylemotion.config import ConfigError
 from stylemotion.datasets import Take, TakeSet, build_dataset
 from stylemotion.io.atomic import atomic_folder
 from stylemotion.io.jsonfile import write_json
@@ -265,6 +266,27 @@ def _sheet_rows(clips: list[Clip], action: str, per_primitive: int) -> dict[str,
     return rows
 
 
+#: Statistics a canonical timeline can take (``timeline=``).
+TIMELINE_STATISTICS = ("median", "mean", "min", "max")
+
+
+def check_report_values(cfg: DictConfig | dict) -> None:
+    """Refuse a bad ``timeline`` or a count that is not a whole number ≥ 0 (``plot_takes=-3`` would be read as
+    a slice), naming the key, before any work.
+
+    Raises:
+        ConfigError: naming the key and the value.
+    """
+    timeline = cfg.get("timeline", "median")
+    if timeline not in TIMELINE_STATISTICS:
+        raise ConfigError(f"timeline={timeline!r} is not a statistic of clip lengths; one of "
+                          f"{list(TIMELINE_STATISTICS)}")
+    for key in ("plot_takes", "plot_rejected", "sheet_clips"):
+        value = cfg.get(key, 0)
+        if isinstance(value, bool) or not isinstance(value, int) or value < 0:
+            raise ConfigError(f"{key} must be a whole number ≥ 0, got {value!r}")
+
+
 def write_report(cfg: DictConfig | dict, out: Path, force: bool = False, command: str = "") -> dict[str, Any]:
     """Segment ``cfg.data`` and write the report folder ``out`` (see the module docstring).
 
@@ -276,6 +298,7 @@ def write_report(cfg: DictConfig | dict, out: Path, force: bool = False, command
 
     out = check_new_output(out, force)
     cfg = OmegaConf.create(cfg) if isinstance(cfg, dict) else cfg
+    check_report_values(cfg)
     settings = SegmentSettings.from_dict(OmegaConf.to_container(cfg.segment, resolve=True) if cfg.get("segment")
                                          else {})
     takeset = build_dataset(cfg.data)
