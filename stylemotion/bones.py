@@ -28,6 +28,7 @@ from stylemotion.skeleton import (
     FOOT_POINTS,
     JOINT_INDEX,
     bone_lengths,
+    checked_positions,
     forward_kinematics,
 )
 
@@ -111,7 +112,7 @@ def retarget_positions(positions: np.ndarray, target_lengths: np.ndarray) -> np.
             child joint has zero length too (naming the bone and frame; a zero-length bone otherwise
             takes the direction from its parent to its child joint), or a zero leg length.
     """
-    source = _check_positions(positions)
+    source = checked_positions(positions)
     target = _check_lengths(target_lengths)
     children, parents = list(BONE_JOINTS), [CANONICAL_PARENTS[j] for j in BONE_JOINTS]
     vectors = source[:, children] - source[:, parents]  # (frames, 20, 3)
@@ -163,22 +164,6 @@ def _through_short_bones(source: np.ndarray, vectors: np.ndarray, lengths: np.nd
         usable = short[:, bone] & (span >= MIN_BONE_LENGTH)
         vectors[usable, bone], lengths[usable, bone] = through[usable], span[usable]
     return vectors, lengths, lengths < MIN_BONE_LENGTH
-
-
-def _check_positions(positions: np.ndarray) -> np.ndarray:
-    """``positions`` as float64 ``(frames, 21, 3)``; ValueError naming what is wrong."""
-    array = np.asarray(positions)
-    if array.ndim != 3 or array.shape[1:] != (len(CANONICAL_JOINTS), 3) or array.shape[0] < 1:
-        raise ValueError(f"positions must have shape (frames, {len(CANONICAL_JOINTS)}, 3) with at least one "
-                         f"frame, got {array.shape}")
-    if not np.issubdtype(array.dtype, np.number):
-        raise ValueError(f"positions must be numbers, got dtype {array.dtype}")
-    array = array.astype(np.float64)
-    if not np.all(np.isfinite(array)):
-        frame, joint, _ = (int(i) for i in np.argwhere(~np.isfinite(array))[0])
-        raise ValueError(f"positions hold NaN or infinite values, first at frame {frame}, joint "
-                         f"{CANONICAL_JOINTS[joint]!r}")
-    return array
 
 
 def _check_lengths(target_lengths: np.ndarray) -> np.ndarray:

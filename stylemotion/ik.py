@@ -33,7 +33,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from stylemotion.geometry import relative_rotation
-from stylemotion.skeleton import CANONICAL_JOINTS, CANONICAL_PARENTS, forward_kinematics
+from stylemotion.skeleton import CANONICAL_JOINTS, CANONICAL_PARENTS, checked_positions, forward_kinematics
 
 #: Bones shorter than this (metres) have no direction to fit and are rejected.
 MIN_BONE_LENGTH = 1e-6
@@ -117,23 +117,10 @@ def _check_parents(parents: np.ndarray | tuple[int, ...] | list[int]) -> tuple[i
     return parents
 
 
-def _check_positions(positions: np.ndarray, parents: tuple[int, ...]) -> np.ndarray:
-    """``positions`` as float64 ``(frames, joints, 3)``; ValueError naming what is wrong."""
-    positions = np.asarray(positions)
-    num_joints = len(parents)
-    if positions.ndim != 3 or positions.shape[1:] != (num_joints, 3) or positions.shape[0] < 1:
-        raise ValueError(f"positions must have shape (frames, {num_joints}, 3) with at least one frame, "
-                         f"got {positions.shape}")
-    if not np.issubdtype(positions.dtype, np.number):
-        raise ValueError(f"positions must be numbers, got dtype {positions.dtype}")
-    positions = positions.astype(np.float64)
-    bad = ~np.isfinite(positions)
-    if bad.any():
-        frame, joint, _ = np.argwhere(bad)[0]
-        raise ValueError(f"positions contain {int(bad.sum())} NaN or infinite value(s); the first is at "
-                         f"frame {frame}, joint {_joint_name(int(joint), parents)}")
-    lengths = _bone_vectors_and_lengths(positions, parents)[1]
-    _check_bone_lengths(lengths, parents, "positions")
+def _positions_with_bones(positions: np.ndarray, parents: tuple[int, ...]) -> np.ndarray:
+    """:func:`~stylemotion.skeleton.checked_positions`, and every bone longer than :data:`MIN_BONE_LENGTH`."""
+    positions = checked_positions(positions, parents)
+    _check_bone_lengths(_bone_vectors_and_lengths(positions, parents)[1], parents, "positions")
     return positions
 
 
@@ -281,7 +268,7 @@ def rest_offsets(positions: np.ndarray, parents: tuple[int, ...] = CANONICAL_PAR
         ``(joints, 3)`` offsets in metres, zeros for the root.
     """
     parents = _check_parents(parents)
-    positions = _check_positions(positions, parents)
+    positions = _positions_with_bones(positions, parents)
     vectors, lengths = _bone_vectors_and_lengths(positions, parents)
     directions = _normalize(np.where(lengths[..., None] > 0, vectors, 1.0))[0]
     for kids in _children(parents):
@@ -334,7 +321,7 @@ def fit_rotations(
             bad ``parents``/``offsets``.
     """
     parents = _check_parents(parents)
-    positions = _check_positions(positions, parents)
+    positions = _positions_with_bones(positions, parents)
     offsets = rest_offsets(positions, parents) if offsets is None else _check_offsets(offsets, parents)
     vectors, lengths = _bone_vectors_and_lengths(positions, parents)
     root = parents.index(-1)

@@ -109,6 +109,32 @@ class Skeleton:
         return [j for j, p in enumerate(self.parents) if p == joint]
 
 
+def checked_positions(positions: np.ndarray, parents: tuple[int, ...] | None = None, min_frames: int = 1,
+                      what: str = "positions") -> np.ndarray:
+    """``positions`` as float64 ``(frames ≥ min_frames, joints, 3)`` (joints: ``len(parents)``, the canonical 21
+    by default), finite numbers; the one check every module runs on a motion's joint positions.
+
+    Raises:
+        ValueError: naming ``what``, the wrong shape or dtype, or the first NaN/inf by frame and joint.
+    """
+    parents = CANONICAL_PARENTS if parents is None else tuple(parents)
+    array = np.asarray(positions)
+    num_joints = len(parents)
+    if array.ndim != 3 or array.shape[1:] != (num_joints, 3) or array.shape[0] < min_frames:
+        raise ValueError(f"{what} must have shape (frames, {num_joints}, 3) with at least {min_frames} frame(s), "
+                         f"got {array.shape}")
+    if not np.issubdtype(array.dtype, np.number):
+        raise ValueError(f"{what} must be numbers, got dtype {array.dtype}")
+    array = array.astype(np.float64)
+    bad = ~np.isfinite(array)
+    if bad.any():
+        frame, joint, _ = (int(i) for i in np.argwhere(bad)[0])
+        name = repr(CANONICAL_JOINTS[joint]) if parents == CANONICAL_PARENTS else f"joint {joint}"
+        raise ValueError(f"{what} hold NaN or infinite values, first at frame {frame}, joint {name} "
+                         f"({int(bad.sum())} in all)")
+    return array
+
+
 def forward_kinematics(
     rotations: np.ndarray, translations: np.ndarray, parents: np.ndarray | tuple[int, ...],
     return_rotations: bool = False,

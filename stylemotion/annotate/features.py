@@ -19,7 +19,7 @@ import numpy as np
 from stylemotion.geometry import facing_direction, left_direction, wrap_angle
 from stylemotion.io.errors import UserInputError
 from stylemotion.representation import facing_yaw
-from stylemotion.skeleton import JOINT_INDEX, NUM_JOINTS
+from stylemotion.skeleton import JOINT_INDEX, checked_positions
 
 J = JOINT_INDEX
 
@@ -85,11 +85,10 @@ def relational_features(positions: np.ndarray, fps: float) -> np.ndarray:
     Raises:
         FeatureInputError: a wrong shape, non-finite positions or a zero-size body (naming the value).
     """
-    p = np.asarray(positions, dtype=np.float64)
-    if p.ndim != 3 or p.shape[1:] != (NUM_JOINTS, 3) or p.shape[0] < 1:
-        raise FeatureInputError(f"positions must be (frames ≥ 1, {NUM_JOINTS}, 3), got {p.shape}")
-    if not np.isfinite(p).all():
-        raise FeatureInputError("positions contain non-finite values")
+    try:
+        p = checked_positions(positions)
+    except ValueError as exc:
+        raise FeatureInputError(str(exc)) from None
     if not fps > 0:
         raise FeatureInputError(f"fps={fps} must be positive")
     h, w = body_units(p)

@@ -31,7 +31,7 @@ import numpy as np
 
 from stylemotion.geometry import EPSILON, facing_direction, rotate_yaw
 from stylemotion.representation import facing_yaw
-from stylemotion.skeleton import JOINT_INDEX, NUM_JOINTS
+from stylemotion.skeleton import JOINT_INDEX, NUM_JOINTS, checked_positions
 
 #: Ways to put joints into the body frame (see the module docstring).
 NORMALIZATIONS = ("3d", "2d")
@@ -52,15 +52,6 @@ E39_JOINTS = E30_JOINTS + ("UpperArm_L", "UpperArm_R", "Spine")
 
 # ---------------------------------------------------------------------------------------------
 # Body frame
-
-
-def _check_positions(positions: np.ndarray) -> np.ndarray:
-    positions = np.asarray(positions)
-    if positions.ndim != 3 or positions.shape[1:] != (NUM_JOINTS, 3) or positions.shape[0] < 1:
-        raise ValueError(f"positions must be (frames ≥ 1, {NUM_JOINTS}, 3), got {positions.shape}")
-    if not np.all(np.isfinite(positions)):
-        raise ValueError("positions contain NaN or infinite values")
-    return positions.astype(np.float64)
 
 
 def _check_normalization(normalization: str) -> None:
@@ -103,7 +94,7 @@ def body_frame_positions(positions: np.ndarray, fps: float, normalization: str =
         ``(frames, 21, 3)`` float64, metres.
     """
     _check_normalization(normalization)
-    positions = _check_positions(positions)
+    positions = checked_positions(positions)
     root = positions[:, JOINT_INDEX["Hips"], :]
     if normalization == "3d":
         rotation = root_frames(positions)
@@ -283,7 +274,7 @@ def physics_terms(positions: np.ndarray, fps: float, terms: int = 4, interval_s:
     for value, key in ((fps, "fps"), (interval_s, "interval_s"), (body_mass_kg, "body_mass_kg")):
         if not (np.isfinite(value) and value > 0):
             raise ValueError(f"physics terms need a positive finite {key}, got {value!r}")
-    positions = _check_positions(positions)
+    positions = checked_positions(positions)
     frames_per_interval = interval_s * fps
     acceleration = _second_difference(centre_of_mass(positions)) * frames_per_interval**2
     momentum = angular_momentum(positions) * frames_per_interval * body_mass_kg
@@ -456,7 +447,7 @@ def compute_features(
     spec = feature_spec(name)
     fps = _check_fps(fps)
     _check_normalization(normalization)
-    positions = _check_positions(positions)
+    positions = checked_positions(positions)
     need = spec.window_frames(fps)
     if not allow_short and positions.shape[0] < need:
         raise ValueError(f"feature set {name} needs at least {need} frames ({WINDOW_SECONDS} s at {fps:g} fps), "

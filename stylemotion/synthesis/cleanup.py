@@ -20,7 +20,7 @@ import numpy as np
 
 from stylemotion.geometry import two_bone_ik
 from stylemotion.primitives.contacts import contact_intervals, foot_contacts, horizontal_speed
-from stylemotion.skeleton import FOOT_POINTS, JOINT_INDEX, NUM_JOINTS
+from stylemotion.skeleton import FOOT_POINTS, JOINT_INDEX, checked_positions
 
 #: Closest a solved leg comes to fully straight or fully folded: the hip–ankle distance stays this
 #: far inside ``[|thigh − shin|, thigh + shin]``, metres.
@@ -83,9 +83,7 @@ def clean_foot_skating(positions: np.ndarray, fps: float, release_frames: int = 
     Returns:
         ``(frames, 21, 3)`` float64 corrected positions (only knees, ankles and toes move).
     """
-    p = np.array(positions, dtype=np.float64)
-    if p.ndim != 3 or p.shape[1:] != (NUM_JOINTS, 3) or len(p) < 2:
-        raise ValueError(f"positions must be (frames ≥ 2, {NUM_JOINTS}, 3), got {p.shape}")
+    p = checked_positions(positions, min_frames=2)
     contact = foot_contacts(p, fps, rest_heights=rest_heights)
     for foot, (hip, knee, ankle, toes) in enumerate(LEGS):
         shift = planted_drift(p, fps, contact[:, foot], foot, release_frames)

@@ -26,7 +26,7 @@ import numpy as np
 
 from stylemotion.io.errors import MotionDataError
 from stylemotion.primitives.contacts import foot_contacts
-from stylemotion.skeleton import CANONICAL_JOINTS, JOINT_INDEX, NUM_JOINTS
+from stylemotion.skeleton import CANONICAL_JOINTS, JOINT_INDEX, NUM_JOINTS, checked_positions
 
 #: Files inside a run folder that hold motions, in the order they are looked for.
 RUN_MOTION = "motion.npz"
@@ -64,15 +64,12 @@ class ViewerMotion:
 
 
 def _check_positions(positions: np.ndarray, source: str, key: str = "positions") -> np.ndarray:
-    if positions.ndim != 3 or positions.shape[1:] != (NUM_JOINTS, 3):
-        raise MotionDataError(source, f"key {key!r} has shape {positions.shape}; expected (frames, {NUM_JOINTS}, 3) "
-                                      f"canonical positions in metres")
-    if positions.shape[0] < 2:
-        raise MotionDataError(source, f"key {key!r} has {positions.shape[0]} frame(s); a motion needs at least 2")
-    if not np.isfinite(positions).all():
-        bad = int(np.argwhere(~np.isfinite(positions))[0][0])
-        raise MotionDataError(source, f"key {key!r} holds a non-finite value at frame {bad}")
-    return positions.astype(np.float32)
+    """Canonical positions of at least 2 frames as float32; MotionDataError naming the file and key."""
+    try:
+        return checked_positions(positions, min_frames=2, what=f"key {key!r}").astype(np.float32)
+    except ValueError as exc:
+        raise MotionDataError(source, f"{exc} (canonical positions in metres; a motion needs at least 2 frames)"
+                              ) from None
 
 
 def _fps(data: np.lib.npyio.NpzFile, source: str) -> float:

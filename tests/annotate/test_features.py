@@ -26,7 +26,7 @@ def test_walk_and_run_features(synthetic_split):
 
 @pytest.mark.parametrize("positions, match", [
     (np.zeros((5, 20, 3)), "21, 3"),
-    (np.full((5, 21, 3), np.nan), "non-finite"),
+    (np.full((5, 21, 3), np.nan), "NaN or infinite"),
     (np.zeros((5, 21, 3)), "degenerate body"),
 ])
 def test_bad_input(positions, match):

@@ -55,13 +55,13 @@ def test_samples_folder_written_by_the_sample_callback(tmp_path):
 
 
 @pytest.mark.parametrize("content, match", [
-    ({"positions": np.zeros((10, 20, 3)), "fps": 30.0}, r"shape \(10, 20, 3\); expected \(frames, 21, 3\)"),
+    ({"positions": np.zeros((10, 20, 3)), "fps": 30.0}, r"must have shape \(frames, 21, 3\).*got \(10, 20, 3\)"),
     ({"positions": np.zeros((10, 21, 3))}, "no key 'fps'"),
     ({"positions": np.zeros((10, 21, 3)), "fps": -1.0}, "key 'fps'"),
     ({"rotations": np.zeros((10, 21, 3)), "fps": 30.0}, "no key 'positions'"),
     ({"positions": np.zeros((2, 10, 21, 3)), "fps": 30.0}, "no key 'num_frames'"),
     ({"positions": np.zeros((10, 21, 3)), "fps": 30.0, "path": np.zeros((5, 3))}, "key 'path'"),
-    ({"positions": np.full((10, 21, 3), np.nan), "fps": 30.0}, "non-finite value at frame 0"),
+    ({"positions": np.full((10, 21, 3), np.nan), "fps": 30.0}, "NaN or infinite values, first at frame 0"),
 ])
 def test_bad_npz_names_file_and_key(tmp_path, content, match):
     bad = tmp_path / "bad.npz"
