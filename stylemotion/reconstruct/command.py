@@ -34,7 +34,7 @@ from omegaconf import DictConfig
 
 from stylemotion.config import ConfigError, positive_int
 from stylemotion.datasets import TakeSet
-from stylemotion.datasets.user_motion import conversion_keys
+from stylemotion.datasets.user_motion import conversion_keys, parse_example
 from stylemotion.io.outputs import check_new_output
 from stylemotion.provenance import provenance
 from stylemotion.reconstruct.inputs import command_takeset, database_without, joints_option, plain_config
@@ -61,7 +61,8 @@ def _number(value: Any, key: str, low: float = 0.0) -> float:
 
 def load_tracks(text: str, takeset: TakeSet, joints: Sequence[str] | None,
                 conversion: Mapping[str, Any] | None = None) -> tuple[MarkerTracks, str | None]:
-    """The marker tracks ``markers=`` names, and the take they were cut from (None for a file)."""
+    """The marker tracks ``markers=`` names (a file, a take, or ``<take>:start-end``: frames of a take, END exclusive),
+    and the take they were cut from (None for a file)."""
     names = {t.name: t for t in takeset.takes}
     if text in names and not Path(text).expanduser().is_file():
         take = names[text]
@@ -69,6 +70,18 @@ def load_tracks(text: str, takeset: TakeSet, joints: Sequence[str] | None,
                                      text), text
     if not text:
         raise MarkerInputError("markers= is empty: give a BVH, NPZ or CSV file or a take of the dataset")
+    name, _, frames = text.rpartition(":")
+    if name in names and not Path(text).expanduser().is_file():  # <take>:start-end, frames of the take
+        spec = parse_example(text, "markers")
+        take = names[name]
+        if spec.start is None or spec.end is None:
+            raise MarkerInputError(f"markers={text}: after a take's name give a frame range START-END "
+                                   f"(e.g. markers={name}:0-120)")
+        if spec.end > len(take.positions):
+            raise MarkerInputError(f"markers={text}: the frame range {frames} runs past the take's "
+                                   f"{len(take.positions)} frames (END exclusive)")
+        return tracks_from_positions(take.positions[spec.start:spec.end], DEFAULT_MARKERS if joints is None
+                                     else joints, takeset.fps, text), name
     return read_markers(text, joints, takeset.fps, dict(conversion or {})), None
 
 
