@@ -39,7 +39,8 @@ def check_new_output(path: str | os.PathLike, force: bool = False, key: str = "o
     """
     path = Path(path).expanduser()
     if path.exists() and not force:
-        raise OutputExistsError(f"{path} already exists; choose another {key}=… or pass force=true to replace it")
+        hint = f"another {key} or pass --force" if key.startswith("--") else f"another {key}=… or pass force=true"
+        raise OutputExistsError(f"{path} already exists; choose {hint} to replace it")
     ancestor = path.absolute().parent
     while not ancestor.exists() and ancestor != ancestor.parent:
         ancestor = ancestor.parent

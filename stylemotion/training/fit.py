@@ -256,6 +256,9 @@ def run(cfg: DictConfig, extra_callbacks: list[pl.Callback] | None = None,
     output_dir = Path(cfg.output_dir)
     set_torch_threads(cfg.get("threads"))
     check_trainer_numbers(cfg.trainer)
+    seed = cfg.get("seed")
+    if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
+        raise ConfigError(f"seed must be a whole number ≥ 0, got {seed!r}")
     callbacks = _instantiate_all(cfg.get("callbacks")) + list(extra_callbacks or [])
     loggers = _instantiate_all(cfg.get("logger"))
     ckpt_path = prepare_output(output_dir, cfg.get("ckpt_path"), bool(cfg.get("force", False)),

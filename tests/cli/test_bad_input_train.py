@@ -92,3 +92,12 @@ def test_the_command_refuses_a_junk_checkpoint_in_one_line(finished, tmp_path, c
     line = done.stderr.strip().splitlines()[-1]
     assert line.startswith(f"stylemotion-train: ckpt_path={junk}: ") and "not a readable checkpoint" in line
     assert not (tmp_path / "run" / "config_resolved.yaml").exists()
+
+
+@pytest.mark.parametrize("seed", ["abc", "-1", "1.5"])
+def test_a_bad_seed_is_refused_before_the_run_folder_is_made(seed, tmp_path):
+    from stylemotion.config import ConfigError
+
+    with pytest.raises(ConfigError, match="seed must be a whole number ≥ 0"):
+        run(_cfg(f"output_dir={tmp_path / 'run'}", f"seed={seed}"))
+    assert not (tmp_path / "run").exists()

@@ -51,7 +51,8 @@ def test_existing_out_refused_unless_forced(motion_files, tmp_path, capsys):
     out.mkdir()
     (out / "keep.txt").write_text("mine")
     assert main([str(motion_files[0]), "--out", str(out)]) == 2
-    assert "already exists" in capsys.readouterr().err and (out / "keep.txt").exists()
+    err = capsys.readouterr().err
+    assert "already exists; choose another --out or pass --force" in err and (out / "keep.txt").exists()
     assert main([str(motion_files[0]), "--out", str(out), "--force"]) == 0
     assert (out / "index.html").is_file() and not (out / "keep.txt").exists()
 
