@@ -70,8 +70,8 @@ def write_json(path: str | os.PathLike, value: Any, indent: int | None = 1) -> P
     return path
 
 
-def read_json(path: str | os.PathLike, what: str = "JSON file") -> Any:
-    """The value in the JSON file ``path``.
+def read_json(path: str | os.PathLike, what: str = "JSON file", remedy: str = "rerun the command that wrote it") -> Any:
+    """The value in the JSON file ``path``; ``remedy`` ends the message of a damaged one.
 
     Raises:
         JsonFileError: the file is missing, not a regular file (a FIFO, a folder), unreadable, not UTF-8 or not
@@ -90,4 +90,4 @@ def read_json(path: str | os.PathLike, what: str = "JSON file") -> Any:
         return json.loads(text)
     except json.JSONDecodeError as exc:
         raise JsonFileError(f"{path}:{exc.lineno}: not valid JSON at column {exc.colno} ({exc.msg}); the {what} is "
-                            "damaged or cut off — rerun the command that wrote it") from None
+                            f"damaged or cut off — {remedy}") from None

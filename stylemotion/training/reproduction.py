@@ -55,12 +55,12 @@ from typing import Any
 from hydra import compose
 from omegaconf import DictConfig, OmegaConf, open_dict
 
-from stylemotion.config import positive_int, set_torch_threads  # also registers the configs' resolvers
+from stylemotion.config import ConfigError, positive_int, set_torch_threads  # also registers the configs' resolvers
 from stylemotion.datasets import build_dataset, data_config_key
 from stylemotion.evaluation.run import recorded_path, run_evaluation, summary_lines
-from stylemotion.io.errors import UserInputError
-from stylemotion.io.jsonfile import write_json
-from stylemotion.io.outputs import inside, safe_name
+from stylemotion.io.errors import OutputWriteError, UserInputError
+from stylemotion.io.jsonfile import JsonFileError, read_json, write_json
+from stylemotion.io.outputs import check_new_output, inside, safe_name
 from stylemotion.primitives.segmentation import SegmentSettings, action_of, parse_primitive, segment_takes
 from stylemotion.provenance import provenance
 
@@ -111,6 +111,28 @@ def _write_json(path: Path, payload: Any) -> None:
     write_json(path, payload)
 
 
+def read_record(path: Path, what: str, remedy: str) -> dict[str, Any]:
+    """The JSON object an earlier run wrote to ``path`` (a stage's ``done.json``, ``evaluation.json``).
+
+    Raises:
+        JsonFileError: it is missing, cut off or not an object; the message names the file and ends in ``remedy``.
+    """
+    value = read_json(path, what, remedy)
+    if not isinstance(value, dict):
+        raise JsonFileError(f"{path}: the {what} holds a {type(value).__name__}, not an object; {remedy}")
+    return value
+
+
+def check_out_folder(out: str | Path) -> Path:
+    """``out`` as a Path, refused in one line (:class:`~stylemotion.io.errors.OutputWriteError` naming ``out``)
+    when it is a file, lies below a file or in a read-only folder; an existing folder is a run to resume."""
+    path = Path(str(out)).expanduser()
+    if path.exists() and not path.is_dir():
+        raise OutputWriteError(f"out={path} is a file, not a folder; the reproduction writes a folder of stages "
+                               "there: choose another out=…")
+    return path if path.is_dir() else check_new_output(path, key="out")
+
+
 class Reproduction:
     """The stages of one reproduction run (see the module doc) and their execution.
 
@@ -126,7 +148,10 @@ class Reproduction:
         self.data_cfg = OmegaConf.to_container(cfg.data, resolve=True)
         self.primitives = [str(p) for p in cfg.primitives]
         for p in self.primitives:
-            parse_primitive(p)
+            try:
+                parse_primitive(p)
+            except ValueError as exc:
+                raise ConfigError(f"primitives: {exc}") from None
         self.provenance = provenance()  # version, commit and command of this run (in reproduce.json)
         self.started = time.perf_counter()
         self.stages: list[Stage] = []
@@ -156,7 +181,7 @@ class Reproduction:
             for s in styles:
                 folder = inside(self.out, "cvae", f"{p}_{safe_name(s, 'style label')}")
                 if folder in folders:
-                    raise ValueError(f"style labels {folders[folder]!r} and {s!r} would share the folder {folder}; "
+                    raise ConfigError(f"style labels {folders[folder]!r} and {s!r} would share the folder {folder}; "
                                      "rename one in the data's labels")
                 folders[folder] = s
                 self.stages.append(Stage("cvae", f"cvae {p}/{s}", folder, list(stages_cfg.cvae) + no_gif,
@@ -174,12 +199,17 @@ class Reproduction:
         styles = takeset.label_values("style")
         neutral = str(self.cfg.evaluation.neutral_style)
         if neutral not in styles:
-            raise ValueError(f"the neutral style {neutral!r} is not in dataset {takeset.name!r} (styles {styles}); "
-                             "set evaluation.neutral_style")
+            raise ConfigError(f"evaluation.neutral_style: the neutral style {neutral!r} is not in dataset "
+                              f"{takeset.name!r} (styles {styles}); set evaluation.neutral_style")
         wanted = [s for s in (self.cfg.styles if self.cfg.styles is not None else styles) if s != neutral]
         missing = [s for s in wanted if s not in styles]
         if missing:
-            raise ValueError(f"style(s) {missing} are not in dataset {takeset.name!r} (styles {styles})")
+            raise ConfigError(f"styles: {missing} are not in dataset {takeset.name!r} (styles {styles}); "
+                              "set styles=[…] to some of them, or styles=null for all")
+        empty = [p for p in self.primitives if not any(counts[(p, s)] for s in styles)]
+        if empty:
+            raise ConfigError(f"primitives: {empty} have no clips in dataset {takeset.name!r} "
+                              f"(contents {sorted({t.content for t in takeset.takes})}); choose others")
         self.data_summary = {"name": takeset.name, "takes": len(takeset), "frames": takeset.num_frames,
                              "styles": styles, "cvae_styles": wanted,
                              "clips": {p: {s: counts[(p, s)] for s in styles} for p in self.primitives},
@@ -202,20 +232,27 @@ class Reproduction:
         done, started = stage.folder / "done.json", stage.folder / "stage.json"
         last = stage.folder / "checkpoints" / "last.ckpt"
         has_results = done.is_file() or any((stage.folder / "checkpoints").glob("*.ckpt"))
+        remedy = f"delete {stage.folder} to train the {stage.name} stage again"
         for record_path in (done, started):
             if record_path.is_file() and has_results:  # a stage that saved nothing is simply started again
-                recorded = json.loads(record_path.read_text()).get("settings_hash")
+                recorded = read_record(record_path, f"{stage.name} stage's record", remedy).get("settings_hash")
                 if recorded != stage.settings_hash:
                     raise StageConflictError(
                         f"{stage.folder} holds the {stage.name} stage of a run with other settings (hash {recorded}, "
                         f"now {stage.settings_hash}: overrides, data, seed or an earlier stage changed). Choose "
                         f"another out=… or delete {stage.folder} to train it again")
         if done.is_file():
-            record = json.loads(done.read_text())
-            checkpoint = self.located(record.get("checkpoint"))
+            record = read_record(done, f"{stage.name} stage's record", remedy)
+            checkpoint, seconds = record.get("checkpoint"), record.get("seconds", 0.0)
+            metrics = record.get("metrics", {})
+            if not (isinstance(checkpoint, (str, type(None))) and isinstance(seconds, (int, float))
+                    and not isinstance(seconds, bool) and isinstance(metrics, dict)):
+                raise JsonFileError(f"{done}: the {stage.name} stage's record has a checkpoint, seconds or metrics of "
+                                    f"the wrong type; {remedy}")
+            checkpoint = self.located(checkpoint)
             if checkpoint and Path(checkpoint).is_file():
                 stage.status, stage.checkpoint = "reused", checkpoint
-                stage.seconds, stage.metrics = float(record.get("seconds", 0.0)), record.get("metrics", {})
+                stage.seconds, stage.metrics = float(seconds), metrics
                 self._line(index, f"{stage.name}: reused {stage.checkpoint}")
                 return None
         resume = last.is_file()
@@ -301,13 +338,15 @@ class Reproduction:
                                "evaluation": OmegaConf.to_container(self.cfg.evaluation, resolve=True),
                                **({"morphable": True} if morphable else {})})  # off: the hash of earlier runs
         if report.exists():
-            recorded = json.loads(record.read_text()).get("settings_hash") if record.is_file() else None
+            remedy = f"delete {report} to evaluate again"
+            recorded = read_record(record, "evaluation record", remedy).get("settings_hash") if record.is_file() \
+                else None
             if recorded != settings_hash or not (report / "report.json").is_file():
                 raise StageConflictError(
                     f"{report} holds a report of other models or settings (a stage was retrained, or the evaluation "
                     f"settings changed); delete {report} to evaluate again, or choose another out=…")
             self._line(step, f"evaluation: reused {report}")
-            return json.loads((report / "report.json").read_text())
+            return read_record(report / "report.json", "evaluation report", remedy)
         self._line(step, f"evaluation → {report}")
         models = [s.checkpoint for s in self.stages if s.kind in ("vae", "cvae")]
         ae = next(s.checkpoint for s in self.stages if s.kind == "autoencoder")
@@ -390,7 +429,7 @@ def executor_engine(cfg: DictConfig) -> str:
     node = cfg.get("executor")
     engine = str(node.get("engine", "pool")) if node is not None else "pool"
     if engine not in ENGINES:
-        raise ValueError(f"reproduce config key 'executor.engine' must be one of {list(ENGINES)}, got {engine!r}")
+        raise ConfigError(f"reproduce config key 'executor.engine' must be one of {list(ENGINES)}, got {engine!r}")
     return engine
 
 
@@ -463,7 +502,7 @@ def choose_budget(cfg: DictConfig) -> str:
     if cfg.get("budget") is not None:
         return f"budget: budget/{cfg.budget.get('name', _data_choice() or '?')}"
     if cfg.get("default_budget") is None:
-        raise ValueError("no training budget: no configs/budget/<data config name>.yaml and no default_budget")
+        raise ConfigError("no training budget: no configs/budget/<data config name>.yaml and no default_budget")
     with open_dict(cfg):
         cfg.budget = cfg.default_budget
     choice = _data_choice()
@@ -492,6 +531,7 @@ def reproduce(cfg: DictConfig, say=print) -> dict[str, Any]:
     workers = positive_int(cfg.get("workers", 1), "workers")
     engine = executor_engine(cfg)
     say(choose_budget(cfg))
+    check_out_folder(cfg.out)
     repro = Reproduction(cfg, say)
     repro.out.mkdir(parents=True, exist_ok=True)
     repro.data_stage()
