@@ -1,5 +1,6 @@
-"""What later tools read of a finished reproduce run (:mod:`stylemotion.training.run_folder`): its JSON objects (with
-its data config, seed and evaluation settings, and recorded paths found again after the run folder moved."""
+"""What later tools read of a finished reproduce run (:mod:`stylemotion.training.run_folder`): its JSON objects
+(with clear errors), its stages by kind, its data config, seed and evaluation settings, and recorded paths found
+again after the run folder moved."""
 
 from __future__ import annotations
 
