@@ -275,9 +275,11 @@ def test_data_without_a_budget_of_its_own_uses_the_default_budget(tmp_path: Path
         bandai = compose(config_name="reproduce", overrides=["data=bandai"])
     assert cfg.get("budget") is None and cfg.data.pattern == "(?P<style>[a-z]+)_(?P<take>\\d+)"
     assert choose_budget(cfg).startswith("budget: budget/default (there is no budget")
-    assert list(cfg.stages.vae) == ["experiment=primitive_vae", "trainer.max_epochs=100"]
-    assert list(cfg.stages.cvae)[1:] == list(bandai.stages.cvae)[1:] == ["trainer.max_epochs=60",
-                                                                         "model.style_weight=5.0"]
+    assert list(cfg.stages.vae) == ["experiment=primitive_vae", "trainer.max_epochs=100", "model.samples_per_item=10",
+                                    "callbacks.checkpoint_last.every_n_epochs=1"]
+    assert list(cfg.stages.cvae)[1:] == list(bandai.stages.cvae)[1:] == [
+        "trainer.max_epochs=60", "model.samples_per_item=10", "callbacks.checkpoint_last.every_n_epochs=1",
+        "model.style_weight=5.0"]
     assert choose_budget(bandai) == "budget: budget/bandai"
 
 
@@ -293,8 +295,8 @@ def write_user_mocap(folder: Path) -> None:
 
 
 def test_readme_regex_example_runs(tmp_path: Path) -> None:
-    """The README's bvh_folder line with a file-name regex, run as written (``~`` is the user's home)."""
-    readme = (Path(__file__).resolve().parents[1] / "README.md").read_text()
+    """The bvh_folder line of docs/commands.md with a file-name regex, run as written (``~`` is the user's home)."""
+    readme = (Path(__file__).resolve().parents[1] / "docs" / "commands.md").read_text()
     line = next(x for x in readme.splitlines() if "data.pattern=" in x and x.startswith("stylemotion-data"))
     home = tmp_path / "home"
     write_user_mocap(home / "mocap")
