@@ -24,7 +24,7 @@ def annotate(cfg: DictConfig, command: str) -> None:
     annotate_from_config(cfg, say=log.info, command=command)
 
 
-main = hydra_command("stylemotion-annotate", "annotate", annotate)
+main = hydra_command("stylemotion-annotate", "annotate", annotate, record_in="out")
 
 
 if __name__ == "__main__":

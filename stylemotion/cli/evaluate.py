@@ -31,7 +31,7 @@ def evaluate(cfg: DictConfig, command: str) -> None:
     log.info("report written to %s", cfg.out)
 
 
-main = hydra_command("stylemotion-eval", "eval", evaluate)
+main = hydra_command("stylemotion-eval", "eval", evaluate, record_in="out")
 
 
 if __name__ == "__main__":

@@ -32,7 +32,7 @@ def generate(cfg: DictConfig, command: str) -> None:
     log.info("written to %s", cfg.out)
 
 
-main = hydra_command("stylemotion-generate", "generate", generate)
+main = hydra_command("stylemotion-generate", "generate", generate, record_in="out")
 
 
 if __name__ == "__main__":

@@ -23,7 +23,7 @@ def keyframes(cfg: DictConfig, command: str) -> None:
     keyframes_from_config(cfg, say=log.info, command=command)
 
 
-main = hydra_command("stylemotion-keyframes", "keyframes", keyframes)
+main = hydra_command("stylemotion-keyframes", "keyframes", keyframes, record_in="out")
 
 
 if __name__ == "__main__":

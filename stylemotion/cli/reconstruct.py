@@ -24,7 +24,7 @@ def reconstruct(cfg: DictConfig, command: str) -> None:
     reconstruct_from_config(cfg, say=log.info, command=command)
 
 
-main = hydra_command("stylemotion-reconstruct", "reconstruct", reconstruct)
+main = hydra_command("stylemotion-reconstruct", "reconstruct", reconstruct, record_in="out")
 
 
 if __name__ == "__main__":

@@ -24,7 +24,7 @@ def search(cfg: DictConfig, command: str) -> None:
     search_from_config(cfg, say=log.info, command=command)
 
 
-main = hydra_command("stylemotion-search", "search", search)
+main = hydra_command("stylemotion-search", "search", search, record_in="out")
 
 
 if __name__ == "__main__":

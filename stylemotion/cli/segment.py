@@ -27,7 +27,7 @@ def segment(cfg: DictConfig, command: str) -> None:
         log.info(line)
 
 
-main = hydra_command("stylemotion-segment", "segment", segment)
+main = hydra_command("stylemotion-segment", "segment", segment, record_in="out")
 
 
 if __name__ == "__main__":

@@ -20,12 +20,14 @@ them to the console and to ``<job>.log``).
 from __future__ import annotations
 
 import functools
+import logging
 import os
 import signal
 import sys
 import threading
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
+from pathlib import Path
 from typing import Any
 
 from stylemotion.io.errors import UserInputError
@@ -82,7 +84,37 @@ def stop_on_sigterm() -> None:
         signal.signal(signal.SIGTERM, _interrupt)
 
 
-def hydra_command(command: str, config_name: str, work: Callable[[Any, str], Any]) -> Callable[[], None]:
+def _job_log() -> Path | None:
+    """The file Hydra's job logging writes (``<job>.log`` in the Hydra run folder), if any."""
+    for handler in logging.getLogger().handlers:
+        if isinstance(handler, logging.FileHandler):
+            handler.flush()
+            return Path(handler.baseFilename)
+    return None
+
+
+def keep_run_record(cfg: Any, key: str) -> None:
+    """Put the resolved config (``config_resolved.yaml``) and the job's log (``<job>.log``) into the new output
+    folder ``cfg[key]`` after the work has made it, beside its results. Nothing is replaced: a name the folder
+    already holds is left alone, as is a link or a folder the work did not make."""
+    from omegaconf import OmegaConf
+
+    from stylemotion.io.atomic import atomic_write_bytes
+
+    folder = Path(str(cfg.get(key) or "")).expanduser()
+    if not str(cfg.get(key) or "") or folder.is_symlink() or not folder.is_dir():
+        return
+    records = {"config_resolved.yaml": OmegaConf.to_yaml(cfg, resolve=True).encode()}
+    log = _job_log()
+    if log is not None and log.is_file():
+        records[log.name] = log.read_bytes()
+    for name, data in records.items():
+        if not (folder / name).exists():
+            atomic_write_bytes(folder / name, data)
+
+
+def hydra_command(command: str, config_name: str, work: Callable[[Any, str], Any],
+                  record_in: str | None = None) -> Callable[[], None]:
     """The console-script entry point of a Hydra command.
 
     Args:
@@ -91,12 +123,18 @@ def hydra_command(command: str, config_name: str, work: Callable[[Any, str], Any
         work: ``work(cfg, command_line) -> value``; the value is the job's return value (a sweep's
             objective for ``stylemotion-train``). Hydra names the job after ``work``'s module, so the log
             of ``stylemotion/cli/search.py`` is ``search.log``.
+        record_in: the config key of the new output folder the work makes (``out``): when it finished, the
+            resolved config and the log go into it (:func:`keep_run_record`); None when the folder holds them
+            already (the Hydra run folder is the run's folder: train, data, reproduce).
     """
 
     @functools.wraps(work)
     def task(cfg: Any) -> Any:
         with one_line_errors(command):
-            return work(cfg, command_line(command))
+            value = work(cfg, command_line(command))
+            if record_in is not None:
+                keep_run_record(cfg, record_in)
+            return value
 
     def main() -> None:
         import hydra

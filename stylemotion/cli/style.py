@@ -27,7 +27,7 @@ def style(cfg: DictConfig, command: str) -> None:
     add_style_from_config(cfg, say=log.info, command=command)
 
 
-main = hydra_command("stylemotion-style", "style", style)
+main = hydra_command("stylemotion-style", "style", style, record_in="out")
 
 
 if __name__ == "__main__":

@@ -24,7 +24,7 @@ def texture(cfg: DictConfig, command: str) -> None:
     texture_from_config(cfg, say=log.info, command=command)
 
 
-main = hydra_command("stylemotion-texture", "texture", texture)
+main = hydra_command("stylemotion-texture", "texture", texture, record_in="out")
 
 
 if __name__ == "__main__":

@@ -75,3 +75,21 @@ def test_sigterm_is_raised_as_ctrl_c_so_the_same_clean_up_runs(capsys: pytest.Ca
         assert capsys.readouterr().err.startswith("stylemotion-x: interrupted")
     finally:
         signal.signal(signal.SIGTERM, previous)
+
+
+def test_the_run_record_goes_into_the_new_output_folder_without_replacing_anything(tmp_path) -> None:
+    from omegaconf import OmegaConf
+
+    from stylemotion.cli.skeleton import keep_run_record
+
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "config_resolved.yaml").write_text("the work's own")
+    cfg = OmegaConf.create({"out": str(out), "k": 3, "twice": "${k}"})
+    keep_run_record(cfg, "out")
+    assert (out / "config_resolved.yaml").read_text() == "the work's own"
+    (out / "config_resolved.yaml").unlink()
+    keep_run_record(cfg, "out")
+    assert OmegaConf.load(out / "config_resolved.yaml") == {"out": str(out), "k": 3, "twice": 3}
+    keep_run_record(OmegaConf.create({"out": str(tmp_path / "never_made")}), "out")  # the work failed: nothing
+    assert not (tmp_path / "never_made").exists()

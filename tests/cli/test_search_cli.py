@@ -70,6 +70,9 @@ def test_a_take_query_finds_its_own_frames_first_and_exports_them(tmp_path: Path
         assert np.linalg.norm(back - source[frames], axis=-1).mean() < 0.01  # metres
     assert len(list((out / "bvh").glob("*.bvh"))) == 1 + min(2, len(matches))
     assert "cost 0" in done.stdout
+    # the command skeleton keeps the run's record beside its results: the resolved config and the log
+    assert f"query: {TAKE}:30-90" in (out / "config_resolved.yaml").read_text()
+    assert "match(es) written to" in (out / "search.log").read_text()
 
 
 def test_the_query_take_is_excluded_by_default_and_gifs_are_written(tmp_path: Path) -> None:
