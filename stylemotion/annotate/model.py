@@ -9,7 +9,6 @@ fps, settings, the takes used, provenance), ``templates.npz`` (``<class>``: ``(f
 from __future__ import annotations
 
 import io
-import json
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -23,7 +22,8 @@ from stylemotion.annotate.tensors import MotionTensor, TensorInputError, build_t
 from stylemotion.datasets.base import Take
 from stylemotion.io.atomic import atomic_write_bytes
 from stylemotion.io.errors import UserInputError
-from stylemotion.io.jsonfile import write_json
+from stylemotion.io.jsonfile import read_json, write_json
+from stylemotion.io.npzfile import load_npz
 from stylemotion.io.outputs import inside
 
 MODEL_FORMAT = 1
@@ -133,24 +133,25 @@ def load_model(folder: str | Path) -> AnnotationModel:
     if not meta_path.is_file():
         raise ModelFolderError(f"templates={folder}: no model.json there (learn one with "
                                f"stylemotion-annotate data=<dataset> out={folder})")
-    try:
-        meta = json.loads(meta_path.read_text())
-    except (OSError, json.JSONDecodeError) as exc:
-        raise ModelFolderError(f"{meta_path}: not readable JSON ({exc})") from None
+    meta = read_json(meta_path, "annotation model's record", f"learn the model again (stylemotion-annotate "
+                     f"data=<dataset> out={folder})")
+    if not isinstance(meta, dict):
+        raise ModelFolderError(f"{meta_path}: holds a {type(meta).__name__}, not an object; learn the model again")
     if meta.get("format") != MODEL_FORMAT or meta.get("features") != list(FEATURE_NAMES):
         raise ModelFolderError(f"{meta_path}: format {meta.get('format')!r} with {len(meta.get('features') or [])} "
                                f"features; this version reads format {MODEL_FORMAT} with {len(FEATURE_NAMES)}")
+    arrays = load_npz(folder / "templates.npz", "annotation templates")  # NpzFileError: names the file
+    npz = load_npz(folder / "tensors.npz", "annotation tensors")
     try:
-        with np.load(folder / "templates.npz") as npz:
-            templates = [MotionTemplate(c["label"], np.array(npz[c["label"]]), int(c["examples"]),
-                                        float(meta["delta"])) for c in meta["classes"]]
+        fps = float(meta["fps"])
+        templates = [MotionTemplate(c["label"], np.array(arrays[c["label"]]), int(c["examples"]),
+                                    float(meta["delta"])) for c in meta["classes"]]
         tensors = {}
-        with np.load(folder / "tensors.npz") as npz:
-            for label, info in meta.get("tensors", {}).items():
-                tensors[label] = MotionTensor(label, tuple(info["styles"]), int(info["repetitions"]),
-                                              np.array(npz[f"{label}/reference"]), np.array(npz[f"{label}/core"]),
-                                              tuple(np.array(npz[f"{label}/U{n}"]) for n in range(1, 5)),
-                                              float(meta["fps"]))
-    except (OSError, KeyError, ValueError) as exc:
+        for label, info in meta.get("tensors", {}).items():
+            tensors[label] = MotionTensor(label, tuple(info["styles"]), int(info["repetitions"]),
+                                          np.array(npz[f"{label}/reference"]), np.array(npz[f"{label}/core"]),
+                                          tuple(np.array(npz[f"{label}/U{n}"]) for n in range(1, 5)),
+                                          fps)
+    except (OSError, KeyError, TypeError, ValueError) as exc:
         raise ModelFolderError(f"templates={folder}: its arrays do not match model.json ({exc})") from None
-    return AnnotationModel(templates, tensors, float(meta["fps"]), meta)
+    return AnnotationModel(templates, tensors, fps, meta)

@@ -17,14 +17,14 @@ project uses. Bad input raises :class:`~stylemotion.io.errors.MotionDataError` n
 from __future__ import annotations
 
 import json
-import zipfile
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from stylemotion.io.errors import MotionDataError
+from stylemotion.io.npzfile import NpzFileError, load_npz
 from stylemotion.primitives.contacts import foot_contacts
 from stylemotion.skeleton import CANONICAL_JOINTS, JOINT_INDEX, NUM_JOINTS, checked_positions
 
@@ -72,8 +72,8 @@ def _check_positions(positions: np.ndarray, source: str, key: str = "positions")
                               ) from None
 
 
-def _fps(data: np.lib.npyio.NpzFile, source: str) -> float:
-    if "fps" not in data.files:
+def _fps(data: Mapping[str, np.ndarray], source: str) -> float:
+    if "fps" not in data:
         raise MotionDataError(source, "no key 'fps' (frames per second); a motion NPZ holds 'positions' and 'fps'")
     fps = np.asarray(data["fps"])
     if fps.size != 1 or not np.issubdtype(fps.dtype, np.number) or not np.isfinite(fps).all() or float(fps) <= 0:
@@ -81,8 +81,8 @@ def _fps(data: np.lib.npyio.NpzFile, source: str) -> float:
     return float(fps)
 
 
-def _ground_points(data: np.lib.npyio.NpzFile, key: str, source: str) -> np.ndarray | None:
-    if key not in data.files:
+def _ground_points(data: Mapping[str, np.ndarray], key: str, source: str) -> np.ndarray | None:
+    if key not in data:
         return None
     points = np.asarray(data[key], dtype=np.float64)
     if points.ndim != 2 or points.shape[1] != 2 or not np.isfinite(points).all():
@@ -90,11 +90,11 @@ def _ground_points(data: np.lib.npyio.NpzFile, key: str, source: str) -> np.ndar
     return points.astype(np.float32)
 
 
-def _walk_targets(positions: np.ndarray, path: np.ndarray | None, data: np.lib.npyio.NpzFile,
+def _walk_targets(positions: np.ndarray, path: np.ndarray | None, data: Mapping[str, np.ndarray],
                   source: str) -> np.ndarray | None:
     """The root's ground point at each step transition (``junctions``) and the path's last point."""
     points = []
-    if "junctions" in data.files:
+    if "junctions" in data:
         junctions = np.asarray(data["junctions"]).reshape(-1)
         if not np.issubdtype(junctions.dtype, np.integer) or (junctions < 0).any() or \
                 (junctions >= positions.shape[0]).any():
@@ -107,8 +107,8 @@ def _walk_targets(positions: np.ndarray, path: np.ndarray | None, data: np.lib.n
     return np.asarray(points, dtype=np.float32).reshape(-1, 2) if points else None
 
 
-def _check_joint_names(data: np.lib.npyio.NpzFile, source: str) -> None:
-    if "joint_names" in data.files:
+def _check_joint_names(data: Mapping[str, np.ndarray], source: str) -> None:
+    if "joint_names" in data:
         names = [str(n) for n in np.asarray(data["joint_names"]).reshape(-1)]
         if names != list(CANONICAL_JOINTS):
             raise MotionDataError(source, f"key 'joint_names' is {names[:4]}…; expected the canonical joints "
@@ -125,34 +125,33 @@ def read_npz(path: Path, group: str | None = None, max_samples: int = 16) -> lis
     """The motions of one motion or samples NPZ (see the module doc); at most ``max_samples`` of a batch."""
     source = str(path)
     try:
-        data = np.load(path, allow_pickle=False)
-    except (OSError, ValueError, zipfile.BadZipFile) as exc:
-        raise MotionDataError(source, f"not a NumPy .npz archive ({exc})") from None
-    with data:
-        if "positions" not in data.files:
-            raise MotionDataError(source, f"no key 'positions' (keys: {', '.join(data.files) or 'none'}); a motion "
-                                          f"NPZ holds 'positions' (frames, {NUM_JOINTS}, 3) and 'fps'")
-        positions = np.asarray(data["positions"])
-        if not np.issubdtype(positions.dtype, np.floating):
-            raise MotionDataError(source, f"key 'positions' has dtype {positions.dtype}; expected floats (metres)")
-        _check_joint_names(data, source)
-        fps = _fps(data, source)
-        group = group or path.stem
-        if positions.ndim == 4:
-            if "num_frames" not in data.files:
-                raise MotionDataError(source, f"key 'positions' has shape {positions.shape} (a batch) but there is no "
-                                              f"key 'num_frames' (n,) giving each sample's length")
-            lengths = np.asarray(data["num_frames"]).reshape(-1)
-            if lengths.shape != (positions.shape[0],) or not np.issubdtype(lengths.dtype, np.integer) or \
-                    (lengths < 2).any() or (lengths > positions.shape[1]).any():
-                raise MotionDataError(source, f"key 'num_frames' must hold {positions.shape[0]} lengths in "
-                                              f"[2, {positions.shape[1]}]; got {lengths[:8]!r}")
-            return [_motion(f"{group} #{i}", group, _check_positions(positions[i, :n], source, f"positions[{i}]"),
-                            fps, source) for i, n in enumerate(lengths[:max_samples])]
-        positions = _check_positions(positions, source)
-        walk_path = _ground_points(data, "path", source)
-        targets = _walk_targets(positions, walk_path, data, source) if walk_path is not None else None
-        return [_motion(path.stem, group, positions, fps, source, walk_path, targets)]
+        data = load_npz(path, "motion NPZ")  # every array, never with pickle
+    except NpzFileError as exc:
+        raise MotionDataError(source, exc.detail) from None
+    if "positions" not in data:
+        raise MotionDataError(source, f"no key 'positions' (keys: {', '.join(data) or 'none'}); a motion "
+                                      f"NPZ holds 'positions' (frames, {NUM_JOINTS}, 3) and 'fps'")
+    positions = np.asarray(data["positions"])
+    if not np.issubdtype(positions.dtype, np.floating):
+        raise MotionDataError(source, f"key 'positions' has dtype {positions.dtype}; expected floats (metres)")
+    _check_joint_names(data, source)
+    fps = _fps(data, source)
+    group = group or path.stem
+    if positions.ndim == 4:
+        if "num_frames" not in data:
+            raise MotionDataError(source, f"key 'positions' has shape {positions.shape} (a batch) but there is no "
+                                          f"key 'num_frames' (n,) giving each sample's length")
+        lengths = np.asarray(data["num_frames"]).reshape(-1)
+        if lengths.shape != (positions.shape[0],) or not np.issubdtype(lengths.dtype, np.integer) or \
+                (lengths < 2).any() or (lengths > positions.shape[1]).any():
+            raise MotionDataError(source, f"key 'num_frames' must hold {positions.shape[0]} lengths in "
+                                          f"[2, {positions.shape[1]}]; got {lengths[:8]!r}")
+        return [_motion(f"{group} #{i}", group, _check_positions(positions[i, :n], source, f"positions[{i}]"),
+                        fps, source) for i, n in enumerate(lengths[:max_samples])]
+    positions = _check_positions(positions, source)
+    walk_path = _ground_points(data, "path", source)
+    targets = _walk_targets(positions, walk_path, data, source) if walk_path is not None else None
+    return [_motion(path.stem, group, positions, fps, source, walk_path, targets)]
 
 
 def read_bvh(path: Path, fps: float = 30.0) -> list[ViewerMotion]:
