@@ -141,7 +141,22 @@ def restore(cls: type[pl.LightningModule], checkpoint: Mapping[str, Any], source
     except RuntimeError as err:
         raise IncompatibleModelError(f"{cls.__name__} checkpoint {source}: its weights do not fit the model its "
                                      f"hyperparameters describe ({str(err).splitlines()[0]})") from err
+    check_finite_weights(model, source)
     return model.eval()
+
+
+def check_finite_weights(model: torch.nn.Module, source: str) -> None:
+    """Refuse a model whose parameters hold NaN/inf (a diverged training saved them: every sample would be NaN, found
+    much later as a puzzling error). Buffers are not checked: some hold NaN for "not known" (``content_spread``).
+
+    Raises:
+        IncompatibleModelError: naming ``source`` and the first tensors affected.
+    """
+    bad = [name for name, value in model.named_parameters() if not torch.isfinite(value).all()]
+    if bad:
+        shown = ", ".join(bad[:3]) + (f" and {len(bad) - 3} more" if len(bad) > 3 else "")
+        raise IncompatibleModelError(f"{source}: the model's weights hold NaN/inf ({shown}); its training diverged "
+                                     "— use an earlier checkpoint or train it again")
 
 
 # -- autoencoders
