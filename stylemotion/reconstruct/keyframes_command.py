@@ -101,9 +101,11 @@ def read_keys(path: str | os.PathLike, takeset: TakeSet,
     if not path.is_file():
         raise KeyframeError(f"keys={path}: no such file")
     try:
-        spec = json.loads(path.read_text())
+        spec = json.loads(path.read_text(encoding="utf-8"))
     except json.JSONDecodeError as exc:
         raise KeyframeError(f"keys={path}: line {exc.lineno}: not valid JSON ({exc.msg})") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise KeyframeError(f"keys={path}: cannot read this keys file ({exc})") from None
     takes = {t.name: t for t in takeset.takes}
     conversion = dict(conversion or {})
     if not isinstance(spec, dict) or ("keys" in spec) == ("every_s" in spec):
@@ -132,7 +134,10 @@ def read_keys(path: str | os.PathLike, takeset: TakeSet,
             raise KeyframeError(f"{where}: unknown field(s) {unknown}; valid: {sorted(_KEY_FIELDS)}")
         time_s = _number(entry, "time", where)
         if "positions" in entry:
-            pose = np.asarray(entry["positions"], dtype=np.float64)
+            try:
+                pose = np.asarray(entry["positions"], dtype=np.float64)
+            except (TypeError, ValueError, OverflowError):
+                pose = np.zeros(0)  # refused below: not a grid of numbers
             if pose.shape != (NUM_JOINTS, 3):
                 raise KeyframeError(f"{where}: positions must be {NUM_JOINTS} [x, y, z] rows (canonical joints, "
                                     f"metres), got shape {pose.shape}")

@@ -33,6 +33,7 @@ from pathlib import Path
 import numpy as np
 
 from stylemotion.io.errors import UserInputError
+from stylemotion.io.npzfile import NpzFileError, load_npz
 from stylemotion.skeleton import CANONICAL_JOINTS, JOINT_INDEX
 
 #: Table 2.3's six markers: the 4 end effectors (wrists, ankles), the head and the root.
@@ -163,10 +164,14 @@ def tracks_from_positions(positions: np.ndarray, joints: Sequence[str], fps: flo
 
 def _read_npz(path: Path, joints: Sequence[str]) -> MarkerTracks:
     try:
-        with np.load(path, allow_pickle=False) as npz:
-            positions, fps = np.asarray(npz["positions"]), float(npz["fps"])
-            names = [str(n) for n in npz["joint_names"]] if "joint_names" in npz.files else list(CANONICAL_JOINTS)
-    except (OSError, ValueError, KeyError) as exc:
+        npz = load_npz(path, "marker NPZ")
+    except NpzFileError as exc:
+        raise MarkerInputError(str(exc)) from None
+    try:
+        positions, fps = np.asarray(npz["positions"]), float(npz["fps"])
+        names = [str(n) for n in np.asarray(npz["joint_names"]).reshape(-1)] if "joint_names" in npz \
+            else list(CANONICAL_JOINTS)
+    except (TypeError, ValueError, KeyError) as exc:
         raise MarkerInputError(f"{path}: not an NPZ with 'positions' and 'fps' ({exc})") from None
     if names != list(CANONICAL_JOINTS):
         raise MarkerInputError(f"{path}: joint_names are not the canonical joints (got {names[:4]}…)")
@@ -213,7 +218,10 @@ def _csv_header(path: Path, header: list[str]) -> list[str]:
 
 
 def _read_csv(path: Path, joints: Sequence[str] | None, fps: float) -> MarkerTracks:
-    lines = path.read_text().splitlines()
+    try:
+        lines = path.read_text(encoding="utf-8").splitlines()
+    except (OSError, UnicodeDecodeError) as exc:
+        raise MarkerInputError(f"{path}: cannot read this marker CSV ({exc})") from None
     if lines and lines[0].startswith("#"):
         comment = lines.pop(0).lstrip("#").strip()
         key, _, value = comment.partition(":")
