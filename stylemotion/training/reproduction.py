@@ -179,7 +179,10 @@ class Reproduction:
         folders: dict[Path, str] = {}
         for p in self.primitives:
             for s in styles:
-                folder = inside(self.out, "cvae", f"{p}_{safe_name(s, 'style label')}")
+                try:
+                    folder = inside(self.out, "cvae", f"{p}_{safe_name(s, 'style label')}")
+                except ValueError as exc:
+                    raise ConfigError(f"styles: {exc}; rename it in the data's labels") from None
                 if folder in folders:
                     raise ConfigError(f"style labels {folders[folder]!r} and {s!r} would share the folder {folder}; "
                                      "rename one in the data's labels")
