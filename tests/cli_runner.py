@@ -3,14 +3,16 @@
 :func:`run_command` calls a console script's entry function (``stylemotion.cli.<module>.main``) with
 ``sys.argv`` set to the command line and returns its exit status, stdout and stderr (read through ``capsys``),
 without paying a new interpreter's import of the package (seconds per call). Hydra's global state (its
-config search, the job's config, the logging it configured) is put back afterwards, so later tests see none
-of it. A subprocess test per console-script family keeps checking that the installed scripts start.
+config search, the job's config, the logging it configured), torch's thread count (``threads=N``) and the
+environment (e.g. Lightning's ``PL_GLOBAL_SEED``) are put back afterwards, so later tests see none of it.
+A subprocess test per console-script family keeps checking that the installed scripts start.
 """
 
 from __future__ import annotations
 
 import importlib
 import logging
+import os
 import sys
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -56,6 +58,9 @@ def run_command(module: str, *args: str, capsys: pytest.CaptureFixture, monkeypa
     monkeypatch.delenv("STYLEMOTION_DEBUG", raising=False)
     if cwd is not None:
         monkeypatch.chdir(cwd)
+    import torch
+
+    threads, environ = torch.get_num_threads(), dict(os.environ)
     capsys.readouterr()  # only this command's output
     root = logging.getLogger()
     handlers, level = root.handlers[:], root.level
@@ -67,6 +72,10 @@ def run_command(module: str, *args: str, capsys: pytest.CaptureFixture, monkeypa
         except SystemExit as exc:
             status = _exit_status(exc.code)
     finally:
+        torch.set_num_threads(threads)
+        for key in set(os.environ) - set(environ):
+            del os.environ[key]
+        os.environ.update(environ)
         GlobalHydra.instance().clear()
         HydraConfig.instance().cfg = None
         for handler in root.handlers:

@@ -4,13 +4,11 @@ console command in one line."""
 from __future__ import annotations
 
 import json
-import os
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
+from cli_runner import run_command
 
 from stylemotion.datasets.registry import load_dataset
 from stylemotion.io.outputs import OutputExistsError
@@ -76,18 +74,16 @@ def test_every_s_keys_and_bad_key_files_are_named(tmp_path):
     assert not (tmp_path / "o").exists()
 
 
-def test_the_console_command_runs_and_refuses_in_one_line(tmp_path):
-    env = {**os.environ, "HYDRA_FULL_ERROR": "0", "PYTHONWARNINGS": "ignore"}
-    root = Path(__file__).resolve().parents[2]
+def test_the_console_command_runs_and_refuses_in_one_line(tmp_path, capsys, monkeypatch):
     keys = _write(tmp_path / "keys.json", {"motion": TAKE, "every_s": 1.0, "start_s": 1.0, "end_s": 3.0})
-    run = [sys.executable, "-m", "stylemotion.cli.keyframes", "data.takes_per_pair=1", "gif=false"]
-    done = subprocess.run(run + [f"keys={keys}", f"out={tmp_path / 'o'}"], cwd=root, env=env,
-                          capture_output=True, text=True, timeout=180)
+    run = ["data.takes_per_pair=1", "gif=false"]
+    done = run_command("keyframes", *run, f"keys={keys}", f"out={tmp_path / 'o'}", capsys=capsys,
+                       monkeypatch=monkeypatch, cwd=tmp_path)
     assert done.returncode == 0, done.stderr
     assert json.loads((tmp_path / "o" / "summary.json").read_text())["frames"] == 61
     assert not (tmp_path / "o" / "motion.gif").exists()
     bad = _write(tmp_path / "bad.json", {"keys": [{"time": 0, "take": "nope", "frame": 0}]})
-    done = subprocess.run(run + [f"keys={bad}", f"out={tmp_path / 'p'}"], cwd=root, env=env,
-                          capture_output=True, text=True, timeout=180)
+    done = run_command("keyframes", *run, f"keys={bad}", f"out={tmp_path / 'p'}", capsys=capsys,
+                       monkeypatch=monkeypatch, cwd=tmp_path)
     assert done.returncode == 2 and "take='nope'" in done.stderr and "Traceback" not in done.stderr
     assert not (tmp_path / "p").exists()

@@ -3,13 +3,10 @@
 from __future__ import annotations
 
 import json
-import os
-import subprocess
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
+from cli_runner import run_command
 
 from stylemotion.config import ConfigError
 from stylemotion.datasets.registry import load_dataset
@@ -65,14 +62,12 @@ def test_bad_values_are_named_and_nothing_is_written(tmp_path):
     assert not (tmp_path / "a").exists()
 
 
-def test_the_console_command_runs_and_refuses_in_one_line(tmp_path):
-    env = {**os.environ, "HYDRA_FULL_ERROR": "0", "PYTHONWARNINGS": "ignore"}
-    root = Path(__file__).resolve().parents[2]
-    run = [sys.executable, "-m", "stylemotion.cli.reconstruct", f"markers={TAKE}", "data.takes_per_pair=1", "gif=false"]
-    done = subprocess.run(run + [f"out={tmp_path / 'o'}", "k=16"], cwd=root, env=env, capture_output=True,
-                          text=True, timeout=120)
+def test_the_console_command_runs_and_refuses_in_one_line(tmp_path, capsys, monkeypatch):
+    run = [f"markers={TAKE}", "data.takes_per_pair=1", "gif=false"]
+    done = run_command("reconstruct", *run, f"out={tmp_path / 'o'}", "k=16", capsys=capsys, monkeypatch=monkeypatch,
+                       cwd=tmp_path)
     assert done.returncode == 0, done.stderr
     assert json.loads((tmp_path / "o" / "summary.json").read_text())["settings"]["k"] == 16
-    done = subprocess.run(run + [f"out={tmp_path / 'p'}", "joints=[Hips,Tail]"], cwd=root, env=env,
-                          capture_output=True, text=True, timeout=120)
+    done = run_command("reconstruct", *run, f"out={tmp_path / 'p'}", "joints=[Hips,Tail]", capsys=capsys,
+                       monkeypatch=monkeypatch, cwd=tmp_path)
     assert done.returncode == 2 and "'Tail'" in done.stderr and "Traceback" not in done.stderr

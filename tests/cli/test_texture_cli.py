@@ -3,13 +3,10 @@
 from __future__ import annotations
 
 import json
-import os
-import subprocess
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
+from cli_runner import run_command
 
 from stylemotion.datasets.registry import load_dataset
 from stylemotion.io.outputs import OutputExistsError
@@ -60,14 +57,12 @@ def test_bad_values_are_named_and_nothing_is_written(tmp_path):
     assert not (tmp_path / "a").exists()
 
 
-def test_the_console_command_runs_and_refuses_in_one_line(tmp_path):
-    env = {**os.environ, "HYDRA_FULL_ERROR": "0", "PYTHONWARNINGS": "ignore"}
-    root = Path(__file__).resolve().parents[2]
-    run = [sys.executable, "-m", "stylemotion.cli.texture", f"motion={TAKE}", "data.takes_per_pair=1", "gif=false"]
-    done = subprocess.run(run + [f"out={tmp_path / 'o'}", "mode=texture", "k=16"], cwd=root, env=env,
-                          capture_output=True, text=True, timeout=120)
+def test_the_console_command_runs_and_refuses_in_one_line(tmp_path, capsys, monkeypatch):
+    run = [f"motion={TAKE}", "data.takes_per_pair=1", "gif=false"]
+    done = run_command("texture", *run, f"out={tmp_path / 'o'}", "mode=texture", "k=16", capsys=capsys,
+                       monkeypatch=monkeypatch, cwd=tmp_path)
     assert done.returncode == 0, done.stderr
     assert json.loads((tmp_path / "o" / "summary.json").read_text())["settings"]["mode"] == "texture"
-    done = subprocess.run(run + [f"out={tmp_path / 'p'}", "mode=blur"], cwd=root, env=env,
-                          capture_output=True, text=True, timeout=120)
+    done = run_command("texture", *run, f"out={tmp_path / 'p'}", "mode=blur", capsys=capsys,
+                       monkeypatch=monkeypatch, cwd=tmp_path)
     assert done.returncode == 2 and "mode=blur" in done.stderr and "Traceback" not in done.stderr

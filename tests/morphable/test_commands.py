@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from cli_runner import run_command
 
 from stylemotion.morphable import MorphableModel
 
@@ -23,13 +24,15 @@ def _run(args: list[str], cwd: Path) -> subprocess.CompletedProcess:
     return subprocess.run([sys.executable, "-m", *args], cwd=cwd, env=env, capture_output=True, text=True, timeout=300)
 
 
-@pytest.mark.slow  # four console commands: ~45 s on a loaded 2-core machine
-def test_train_then_generate(tmp_path):
+@pytest.mark.slow  # four console commands (in this process): ~4 s on a loaded 2-core machine
+def test_train_then_generate(tmp_path, capsys, monkeypatch):
+    def command(module: str, *args: str):
+        return run_command(module, *args, capsys=capsys, monkeypatch=monkeypatch, cwd=tmp_path)
+
     runs = {}
     for primitive in ("walk_leftStance", "walk_rightStance"):
         out = tmp_path / primitive
-        done = _run(["stylemotion.cli.train", "experiment=morphable_graph", f"primitive={primitive}",
-                     f"hydra.run.dir={out}", *SMALL], tmp_path)
+        done = command("train", "experiment=morphable_graph", f"primitive={primitive}", f"hydra.run.dir={out}", *SMALL)
         assert done.returncode == 0, done.stderr[-2000:]
         metrics = json.loads((out / "metrics.json").read_text())
         assert metrics["fit"]["clips"] > 5 and 0 < metrics["test/joint_rmse_m"] < 0.1
@@ -37,13 +40,12 @@ def test_train_then_generate(tmp_path):
         model = MorphableModel.load(out)
         assert model.meta["primitive"] == primitive.split("_")[1] and model.tree is not None
         runs[primitive] = out
-    again = _run(["stylemotion.cli.train", "experiment=morphable_graph", f"hydra.run.dir={runs['walk_leftStance']}",
-                  *SMALL], tmp_path)
+    again = command("train", "experiment=morphable_graph", f"hydra.run.dir={runs['walk_leftStance']}", *SMALL)
     assert again.returncode != 0 and "already holds a morphable model" in again.stderr + again.stdout
     walk = tmp_path / "walk"
-    done = _run(["stylemotion.cli.generate", "model=morphable", f"+models.walk_leftStance={runs['walk_leftStance']}",
-                 f"+models.walk_rightStance={runs['walk_rightStance'] / 'model.npz'}", f"out={walk}",
-                 "path.s_curve.length_m=3.0", "path.s_curve.amplitude_m=0.2", "outputs.gif=false"], tmp_path)
+    done = command("generate", "model=morphable", f"+models.walk_leftStance={runs['walk_leftStance']}",
+                   f"+models.walk_rightStance={runs['walk_rightStance'] / 'model.npz'}", f"out={walk}",
+                   "path.s_curve.length_m=3.0", "path.s_curve.amplitude_m=0.2", "outputs.gif=false")
     assert done.returncode == 0, done.stderr[-2000:]
     summary = json.loads((walk / "summary.json").read_text())
     assert summary["meta"]["model"] == "morphable" and summary["deviation"]["mean_m"] < 0.15
