@@ -1,17 +1,14 @@
 """``stylemotion-style`` as a command: a new style from a shared-data walk of another skeleton (CMU 21 joints,
-60 fps, a frame range) on a tiny synthetic reproduce run, then ``stylemotion-generate`` with it; refused input
-(a taken name, a ``network=`` mapping of CVAEs for ``method=zero_shot``) is one line naming the key, with
-nothing written; the config names a missing mandatory key."""
+60 fps, a frame range) on a tiny synthetic reproduce run, then ``stylemotion-generate`` with it (both called in
+this process); refused input (a taken name, a ``network=`` mapping of CVAEs for ``method=zero_shot``) is one line
+naming the key, with nothing written; the config names a missing mandatory key."""
 
 from __future__ import annotations
 
 import hashlib
 import json
 import math
-import os
 import re
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
@@ -24,24 +21,21 @@ from stylemotion.config import CONFIG_DIR, ConfigError
 from stylemotion.style_example import add_style_from_config
 
 
-def command(module: str, *args: str, cwd: Path, timeout: float = 300) -> subprocess.CompletedProcess:
-    env = {**os.environ, "HYDRA_FULL_ERROR": "0", "PYTHONWARNINGS": "ignore", "OMP_NUM_THREADS": "1"}
-    return subprocess.run([sys.executable, "-m", f"stylemotion.cli.{module}", *args], cwd=cwd, env=env,
-                          capture_output=True, text=True, timeout=timeout)
-
-
 @pytest.fixture(scope="session")
 def run(tiny_run) -> Path:
     return tiny_run.folder
 
 
 @pytest.mark.realdata
-@pytest.mark.slow  # two commands in subprocesses, one of them training two CVAEs: ~12 s on an idle core
-def test_a_style_from_a_cmu_walk_then_a_walk_in_it(run: Path, other_skeleton_paths, tmp_path: Path) -> None:
+@pytest.mark.slow  # two commands (in this process), one of them training two CVAEs: ~12 s on an idle core
+def test_a_style_from_a_cmu_walk_then_a_walk_in_it(run: Path, other_skeleton_paths, tmp_path: Path, capsys,
+                                                   monkeypatch) -> None:
+    def command(module: str, *args: str):
+        return run_command(module, *args, capsys=capsys, monkeypatch=monkeypatch, cwd=tmp_path)
+
     bvh = other_skeleton_paths["cmu21_walk"]
     out = tmp_path / "cmu"
-    done = command("style", f"example={bvh}:10-150", f"run={run}", "name=cmu", f"out={out}", "samples=40",
-                   cwd=tmp_path)
+    done = command("style", f"example={bvh}:10-150", f"run={run}", "name=cmu", f"out={out}", "samples=40")
     assert done.returncode == 0, done.stdout[-3000:] + done.stderr[-3000:]
     steps = [line for line in done.stdout.splitlines() if line.startswith("[")]
     assert [s[:5] for s in steps] == [f"[{k}/5]" for k in range(1, 6)], done.stdout
@@ -57,8 +51,7 @@ def test_a_style_from_a_cmu_walk_then_a_walk_in_it(run: Path, other_skeleton_pat
         assert all(10 <= e["file_frames"][0] < e["file_frames"][1] <= 150 for e in examples)
     assert report["meta"]["command"].startswith("stylemotion-style example=")
     walk = command("generate", f"run={out}", "style=cmu", f"out={tmp_path / 'walk'}", "outputs.gif=false",
-                   "outputs.bvh=false", "follow.iterations=5", "follow.candidates=32", "path.points=[[0,0],[0,2]]",
-                   cwd=tmp_path)
+                   "outputs.bvh=false", "follow.iterations=5", "follow.candidates=32", "path.points=[[0,0],[0,2]]")
     assert walk.returncode == 0, walk.stderr[-3000:]
     assert "cmu:" in walk.stdout and (tmp_path / "walk" / "motion.npz").is_file()
 

@@ -1,13 +1,9 @@
 """``stylemotion-train experiment=morphable_graph`` and ``stylemotion-generate model=morphable`` as console
-commands on the synthetic default."""
+commands on the synthetic default (entry functions called in this process: :func:`cli_runner.run_command`)."""
 
 from __future__ import annotations
 
 import json
-import os
-import subprocess
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -17,11 +13,6 @@ from stylemotion.morphable import MorphableModel
 
 SMALL = ["data.takes_per_pair=3", "data.duration_s=5.0", "model.latent_dim=5", "model.reduction=fpca",
          "model.num_coefficients=6", "model.tree.samples=500", "samples=false", "threads=1"]
-
-
-def _run(args: list[str], cwd: Path) -> subprocess.CompletedProcess:
-    env = {**os.environ, "OMP_NUM_THREADS": "1"}
-    return subprocess.run([sys.executable, "-m", *args], cwd=cwd, env=env, capture_output=True, text=True, timeout=300)
 
 
 @pytest.mark.slow  # four console commands (in this process): ~4 s on a loaded 2-core machine
@@ -55,17 +46,19 @@ def test_train_then_generate(tmp_path, capsys, monkeypatch):
 
 
 @pytest.mark.realdata
-def test_an_arm_primitive_of_bandai_trains_through_the_command(tmp_path, bandai_zip_path):
+def test_an_arm_primitive_of_bandai_trains_through_the_command(tmp_path, bandai_zip_path, capsys, monkeypatch):
+    def train(*args: str):
+        return run_command("train", "experiment=morphable_graph", *args, capsys=capsys, monkeypatch=monkeypatch,
+                           cwd=tmp_path)
+
     out = tmp_path / "raise"
     bandai = ["data=bandai", f"data.root={bandai_zip_path}", "data.contents=[raise-up-left-hand]"]
-    done = _run(["stylemotion.cli.train", "experiment=morphable_graph", *bandai, "primitive=raise-up-left-hand_raise",
-                 f"hydra.run.dir={out}", "samples=false", "threads=1"], tmp_path)
+    done = train(*bandai, "primitive=raise-up-left-hand_raise", f"hydra.run.dir={out}", "samples=false", "threads=1")
     assert done.returncode == 0, done.stderr[-2000:]
     metrics = json.loads((out / "metrics.json").read_text())
     assert metrics["clips"]["train"] >= 20 and metrics["clips"]["test"] >= 1
     assert metrics["test/joint_rmse_m"] < 0.02  # measured 0.0049 m
     model = MorphableModel.load(out)
     assert (model.meta["action"], model.meta["primitive"]) == ("raise-up-left-hand", "raise")
-    bad = _run(["stylemotion.cli.train", "experiment=morphable_graph", *bandai, "primitive=raise-up-left-hand_wave",
-                f"hydra.run.dir={tmp_path / 'bad'}", "samples=false"], tmp_path)
+    bad = train(*bandai, "primitive=raise-up-left-hand_wave", f"hydra.run.dir={tmp_path / 'bad'}", "samples=false")
     assert bad.returncode != 0 and "raise-up-left-hand_raise" in bad.stderr + bad.stdout
