@@ -7,13 +7,11 @@ range outside the take, an existing out) is one line naming the value, with noth
 from __future__ import annotations
 
 import json
-import os
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
+from cli_runner import Done, run_command
 from conftest import BANDAI_ZIP, shared_data_dir
 from PIL import Image
 from test_commands_cli import one_line_error
@@ -34,20 +32,20 @@ def _cache(tmp_path_factory, monkeypatch) -> None:
     monkeypatch.setenv("STYLEMOTION_CACHE", str(tmp_path_factory.getbasetemp() / "search-cache"))
 
 
-def command(*args: str, cwd: Path, timeout: float = 300) -> subprocess.CompletedProcess:
-    env = {**os.environ, "HYDRA_FULL_ERROR": "0", "PYTHONWARNINGS": "ignore", "OMP_NUM_THREADS": "1"}
-    return subprocess.run([sys.executable, "-m", "stylemotion.cli.search", *args, f"hydra.run.dir={cwd / 'hydra'}"],
-                          cwd=cwd, env=env, capture_output=True, text=True, timeout=timeout)
+def command(*args: str, cwd: Path, capsys: pytest.CaptureFixture, monkeypatch: pytest.MonkeyPatch) -> Done:
+    """``stylemotion-search args`` in this process (:func:`cli_runner.run_command`)."""
+    return run_command("search", *args, f"hydra.run.dir={cwd / 'hydra'}", cwd=cwd, capsys=capsys,
+                       monkeypatch=monkeypatch)
 
 
 def quiet(_: str) -> None:
     pass
 
 
-def test_a_take_query_finds_its_own_frames_first_and_exports_them(tmp_path: Path) -> None:
+def test_a_take_query_finds_its_own_frames_first_and_exports_them(tmp_path: Path, capsys, monkeypatch) -> None:
     out = tmp_path / "found"
     done = command(f"query={TAKE}:30-90", "data.takes_per_pair=1", f"out={out}", "exclude_query_take=false",
-                   "export.bvh=true", "export.top=2", "top=4", cwd=tmp_path)
+                   "export.bvh=true", "export.top=2", "top=4", cwd=tmp_path, capsys=capsys, monkeypatch=monkeypatch)
     assert done.returncode == 0, done.stdout[-2000:] + done.stderr[-2000:]
     matches = json.loads((out / "matches.json").read_text())
     assert 1 <= len(matches) <= 4 and all(list(m) == list(MATCH_KEYS) for m in matches)
@@ -109,9 +107,11 @@ def test_bad_input_is_refused_naming_the_value(overrides: dict, message: str, tm
     assert not (tmp_path / "out").exists()
 
 
-def test_an_unmappable_skeleton_and_an_existing_out_are_one_line(tmp_path: Path, tiny_bvh: str) -> None:
+def test_an_unmappable_skeleton_and_an_existing_out_are_one_line(tmp_path: Path, tiny_bvh: str, capsys,
+                                                                 monkeypatch) -> None:
     (tmp_path / "tiny.bvh").write_text(tiny_bvh)
-    done = command(f"query={tmp_path / 'tiny.bvh'}", "data.takes_per_pair=1", f"out={tmp_path / 'out'}", cwd=tmp_path)
+    done = command(f"query={tmp_path / 'tiny.bvh'}", "data.takes_per_pair=1", f"out={tmp_path / 'out'}", cwd=tmp_path,
+                   capsys=capsys, monkeypatch=monkeypatch)
     message = one_line_error(done, "stylemotion-search")
     assert message.startswith(f"stylemotion-search: query={tmp_path / 'tiny.bvh'}: ") and "joint_map=" in message
     assert not (tmp_path / "out").exists()
