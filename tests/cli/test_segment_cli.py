@@ -4,12 +4,10 @@ from __future__ import annotations
 
 import dataclasses
 import json
-import os
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
+from cli_runner import run_command
 from hydra import compose, initialize_config_dir
 from omegaconf import OmegaConf
 
@@ -21,7 +19,6 @@ from stylemotion.primitives.segmentation import SegmentSettings
 
 register_schemas()  # the configs composed here take structured schemas (stylemotion.cli.schemas)
 
-REPO = Path(__file__).resolve().parents[2]
 SMALL = ["data.takes_per_pair=1", "data.duration_s=3.0", "data.styles=[normal,elderly]", "data.contents=[walk,run]",
          "plot_rejected=2"]
 
@@ -81,14 +78,12 @@ def test_config_defaults_match_the_code() -> None:
     assert set(cfg["contacts"]) == {f.name for f in dataclasses.fields(SegmentSettings().contacts)}
 
 
-def test_command_line(tmp_path: Path) -> None:
+def test_command_line(tmp_path: Path, capsys, monkeypatch) -> None:
     out = tmp_path / "cli"
-    args = [sys.executable, "-m", "stylemotion.cli.segment", f"out={out}", *SMALL, "plot_takes=0", "sheet_clips=2",
-            f"hydra.run.dir={tmp_path / 'run'}"]
-    env = {**os.environ, "PYTHONPATH": str(REPO)}
-    first = subprocess.run(args, capture_output=True, text=True, cwd=tmp_path, env=env, timeout=120)
+    args = ["segment", f"out={out}", *SMALL, "plot_takes=0", "sheet_clips=2", f"hydra.run.dir={tmp_path / 'run'}"]
+    first = run_command(*args, cwd=tmp_path, capsys=capsys, monkeypatch=monkeypatch)
     assert first.returncode == 0, first.stderr
     assert "walk:" in first.stdout and "report written to" in first.stdout
     assert "report written to" in (tmp_path / "run" / "segment.log").read_text()  # the run folder keeps it too
-    again = subprocess.run(args, capture_output=True, text=True, cwd=tmp_path, env=env, timeout=120)
+    again = run_command(*args, cwd=tmp_path, capsys=capsys, monkeypatch=monkeypatch)
     assert again.returncode != 0 and "exists" in again.stderr and "force=true" in again.stderr

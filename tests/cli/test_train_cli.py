@@ -1,10 +1,10 @@
 """``stylemotion-train``: run folders (unique ids, never overwritten), sweeps (basic and joblib
 launchers), resume, DDP, bad config and bad values (one line naming the key).
 
-The command-line tests run ``python -m stylemotion.cli.train`` (what the ``stylemotion-train``
-console script calls) in a subprocess on a tiny synthetic dataset with the ``smoke`` preset; refused command
-lines run the entry function in-process (:func:`cli_runner.run_command`); the resume and bad-value tests call
-:func:`stylemotion.training.run` in-process on a composed config.
+The command-line tests run the entry function in-process (:func:`cli_runner.run_command`) on a tiny synthetic
+dataset with the ``smoke`` preset; the joblib sweep and DDP, which need processes of their own, run
+``python -m stylemotion.cli.train`` (what the ``stylemotion-train`` console script calls) in a subprocess; the
+resume and bad-value tests call :func:`stylemotion.training.run` in-process on a composed config.
 """
 
 from __future__ import annotations
@@ -61,8 +61,10 @@ def check_run_dir(run_dir: Path, hydra: bool = True) -> dict:
     return resolved
 
 
-def test_sweep_over_kernel_sizes_writes_one_run_folder_each(tmp_path):
-    done = train_cli("-m", *SMOKE, f"hydra.sweep.dir={tmp_path}/sweep", "model.kernel_size=9,15,25", cwd=tmp_path)
+def test_sweep_over_kernel_sizes_writes_one_run_folder_each(tmp_path, capsys, monkeypatch):
+    # Hydra's basic launcher runs the jobs one after another in the command's process: so here, in this one
+    done = run_command("train", "-m", *SMOKE, f"hydra.sweep.dir={tmp_path}/sweep", "model.kernel_size=9,15,25",
+                       cwd=tmp_path, capsys=capsys, monkeypatch=monkeypatch)
     assert done.returncode == 0, done.stderr[-4000:]
     jobs = sorted((tmp_path / "sweep").glob("[0-9]*"))
     assert [p.name for p in jobs] == ["0", "1", "2"]
@@ -85,7 +87,8 @@ def test_joblib_launcher_runs_the_sweep_in_parallel_processes(tmp_path):
 
 def test_single_run_folder_and_unknown_key(tmp_path, capsys, monkeypatch):
     run_dir = tmp_path / "run"
-    done = train_cli(*SMOKE, f"hydra.run.dir={run_dir}", cwd=tmp_path)
+    done = run_command("train", *SMOKE, f"hydra.run.dir={run_dir}", cwd=tmp_path, capsys=capsys,
+                       monkeypatch=monkeypatch)
     assert done.returncode == 0, done.stderr[-4000:]
     check_run_dir(run_dir)
     typo = run_command("train", *SMOKE, "model.kernal_size=9", cwd=tmp_path, capsys=capsys, monkeypatch=monkeypatch)
@@ -95,7 +98,7 @@ def test_single_run_folder_and_unknown_key(tmp_path, capsys, monkeypatch):
 
 
 def test_run_folder_has_a_unique_id_records_itself_and_is_never_overwritten(tmp_path, capsys, monkeypatch):
-    done = train_cli(*SMOKE, cwd=tmp_path)
+    done = run_command("train", *SMOKE, cwd=tmp_path, capsys=capsys, monkeypatch=monkeypatch)
     assert done.returncode == 0, done.stderr[-4000:]
     (run_dir,) = (tmp_path / "runs" / "train" / "smoke").iterdir()
     resolved = check_run_dir(run_dir)
