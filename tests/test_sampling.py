@@ -4,7 +4,7 @@
 from __future__ import annotations
 
 import json
-import subprocess
+import runpy
 import sys
 from pathlib import Path
 
@@ -105,14 +105,17 @@ def test_gif_and_last_frame_sheet(model, tmp_path) -> None:
     assert not list((tmp_path / "out").glob(".*tmp*"))  # written atomically
 
 
-def test_benchmark_script_prints_json(model, tmp_path) -> None:
+def test_benchmark_script_prints_json(model, tmp_path, capsys, monkeypatch) -> None:
     ckpt = tmp_path / "vae.ckpt"
     torch.save({"state_dict": model.state_dict(), "hyper_parameters": dict(model.hparams),
                 "pytorch-lightning_version": "2.6.6"}, ckpt)
     script = str(REPO / "scripts" / "bench_sampling.py")
-    done = subprocess.run([sys.executable, script, "--ckpt", str(ckpt), "-n", "500", "--repeats", "1"],
-                          capture_output=True, text=True, timeout=120)
-    assert done.returncode == 0, done.stderr[-3000:]
-    result = json.loads(done.stdout.strip().splitlines()[-1])
+    monkeypatch.setattr(sys, "argv", [script, "--ckpt", str(ckpt), "-n", "500", "--repeats", "1"])
+    capsys.readouterr()
+    with pytest.raises(SystemExit) as done:  # the script as `python scripts/bench_sampling.py ...` runs it
+        runpy.run_path(script, run_name="__main__")
+    out = capsys.readouterr()
+    assert done.value.code == 0, out.err[-3000:]
+    result = json.loads(out.out.strip().splitlines()[-1])
     assert result["samples"] == 500 and result["seconds"] > 0 and result["samples_per_s"] > 0
     assert result["positions_shape"][0] == 500 and np.isfinite(result["mean_duration_s"])
