@@ -212,24 +212,18 @@ def test_convert_cli_matches_dataset_path(other_skeleton_paths: dict[str, Path],
     assert not (tmp_path / "x.npz").exists()
 
 
-def test_prepare_cli_writes_summary(other_skeleton_paths: dict[str, Path], tmp_path: Path) -> None:
-    import subprocess
-    import sys
+def test_prepare_cli_writes_summary(other_skeleton_paths: dict[str, Path], tmp_path: Path, capsys,
+                                    monkeypatch) -> None:
+    from cli_runner import run_command
 
     folder = next(iter(other_skeleton_paths.values())).parent
     out = tmp_path / "run"
-    result = subprocess.run(
-        [sys.executable, "-m", "stylemotion.cli.prepare", "data=bvh_folder", f"data.root={folder}",
-         f"data.cache_dir={tmp_path / 'cache'}", f"hydra.run.dir={out}"],
-        capture_output=True, text=True, timeout=120,
-    )
+    result = run_command("prepare", "data=bvh_folder", f"data.root={folder}", f"data.cache_dir={tmp_path / 'cache'}",
+                         f"hydra.run.dir={out}", capsys=capsys, monkeypatch=monkeypatch)
     assert result.returncode == 0, result.stderr
     summary = json.loads((out / "summary.json").read_text())
     assert summary["takes"] == 3 and summary["fps"] == 30
     assert sum(v["takes"] for v in summary["split"].values()) == 3
-    bad = subprocess.run(
-        [sys.executable, "-m", "stylemotion.cli.prepare", "data=bvh_folder", f"data.root={folder}",
-         "+data.colour=red", f"hydra.run.dir={tmp_path / 'bad'}"],
-        capture_output=True, text=True, timeout=120,
-    )
+    bad = run_command("prepare", "data=bvh_folder", f"data.root={folder}", "+data.colour=red",
+                      f"hydra.run.dir={tmp_path / 'bad'}", capsys=capsys, monkeypatch=monkeypatch)
     assert bad.returncode != 0 and "colour" in bad.stderr
