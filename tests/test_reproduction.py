@@ -8,7 +8,6 @@ import json
 import os
 import shutil
 import subprocess
-import sys
 from pathlib import Path
 
 import pytest
@@ -110,14 +109,13 @@ def test_parallel_stages_train_the_same_models_as_sequential_ones(reproduced, tm
     assert table(tmp_path / "seq", 2) == pytest.approx(table(out, 2), rel=1e-5)  # neutral and elderly
 
 
-def test_rerun_reuses_finished_stages_and_resumes_an_interrupted_one(tiny_run, tmp_path: Path) -> None:
+def test_rerun_reuses_finished_stages_and_resumes_an_interrupted_one(tiny_run, tmp_path: Path, capsys,
+                                                                      monkeypatch) -> None:
     out = copy_run(tiny_run, tmp_path / "run")
     interrupted = out / "cvae" / "walk_leftStance_youthful"
     (interrupted / "done.json").unlink()  # as if killed after its last checkpoint
     before = (out / "report" / "report.json").read_text()
-    env = {**os.environ, "OMP_NUM_THREADS": "1"}
-    proc = subprocess.run([sys.executable, "-m", "stylemotion.cli.reproduce", *tiny_overrides(out)],
-                          capture_output=True, text=True, env=env, timeout=300)
+    proc = run_command("reproduce", *tiny_overrides(out), capsys=capsys, monkeypatch=monkeypatch)
     assert proc.returncode == 0, proc.stderr[-3000:]
     steps = [line for line in proc.stdout.splitlines() if line.startswith("[")]
     assert sum(": reused " in line for line in steps) == 7, proc.stdout  # autoencoder, 2 vaes, 3 cvaes, report
