@@ -26,9 +26,12 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from typing import TYPE_CHECKING
 
 import numpy as np
-import torch
+
+if TYPE_CHECKING:  # torch is imported by the functions that use it, so that the numpy paths (search,
+    import torch  # reconstruct, annotate, datasets) start without it (docs/architecture.md)
 
 #: Lengths below this (metres, or unit vectors' norms) count as zero where a division needs a guard.
 EPSILON = 1e-9
@@ -49,6 +52,7 @@ def wrap_angle(angle: np.ndarray) -> np.ndarray:
 
 def wrap_angle_torch(angle: torch.Tensor) -> torch.Tensor:
     """Torch twin of :func:`wrap_angle`."""
+    import torch
     return torch.remainder(angle + math.pi, 2 * math.pi) - math.pi
 
 
@@ -59,6 +63,7 @@ def direction_yaw(direction: np.ndarray) -> np.ndarray:
 
 def direction_yaw_torch(direction: torch.Tensor) -> torch.Tensor:
     """Torch twin of :func:`direction_yaw`."""
+    import torch
     return torch.atan2(direction[..., 0], direction[..., 1])
 
 
@@ -69,6 +74,7 @@ def facing_direction(yaw: np.ndarray) -> np.ndarray:
 
 def facing_direction_torch(yaw: torch.Tensor) -> torch.Tensor:
     """Torch twin of :func:`facing_direction`."""
+    import torch
     return torch.stack([torch.sin(yaw), torch.cos(yaw)], dim=-1)
 
 
@@ -79,6 +85,7 @@ def left_direction(yaw: np.ndarray) -> np.ndarray:
 
 def left_direction_torch(yaw: torch.Tensor) -> torch.Tensor:
     """Torch twin of :func:`left_direction`."""
+    import torch
     return torch.stack([torch.cos(yaw), -torch.sin(yaw)], dim=-1)
 
 
@@ -88,6 +95,7 @@ def left_direction_torch(yaw: torch.Tensor) -> torch.Tensor:
 
 def _cos_sin(yaw: torch.Tensor | float, like: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
     """``cos`` and ``sin`` of a tensor yaw as it is; a number becomes a tensor of ``like``'s dtype and device."""
+    import torch
     if not isinstance(yaw, torch.Tensor):
         yaw = torch.tensor(float(yaw), dtype=like.dtype, device=like.device)
     return torch.cos(yaw), torch.sin(yaw)
@@ -103,6 +111,7 @@ def rotate_yaw(vectors: np.ndarray, yaw: np.ndarray | float) -> np.ndarray:
 
 def rotate_yaw_torch(vectors: torch.Tensor, yaw: torch.Tensor | float) -> torch.Tensor:
     """Torch twin of :func:`rotate_yaw`."""
+    import torch
     c, s = _cos_sin(yaw, vectors)
     x, y, z = vectors[..., 0], vectors[..., 1], vectors[..., 2]
     rotated_x = c * x + s * z
@@ -118,6 +127,7 @@ def rotate_yaw_xz(ground: np.ndarray, yaw: np.ndarray | float) -> np.ndarray:
 
 def rotate_yaw_xz_torch(ground: torch.Tensor, yaw: torch.Tensor | float) -> torch.Tensor:
     """Torch twin of :func:`rotate_yaw_xz`."""
+    import torch
     c, s = _cos_sin(yaw, ground)
     x, z = ground[..., 0], ground[..., 1]
     return torch.stack([c * x + s * z, -s * x + c * z], dim=-1)
@@ -134,6 +144,7 @@ def _axis_matrix_np(angle: np.ndarray, layout: str) -> np.ndarray:
 
 
 def _axis_matrix_torch(angle: torch.Tensor, layout: str) -> torch.Tensor:
+    import torch
     c, s, o, i = torch.cos(angle), torch.sin(angle), torch.zeros_like(angle), torch.ones_like(angle)
     entries = {"x": (i, o, o, o, c, -s, o, s, c), "y": (c, o, s, o, i, o, -s, o, c), "z": (c, -s, o, s, c, o, o, o, i)}
     return torch.stack(entries[layout], dim=-1).reshape(angle.shape + (3, 3))
@@ -208,6 +219,7 @@ def local_rotations(global_rotations: np.ndarray, parents: Sequence[int] | np.nd
 
 def local_rotations_torch(global_rotations: torch.Tensor, parents: Sequence[int] | np.ndarray) -> torch.Tensor:
     """Torch twin of :func:`local_rotations`."""
+    import torch
     index, roots = _parent_index(parents)
     local = relative_rotation_torch(global_rotations[..., index, :, :], global_rotations)
     is_root = torch.zeros(len(index), 1, 1, dtype=torch.bool, device=global_rotations.device)
@@ -274,6 +286,7 @@ def two_bone_ik_torch(
     lower: torch.Tensor | float, law: str = "distances", margin: float | None = None,
 ) -> tuple[torch.Tensor, torch.Tensor]:
     """Torch twin of :func:`two_bone_ik` (its gradient is infinite where the chain is straight)."""
+    import torch
     if law not in IK_LAWS:
         raise ValueError(f"law must be one of {IK_LAWS}, got {law!r}")
     to_target = target - root

@@ -24,12 +24,16 @@ and the angle wrapping are those of :mod:`stylemotion.geometry`.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
-import torch
 from scipy.ndimage import gaussian_filter1d
 
 from stylemotion.geometry import direction_yaw, rotate_yaw, rotate_yaw_torch, rotate_yaw_xz_torch, wrap_angle
 from stylemotion.skeleton import JOINT_INDEX, NUM_JOINTS
+
+if TYPE_CHECKING:  # torch is imported by the functions that use it, so that the numpy paths (search,
+    import torch  # reconstruct, annotate, datasets) start without it (docs/architecture.md)
 
 #: Identifier of the 66-dim frame layout below; a model trained on one representation refuses data or
 #: checkpoints of another. Bump when the layout changes.
@@ -120,6 +124,7 @@ def integrate_root(
     Returns:
         ``root_xz`` ``(..., frames, 2)`` metres and ``yaw`` ``(..., frames)`` radians (not wrapped).
     """
+    import torch
     f = frames
     dtype, lead = f.dtype, f.shape[:-2]
     yaw0 = torch.as_tensor(start_yaw, dtype=dtype, device=f.device).expand(lead)
@@ -150,6 +155,7 @@ def frames_to_positions(
     Returns:
         ``(..., frames, 21, 3)`` global positions, metres, Y up.
     """
+    import torch
     as_numpy = isinstance(frames, np.ndarray)
     f = torch.as_tensor(frames) if as_numpy else frames
     if f.shape[-1] != FRAME_DIM:

@@ -17,9 +17,12 @@ There is exactly one numpy FK (:func:`forward_kinematics`) and one torch FK
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
-import torch
+
+if TYPE_CHECKING:  # torch is imported by the functions that use it, so that the numpy paths (search,
+    import torch  # reconstruct, annotate, datasets) start without it (docs/architecture.md)
 
 #: The 21 canonical joints, named as the Bandai-Namco dataset names them (without joint_Root).
 CANONICAL_JOINTS: tuple[str, ...] = (
@@ -182,6 +185,7 @@ def forward_kinematics_torch(
     Returns:
         ``(..., joints, 3)`` global positions.
     """
+    import torch
     lead = torch.broadcast_shapes(rotations.shape[:-3], translations.shape[:-2])
     global_rot: list[torch.Tensor] = []
     global_pos: list[torch.Tensor] = []

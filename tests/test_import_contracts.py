@@ -243,3 +243,17 @@ def test_reading_a_users_motion_loads_no_lightning(module):
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, done.stderr
     assert done.stdout.strip() == "", f"import {module} loads {done.stdout.strip()}"
+
+
+NUMPY_SIDE = ["stylemotion.config", "stylemotion.search.command", "stylemotion.reconstruct.command",
+              "stylemotion.datasets.user_motion"]
+
+
+@pytest.mark.parametrize("module", NUMPY_SIDE)
+def test_the_numpy_side_loads_no_torch(module):
+    """The kinematics core imports torch inside its torch functions only, so reading motion and searching start
+    without it (a second or more of start-up)."""
+    code = f"import sys, {module}\nprint('torch' in sys.modules)"
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip() == "False", f"import {module} loads torch"
