@@ -91,3 +91,16 @@ def read_json(path: str | os.PathLike, what: str = "JSON file", remedy: str = "r
     except json.JSONDecodeError as exc:
         raise JsonFileError(f"{path}:{exc.lineno}: not valid JSON at column {exc.colno} ({exc.msg}); the {what} is "
                             f"damaged or cut off — {remedy}") from None
+
+
+def read_json_object(path: str | os.PathLike, what: str = "JSON file",
+                     remedy: str = "rerun the command that wrote it") -> dict[str, Any]:
+    """:func:`read_json` for a file that must hold an object (a record, a summary, a report).
+
+    Raises:
+        JsonFileError: as :func:`read_json`, or the file holds another JSON value (naming its type).
+    """
+    value = read_json(path, what, remedy)
+    if not isinstance(value, dict):
+        raise JsonFileError(f"{path}: the {what} holds a {type(value).__name__}, not an object; {remedy}")
+    return value

@@ -59,7 +59,7 @@ from stylemotion.config import ConfigError, positive_int, set_torch_threads  # a
 from stylemotion.datasets import build_dataset, data_config_key
 from stylemotion.evaluation.run import recorded_path, run_evaluation, summary_lines
 from stylemotion.io.errors import OutputWriteError, UserInputError
-from stylemotion.io.jsonfile import JsonFileError, read_json, write_json
+from stylemotion.io.jsonfile import JsonFileError, read_json_object, write_json
 from stylemotion.io.outputs import check_new_output, inside, safe_name
 from stylemotion.primitives.segmentation import SegmentSettings, action_of, parse_primitive, segment_takes
 from stylemotion.provenance import provenance
@@ -105,22 +105,6 @@ class Stage:
 
 def _hash(payload: Any) -> str:
     return hashlib.sha256(json.dumps(payload, sort_keys=True, default=str).encode()).hexdigest()[:16]
-
-
-def _write_json(path: Path, payload: Any) -> None:
-    write_json(path, payload)
-
-
-def read_record(path: Path, what: str, remedy: str) -> dict[str, Any]:
-    """The JSON object an earlier run wrote to ``path`` (a stage's ``done.json``, ``evaluation.json``).
-
-    Raises:
-        JsonFileError: it is missing, cut off or not an object; the message names the file and ends in ``remedy``.
-    """
-    value = read_json(path, what, remedy)
-    if not isinstance(value, dict):
-        raise JsonFileError(f"{path}: the {what} holds a {type(value).__name__}, not an object; {remedy}")
-    return value
 
 
 def check_out_folder(out: str | Path) -> Path:
@@ -221,7 +205,7 @@ class Reproduction:
         self._line(1, f"data: {takeset.name}, {len(takeset)} takes, {takeset.num_frames} frames; CVAE styles {wanted}")
         for p in self.primitives:
             self.say("    " + p + " clips: " + ", ".join(f"{s} {counts[(p, s)]}" for s in styles))
-        _write_json(self.out / "data.json", self.data_summary)
+        write_json(self.out / "data.json", self.data_summary)
 
     def prepare_stage(self, index: int, stage: Stage) -> bool | None:
         """Hash ``stage``'s settings, refuse a folder of other settings, reuse a finished stage.
@@ -238,14 +222,14 @@ class Reproduction:
         remedy = f"delete {stage.folder} to train the {stage.name} stage again"
         for record_path in (done, started):
             if record_path.is_file() and has_results:  # a stage that saved nothing is simply started again
-                recorded = read_record(record_path, f"{stage.name} stage's record", remedy).get("settings_hash")
+                recorded = read_json_object(record_path, f"{stage.name} stage's record", remedy).get("settings_hash")
                 if recorded != stage.settings_hash:
                     raise StageConflictError(
                         f"{stage.folder} holds the {stage.name} stage of a run with other settings (hash {recorded}, "
                         f"now {stage.settings_hash}: overrides, data, seed or an earlier stage changed). Choose "
                         f"another out=… or delete {stage.folder} to train it again")
         if done.is_file():
-            record = read_record(done, f"{stage.name} stage's record", remedy)
+            record = read_json_object(done, f"{stage.name} stage's record", remedy)
             checkpoint, seconds = record.get("checkpoint"), record.get("seconds", 0.0)
             metrics = record.get("metrics", {})
             if not (isinstance(checkpoint, (str, type(None))) and isinstance(seconds, (int, float))
@@ -260,7 +244,7 @@ class Reproduction:
                 return None
         resume = last.is_file()
         self._line(index, f"{stage.name}: {'resuming from ' + str(last) if resume else 'training'}")
-        _write_json(started, {"settings_hash": stage.settings_hash, "name": stage.name})
+        write_json(started, {"settings_hash": stage.settings_hash, "name": stage.name})
         stage.folder.mkdir(parents=True, exist_ok=True)
         return resume
 
@@ -273,7 +257,7 @@ class Reproduction:
         stage.status, stage.checkpoint = ("resumed" if resume else "trained"), str(Path(ckpt).resolve())
         stage.seconds = seconds
         stage.metrics = {k: v for k, v in metrics.items() if k in ("test", "best_score", "global_step", "epoch")}
-        _write_json(stage.folder / "done.json", {"settings_hash": stage.settings_hash,
+        write_json(stage.folder / "done.json", {"settings_hash": stage.settings_hash,
                                                  "checkpoint": self.recorded(stage.checkpoint),
                                                  "seconds": stage.seconds, "metrics": stage.metrics,
                                                  "name": stage.name})
@@ -312,7 +296,7 @@ class Reproduction:
             except Exception as exc:  # noqa: BLE001 - reported below, after the others are recorded
                 self.say(f"    {stage.name} FAILED: {type(exc).__name__}: {exc}")
                 errors.append((stage, exc))
-            _write_json(self.out / "reproduce.json", self.summary())
+            write_json(self.out / "reproduce.json", self.summary())
         if errors:
             names = ", ".join(stage.name for stage, _ in errors)
             raise RuntimeError(f"{len(errors)} training stage(s) failed ({names}); rerun to resume") from errors[0][1]
@@ -342,14 +326,14 @@ class Reproduction:
                                **({"morphable": True} if morphable else {})})  # off: the hash of earlier runs
         if report.exists():
             remedy = f"delete {report} to evaluate again"
-            recorded = read_record(record, "evaluation record", remedy).get("settings_hash") if record.is_file() \
+            recorded = read_json_object(record, "evaluation record", remedy).get("settings_hash") if record.is_file() \
                 else None
             if recorded != settings_hash or not (report / "report.json").is_file():
                 raise StageConflictError(
                     f"{report} holds a report of other models or settings (a stage was retrained, or the evaluation "
                     f"settings changed); delete {report} to evaluate again, or choose another out=…")
             self._line(step, f"evaluation: reused {report}")
-            return read_record(report / "report.json", "evaluation report", remedy)
+            return read_json_object(report / "report.json", "evaluation report", remedy)
         self._line(step, f"evaluation → {report}")
         models = [s.checkpoint for s in self.stages if s.kind in ("vae", "cvae")]
         ae = next(s.checkpoint for s in self.stages if s.kind == "autoencoder")
@@ -358,7 +342,7 @@ class Reproduction:
         results = run_evaluation(self.cfg.data, models, self.cfg.evaluation, report, int(self.cfg.seed),
                                  autoencoder_ckpt=ae, command=command, progress=lambda text: self.say("    " + text),
                                  root=self.out, extra_rows=extra)
-        _write_json(record, {"settings_hash": settings_hash, "report": self.recorded(report)})
+        write_json(record, {"settings_hash": settings_hash, "report": self.recorded(report)})
         return results
 
     def morphable_rows(self) -> dict[str, dict[str, Any]]:
@@ -543,13 +527,13 @@ def reproduce(cfg: DictConfig, say=print) -> dict[str, Any]:
     in_process = 1 if parallel else len(indexed)  # stage 1 is the autoencoder the others need
     for index, stage in indexed[:in_process]:
         repro.run_stage(index, stage)
-        _write_json(repro.out / "reproduce.json", repro.summary())
+        write_json(repro.out / "reproduce.json", repro.summary())
     if indexed[in_process:]:
         repro.run_stages_in_parallel(indexed[in_process:], workers)
     results = repro.evaluation_stage()
     summary = repro.summary()
     summary["report"] = repro.recorded(repro.out / "report")
-    _write_json(repro.out / "reproduce.json", summary)
+    write_json(repro.out / "reproduce.json", summary)
     say(f"done in {summary['seconds'] / 60:.1f} min: "
         + ", ".join(f"{k} {v}" for k, v in Counter(s.status for s in repro.stages).items()) + " training stages")
     for line in summary_lines(results):

@@ -6,7 +6,6 @@ they need of it."""
 
 from __future__ import annotations
 
-import json
 from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
@@ -14,14 +13,15 @@ from typing import Any
 
 from stylemotion.evaluation.run import settings_from_config
 from stylemotion.evaluation.settings import EvalSettings
+from stylemotion.io.jsonfile import JsonFileError, read_json
 from stylemotion.synthesis.graph import relocated
 
 
 def read_json_object(path: Path, what: str, error: type[Exception] = ValueError) -> dict[str, Any]:
     """The JSON object in ``path`` (``what`` names it in messages); ``error`` if unreadable or not an object."""
     try:
-        value = json.loads(Path(path).read_text())
-    except (OSError, ValueError) as exc:
+        value = read_json(path, what)
+    except JsonFileError as exc:
         raise error(f"run={Path(path).parent}: cannot read its {what} {path} ({exc})") from None
     if not isinstance(value, dict):
         raise error(f"run={Path(path).parent}: {path} does not hold a JSON object")
