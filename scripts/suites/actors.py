@@ -1,0 +1,47 @@
+"""Suite ``actors``: how many skeletons (actor groups) each data set holds, i.e. which cross-actor splits exist.
+
+Bandai dataset-2 was recorded by three actors, but a cross-actor split needs to know which take is whose; the
+labels name content and style only, so :func:`stylemotion.datasets.retarget.actor_groups` groups takes by their
+bone lengths. This suite measures how far those lengths differ between takes and how many groups result.
+"""
+
+from __future__ import annotations
+
+import argparse
+from typing import Any
+
+import numpy as np
+from suites.common import DATA_ROOT, fmt, md_table, provenance_line
+
+DESCRIPTION = "actor groups by bone length in Bandai (which cross-actor splits the data set allows)"
+DEFAULT_SEEDS = (0,)  # deterministic: no training or sampling
+
+
+def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
+    from stylemotion.bones import median_bone_lengths
+    from stylemotion.datasets.registry import load_dataset
+    from stylemotion.datasets.retarget import ACTOR_TOLERANCE_M, actor_groups
+
+    bandai = load_dataset("bandai", root=str(DATA_ROOT / "bandai-namco-motion-2" / "data.zip"))
+    lengths = np.stack([median_bone_lengths(t.positions) for t in bandai.takes])  # (takes, 20) m
+    rows = []
+    for content in ["all", *bandai.label_values("content")]:
+        takes = bandai.takes if content == "all" else [t for t in bandai.takes if t.content == content]
+        groups = actor_groups(takes)
+        rows.append({"content": content, "takes": len(takes), "groups": len(groups.styles),
+                     "styles_per_group": [len(s) for s in groups.styles.values()]})
+    return {"splits": {"kind": "none: every take of the data set is measured"},
+            "tolerance_m": ACTOR_TOLERANCE_M, "takes": len(bandai.takes),
+            "bone_length_sd_max_m": float(lengths.std(axis=0).max()),
+            "height_sum_of_bones_m": {"min": float(lengths.sum(1).min()), "max": float(lengths.sum(1).max())},
+            "by_content": rows}
+
+
+def render(record: dict[str, Any]) -> dict[str, str]:
+    r = record["results"]
+    table = md_table(["content", "takes", "actor groups (bones within 1 mm)"],
+                     [[row["content"], f"{row['takes']:,}", str(row["groups"])] for row in r["by_content"]])
+    text = (f"{table}\n\nLargest standard deviation of any bone's median length across the {r['takes']:,} takes: "
+            f"{fmt(r['bone_length_sd_max_m'] * 1000, 3)} mm (sum of the 20 bones {fmt(r['height_sum_of_bones_m']['min'], 3)}"
+            f"–{fmt(r['height_sum_of_bones_m']['max'], 3)} m). {provenance_line(record)}")
+    return {"headline": text}

@@ -1,0 +1,98 @@
+"""Helpers every benchmark suite shares: spreads over seeds, number formatting, tables, the split record.
+
+Suites import this as ``from suites.common import ...`` (``scripts/benchmarks.py`` puts ``scripts/`` on the
+path). Protocol: docs/benchmarks.md.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable, Mapping, Sequence
+from typing import Any
+
+import numpy as np
+
+from stylemotion.io.markdown import md_table
+
+__all__ = ["spread", "fmt", "fmt_spread", "fmt_range", "md_table", "provenance_line", "take_split_record",
+           "quantiles", "DATA_ROOT"]
+
+#: Where the benchmark data lies (``$STYLEMOTION_DATA`` or ``../shared/data`` beside the repository).
+DATA_ROOT = None  # set below
+
+
+def _data_root():
+    import os
+    from pathlib import Path
+
+    return Path(os.environ.get("STYLEMOTION_DATA") or Path(__file__).resolve().parents[3] / "shared" / "data")
+
+
+DATA_ROOT = _data_root()
+
+
+def spread(values: Iterable[float | None]) -> dict[str, Any]:
+    """Mean, sample SD, min, max and count of ``values``; ``missing`` counts None/non-finite values, which are
+    left out of the statistics but never silently (a suite shows ``missing`` beside the figure)."""
+    raw = list(values)
+    finite = [float(v) for v in raw if v is not None and math.isfinite(float(v))]
+    out: dict[str, Any] = {"n": len(finite), "missing": len(raw) - len(finite)}
+    if finite:
+        arr = np.asarray(finite)
+        out.update(mean=float(arr.mean()), sd=float(arr.std(ddof=1)) if len(arr) > 1 else 0.0,
+                   min=float(arr.min()), max=float(arr.max()))
+    return out
+
+
+def quantiles(values: Sequence[float], qs: Sequence[float] = (50, 95, 100)) -> dict[str, float | None]:
+    """Percentiles of ``values`` as ``{"p50": …, "p95": …, "p100": …}`` (None for no values)."""
+    arr = np.asarray([v for v in values if v is not None], dtype=float)
+    return {f"p{q:g}": (float(np.percentile(arr, q)) if arr.size else None) for q in qs}
+
+
+def fmt(value: float | None, digits: int = 2, unit: str = "") -> str:
+    """``value`` with ``digits`` decimals (thousands separated) and ``unit``; an em dash for None."""
+    if value is None or (isinstance(value, float) and not math.isfinite(value)):
+        return "—"
+    return f"{value:,.{digits}f}{unit}"
+
+
+def fmt_spread(s: Mapping[str, Any], digits: int = 2, unit: str = "") -> str:
+    """``mean ± sd`` over seeds (``(n = k)`` appended when fewer than 3; ``, m missing`` when any was missing)."""
+    if not s.get("n"):
+        return f"— ({s.get('missing', 0)} missing)"
+    text = f"{fmt(s['mean'], digits)} ± {fmt(s['sd'], digits)}{unit}"
+    if s["n"] < 3:
+        text += f" (n = {s['n']})"
+    if s.get("missing"):
+        text += f", {s['missing']} missing"
+    return text
+
+
+def fmt_range(s: Mapping[str, Any], digits: int = 2, unit: str = "") -> str:
+    """``min–max`` of a :func:`spread`."""
+    if not s.get("n"):
+        return "—"
+    return f"{fmt(s['min'], digits)}–{fmt(s['max'], digits)}{unit}"
+
+
+def provenance_line(record: Mapping[str, Any]) -> str:
+    """One sentence naming the command, commit, date, machine, load and seeds of a results record."""
+    m = record.get("machine", {})
+    load = record.get("load_average_start") or ["?"]
+    load_end = record.get("load_average_end") or ["?"]
+    return (f"Command: `{record['command']}` (commit {str(record['commit'])[:12]}, {record['started'][:10]}, "
+            f"{m.get('cpu', '?')}, {m.get('cores', '?')} cores, load {load[0]} → {load_end[0]}, seeds "
+            f"{', '.join(map(str, record.get('seeds', [])))}, {record.get('seconds', '?')} s).")
+
+
+def take_split_record(split: Mapping[str, Sequence[Any]], seed: int, val_fraction: float, test_fraction: float,
+                      group_by: Sequence[str] = ("content", "style")) -> dict[str, Any]:
+    """What a suite records about a :meth:`~stylemotion.datasets.base.TakeSet.split`: the seed, fractions and
+    the number of takes in each part (take names of ``val``/``test`` so a reader can check no test take was
+    used to choose anything)."""
+    return {"kind": "by take", "seed": int(seed), "val_fraction": float(val_fraction),
+            "test_fraction": float(test_fraction), "group_by": list(group_by),
+            "takes": {part: len(takes) for part, takes in split.items()},
+            "val_takes": sorted(getattr(t, "name", str(t)) for t in split.get("val", [])),
+            "test_takes": sorted(getattr(t, "name", str(t)) for t in split.get("test", []))}

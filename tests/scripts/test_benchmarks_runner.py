@@ -1,0 +1,56 @@
+"""scripts/benchmarks.py: results files carry their provenance, render rewrites only marked blocks, and the
+committed documents are exactly what their results files render."""
+
+from __future__ import annotations
+
+import importlib.util
+import json
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+@pytest.fixture(scope="module")
+def runner():
+    spec = importlib.util.spec_from_file_location("benchmarks_runner", ROOT / "scripts" / "benchmarks.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_committed_documents_are_what_their_results_render(runner, capsys) -> None:
+    """The aim of issue 24: `render` on a clean checkout changes nothing."""
+    status = runner.main(["render", "--check"])
+    assert status == 0, capsys.readouterr().out
+
+
+def test_render_replaces_only_the_marked_block_and_refuses_unknown_ones(runner, tmp_path) -> None:
+    record = json.loads((ROOT / "benchmarks" / "results" / "actors.json").read_text())
+    block = runner.load_suite("actors").render(record)["headline"]
+    text = "before 1.5\n<!-- begin: actors/headline -->\nstale 9.9\n<!-- end: actors/headline -->\nafter 2.5\n"
+    new = runner.rendered(text, tmp_path / "doc.md", {})
+    assert new.startswith("before 1.5\n<!-- begin: actors/headline -->\n") and new.endswith(
+        "<!-- end: actors/headline -->\nafter 2.5\n")
+    assert "stale 9.9" not in new and block.strip() in new
+    with pytest.raises(runner.BenchmarkError, match="renders no block 'nope'"):
+        runner.rendered("<!-- begin: actors/nope -->\n<!-- end: actors/nope -->", tmp_path / "doc.md", {})
+    with pytest.raises(runner.BenchmarkError, match="no results file"):
+        runner.rendered("<!-- begin: zzz_none/headline -->\n<!-- end: zzz_none/headline -->", tmp_path / "d.md", {})
+
+
+def test_unknown_suite_is_one_line_naming_the_suites(runner, capsys) -> None:
+    assert runner.main(["run", "no_such_suite"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and "no suite 'no_such_suite'" in err and "actors" in err
+
+
+def test_run_writes_results_with_command_commit_machine_load_and_seeds(runner, tmp_path) -> None:
+    out = tmp_path / "actors.json"
+    assert runner.main(["run", "actors", "--out", str(out)]) == 0
+    record = json.loads(out.read_text())
+    assert record["command"].startswith("python scripts/benchmarks.py run actors")
+    assert len(record["commit"]) >= 40 and record["seeds"] == [0]
+    assert record["machine"]["cores"] >= 1 and record["load_average_start"] is not None
+    assert record["results"]["splits"] and record["results"]["takes"] == 2902
