@@ -31,6 +31,33 @@ def _peak_rss_mb() -> dict[str, float]:
     return {"peak_rss_main_mb": round(own, 1), "peak_rss_worker_mb": round(children, 1)}
 
 
+def measure(root: str, contents=None, styles=None, workers: int | None = None, repeats: int = 3,
+            colds: int = 1) -> list[dict]:
+    """``colds`` cold builds (each in a fresh, empty cache folder), then ``repeats`` cached loads of the last
+    one (best kept): one record per measurement, with the peak memory so far."""
+    records = []
+    for _ in range(colds):
+        with tempfile.TemporaryDirectory(prefix="stylemotion-bench-") as cache:
+            options = dict(root=root, contents=contents, styles=styles, cache_dir=cache, workers=workers)
+            start = time.perf_counter()
+            takeset = load_dataset("bandai", **options)
+            cold = time.perf_counter() - start
+            frames = takeset.num_frames
+            records.append({"bench": "bandai_cold", "files": len(takeset), "frames": frames,
+                            "seconds": round(cold, 3), "frames_per_s": round(frames / cold, 1),
+                            "workers": workers or os.cpu_count(), **_peak_rss_mb()})
+            best = float("inf")
+            for _ in range(repeats):
+                start = time.perf_counter()
+                cached = load_dataset("bandai", **options)
+                best = min(best, time.perf_counter() - start)
+            assert cached.num_frames == frames
+        records.append({"bench": "bandai_cached", "files": len(cached), "frames": frames,
+                        "seconds": round(best, 3), "frames_per_s": round(frames / best, 1),
+                        "cold_over_cached": round(cold / best, 1), **_peak_rss_mb()})
+    return records
+
+
 def main(argv: list[str] | None = None) -> int:
     default_root = os.path.join(os.environ.get("STYLEMOTION_DATA", "../shared/data"),
                                 "bandai-namco-motion-2", "data.zip")
@@ -44,26 +71,8 @@ def main(argv: list[str] | None = None) -> int:
 
     machine = {"machine": platform.machine(), "cpus": os.cpu_count(), "python": platform.python_version(),
                "load_avg_1m": round(os.getloadavg()[0], 2)}
-    with tempfile.TemporaryDirectory(prefix="stylemotion-bench-") as cache:
-        options = dict(root=args.root, contents=args.contents, styles=args.styles, cache_dir=cache,
-                       workers=args.workers)
-        start = time.perf_counter()
-        takeset = load_dataset("bandai", **options)
-        cold = time.perf_counter() - start
-        frames = takeset.num_frames
-        print(json.dumps({"bench": "bandai_cold", "files": len(takeset), "frames": frames,
-                          "seconds": round(cold, 3), "frames_per_s": round(frames / cold, 1),
-                          "workers": args.workers or os.cpu_count(), **machine, **_peak_rss_mb()}))
-        sys.stdout.flush()
-        best = float("inf")
-        for _ in range(args.repeats):
-            start = time.perf_counter()
-            cached = load_dataset("bandai", **options)
-            best = min(best, time.perf_counter() - start)
-        assert cached.num_frames == frames
-        print(json.dumps({"bench": "bandai_cached", "files": len(cached), "frames": frames,
-                          "seconds": round(best, 3), "frames_per_s": round(frames / best, 1),
-                          "cold_over_cached": round(cold / best, 1), **machine, **_peak_rss_mb()}))
+    for record in measure(args.root, args.contents, args.styles, args.workers, args.repeats):
+        print(json.dumps({**record, **machine}), flush=True)
     return 0
 
 
