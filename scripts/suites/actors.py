@@ -42,6 +42,7 @@ def render(record: dict[str, Any]) -> dict[str, str]:
     table = md_table(["content", "takes", "actor groups (bones within 1 mm)"],
                      [[row["content"], f"{row['takes']:,}", str(row["groups"])] for row in r["by_content"]])
     text = (f"{table}\n\nLargest standard deviation of any bone's median length across the {r['takes']:,} takes: "
-            f"{fmt(r['bone_length_sd_max_m'] * 1000, 3)} mm (sum of the 20 bones {fmt(r['height_sum_of_bones_m']['min'], 3)}"
-            f"–{fmt(r['height_sum_of_bones_m']['max'], 3)} m). {provenance_line(record)}")
+            f"{fmt(r['bone_length_sd_max_m'] * 1000, 3)} mm (sum of the 20 bones "
+            f"{fmt(r['height_sum_of_bones_m']['min'], 3)}–{fmt(r['height_sum_of_bones_m']['max'], 3)} m). "
+            f"{provenance_line(record)}")
     return {"headline": text}

@@ -11,7 +11,7 @@ from __future__ import annotations
 import argparse
 from typing import Any
 
-from suites.common import DATA_ROOT, fmt, fmt_range, md_table, provenance_line, spread
+from suites.common import DATA_ROOT, fmt_range, md_table, provenance_line, spread
 
 DESCRIPTION = "data-layer load, command start-up and viewer speed (run alone; repetitions as seeds)"
 PARTS = ("data", "imports", "viewer")
@@ -46,8 +46,9 @@ def _data(record: dict[str, Any]) -> str:
     cached = [r for r in data if r["bench"] == "bandai_cached"]
     rows = [["cold: parse, resample, FK, canonical, cache write", f"{cold[0]['files']:,}", f"{cold[0]['frames']:,}",
              fmt_range(spread(r["seconds"] for r in cold), 1, " s"),
-             fmt_range(spread(r["frames_per_s"] for r in cold), 0), f"{max(r['peak_rss_main_mb'] for r in cold):,.0f} / "
-             f"{max(r['peak_rss_worker_mb'] for r in cold):,.0f} MB", "≤ 60 s"],
+             fmt_range(spread(r["frames_per_s"] for r in cold), 0),
+             f"{max(r['peak_rss_main_mb'] for r in cold):,.0f} / {max(r['peak_rss_worker_mb'] for r in cold):,.0f} MB",
+             "≤ 60 s"],
             ["cached: fingerprints, labels, one .npy read (best of 3 per repetition)", f"{cached[0]['files']:,}",
              f"{cached[0]['frames']:,}", fmt_range(spread(r["seconds"] for r in cached), 3, " s"),
              fmt_range(spread(r["frames_per_s"] for r in cached), 0), "", "≤ 3 s"]]
@@ -100,5 +101,6 @@ def render(record: dict[str, Any]) -> dict[str, str]:
         head.append(["viewer, 16 × 300 frames: page load / frames per second (auto quality)",
                      f"{fmt_range(spread(x['load_s_median'] for x in r['viewer']), 2, ' s')} / "
                      f"{fmt_range(spread(x['fps_playing']['auto'] for x in r['viewer']), 1)}"])
-    blocks["headline"] = md_table(["figure (measured alone)", "result (min–max over repetitions)"], head) + f"\n\n{line}"
+    table = md_table(["figure (measured alone)", "result (min–max over repetitions)"], head)
+    blocks["headline"] = f"{table}\n\n{line}"
     return blocks

@@ -46,11 +46,27 @@ def test_unknown_suite_is_one_line_naming_the_suites(runner, capsys) -> None:
     assert err.count("\n") == 0 and "no suite 'no_such_suite'" in err and "actors" in err
 
 
-def test_run_writes_results_with_command_commit_machine_load_and_seeds(runner, tmp_path) -> None:
-    out = tmp_path / "actors.json"
-    assert runner.main(["run", "actors", "--out", str(out)]) == 0
+TINY_SUITE = """
+DESCRIPTION = "a tiny suite for the runner's test"
+def run(args, seeds):
+    return {"splits": {"kind": "none"}, "squares": [s * s for s in seeds]}
+def render(record):
+    return {"headline": str(record["results"]["squares"])}
+"""
+
+
+def test_run_writes_results_with_command_commit_machine_load_and_seeds(runner, tmp_path, monkeypatch,
+                                                                      capsys) -> None:
+    (tmp_path / "tiny.py").write_text(TINY_SUITE)
+    (tmp_path / "silent.py").write_text(TINY_SUITE.replace('"splits": {"kind": "none"}, ', ""))
+    monkeypatch.setattr(runner, "SUITES", tmp_path)
+    out = tmp_path / "tiny.json"
+    assert runner.main(["run", "tiny", "--seeds", "2", "3", "--out", str(out)]) == 0
     record = json.loads(out.read_text())
-    assert record["command"].startswith("python scripts/benchmarks.py run actors")
-    assert len(record["commit"]) >= 40 and record["seeds"] == [0]
+    assert record["command"] == f"python scripts/benchmarks.py run tiny --seeds 2 3 --out {out}"
+    assert len(record["commit"]) >= 40 and record["seeds"] == [2, 3]
     assert record["machine"]["cores"] >= 1 and record["load_average_start"] is not None
-    assert record["results"]["splits"] and record["results"]["takes"] == 2902
+    assert record["results"]["squares"] == [4, 9]
+    capsys.readouterr()
+    assert runner.main(["run", "silent", "--out", str(tmp_path / "silent.json")]) == 2
+    assert "no 'splits' entry" in capsys.readouterr().err and not (tmp_path / "silent.json").exists()
