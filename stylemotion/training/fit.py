@@ -245,6 +245,34 @@ class HyperparametersWithMetric(pl.Callback):
                 logger.log_hyperparams(self.params, metrics={f"hp/{self.monitor}": float(_plain(value))})
 
 
+class ValidationAtBest(pl.Callback):
+    """Keeps the validation metrics (every logged ``val/…`` value) of the epoch where ``monitor`` was lowest,
+    and of the last validation; :func:`run` writes them to ``metrics.json`` as ``val`` and ``val_last``, the
+    numbers a sweep's :func:`objective` is read from (never the test split's)."""
+
+    def __init__(self, monitor: str):
+        self.monitor = monitor
+        self.best: dict[str, float] = {}
+        self.last: dict[str, float] = {}
+
+    def on_validation_end(self, trainer: pl.Trainer, pl_module: pl.LightningModule) -> None:
+        if trainer.sanity_checking:
+            return
+        values = {k: float(_plain(v)) for k, v in trainer.callback_metrics.items() if k.startswith("val/")}
+        if not values:
+            return
+        self.last = values
+        score, best = values.get(self.monitor), self.best.get(self.monitor)
+        if score is not None and math.isfinite(score) and (best is None or score < best):
+            self.best = values
+
+    def state_dict(self) -> dict[str, Any]:  # kept in checkpoints, so a resumed run knows its best epoch
+        return {"best": dict(self.best), "last": dict(self.last)}
+
+    def load_state_dict(self, state_dict: dict[str, Any]) -> None:
+        self.best, self.last = dict(state_dict.get("best", {})), dict(state_dict.get("last", {}))
+
+
 def run(cfg: DictConfig, extra_callbacks: list[pl.Callback] | None = None,
         datamodule_args: Mapping[str, Any] | None = None) -> dict[str, Any]:
     """Train (and test) as ``cfg`` says; returns ``{"trainer", "model", "datamodule", "metrics"}``.
@@ -260,6 +288,8 @@ def run(cfg: DictConfig, extra_callbacks: list[pl.Callback] | None = None,
     if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
         raise ConfigError(f"seed must be a whole number ≥ 0, got {seed!r}")
     callbacks = _instantiate_all(cfg.get("callbacks")) + list(extra_callbacks or [])
+    validation = ValidationAtBest(str(cfg.get("monitor") or ""))
+    callbacks.append(validation)
     loggers = _instantiate_all(cfg.get("logger"))
     ckpt_path = prepare_output(output_dir, cfg.get("ckpt_path"), bool(cfg.get("force", False)),
                                *result_locations(output_dir, callbacks, loggers))
@@ -296,6 +326,9 @@ def run(cfg: DictConfig, extra_callbacks: list[pl.Callback] | None = None,
     if best:
         metrics["best_checkpoint"] = best
         metrics["best_score"] = _plain(_best_score(trainer))
+    if validation.best or validation.last:  # the validation metrics at the best epoch (what sweeps minimize)
+        metrics["val"] = dict(validation.best or validation.last)
+        metrics["val_last"] = dict(validation.last)
     if cfg.get("test", True):
         for cb in trainer.checkpoint_callbacks:  # a failure while testing must not save the tested weights
             if isinstance(cb, ModelCheckpoint):  # as last.ckpt
@@ -408,8 +441,36 @@ def _write_text(path: Path, text: str) -> None:
     atomic_write_bytes(path, text.encode())
 
 
-def objective(metrics: dict[str, Any], cfg: DictConfig) -> float | None:
-    """The number a sweeper minimizes: the test value of ``cfg.monitor`` (else its best val value)."""
-    name = str(cfg.get("monitor") or "")
-    value = metrics.get("test", {}).get(name.replace("val/", "test/"), metrics.get("best_score"))
-    return None if value is None or not math.isfinite(value) else float(value)
+def objective_names(cfg: DictConfig) -> list[str]:
+    """The validation metrics a sweep minimizes: ``cfg.sweep_objective`` (a name or a list of names, for
+    Optuna's multi-objective search) or else ``cfg.monitor``.
+
+    Raises:
+        ConfigError: a name that is not a validation metric (``val/…``): sweeps never choose on test data.
+    """
+    chosen = cfg.get("sweep_objective") or cfg.get("monitor") or ""
+    names = [str(n) for n in chosen] if isinstance(chosen, (list, tuple)) or OmegaConf.is_list(chosen) \
+        else [str(chosen)]
+    bad = [n for n in names if not n.startswith("val/")]
+    if bad or not names:
+        raise ConfigError(f"sweep_objective/monitor must name validation metrics (val/…), got {bad or names}: a sweep "
+                          "chooses on the validation takes, never on the test takes it reports")
+    return names
+
+
+def objective(metrics: dict[str, Any], cfg: DictConfig) -> float | list[float] | None:
+    """The number(s) a sweeper minimizes, read from the **validation** split only: for each name of
+    :func:`objective_names`, its value at the epoch where ``cfg.monitor`` was best (``metrics["val"]``; for
+    the monitor itself the best checkpoint's score). Never a ``test/…`` value. One name → a float, several →
+    a list (Optuna's multi-objective sweeps); None when a value is missing or not finite (a failed trial)."""
+    names = objective_names(cfg)
+    monitor = str(cfg.get("monitor") or "")
+    at_best = metrics.get("val") or {}
+    values = []
+    for name in names:
+        value = metrics.get("best_score") if name == monitor and metrics.get("best_score") is not None \
+            else at_best.get(name)
+        if value is None or not math.isfinite(float(value)):
+            return None
+        values.append(float(value))
+    return values[0] if len(values) == 1 else values

@@ -1,0 +1,194 @@
+"""Suite ``style``: the style models of Du ch. 5 (per-primitive VAEs, Gram-matrix style CVAEs), over seeds.
+
+For each seed, ``stylemotion-reproduce seed=<k> out=runs/benchmarks/style/<data>/seed<k>`` runs through its library
+entry (:func:`stylemotion.training.reproduction.reproduce`, stages reused when that folder already finished them, an
+interrupted one resumed) and the suite reads its ``report/report.json``: Table 5.1's diagonal (rows and columns whose
+nearest model/example is their own), the style classifier's recognition of the samples, and the variation figures
+(pose/V/step SD relative to the training data, pose_across_SD and the models' variation relative to real clips of
+their own style). Figures are mean ± sd and min–max over seeds; the seed changes the models' initialization, batches
+and samples, not the data or its split (``data.split``: by take, seeded separately and recorded).
+
+``--data synthetic`` (default) is the embedded synthetic set: a smoke test of the pipeline, never evidence that the
+method works. ``--data bandai`` runs Bandai dataset-2's walks (30–60 min per seed on 2 cores).
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+from typing import Any
+
+from suites.common import DATA_ROOT, fmt, fmt_range, fmt_spread, md_table, provenance_line, spread
+
+DESCRIPTION = "style VAEs/CVAEs (Du ch. 5): Table 5.1 diagonal, recognition and variation over seeds"
+DEFAULT_SEEDS = (0, 1, 2)
+ROOT = Path(__file__).resolve().parents[2]
+#: The reproduction's data overrides per ``--data``.
+DATA = {
+    "synthetic": ["data=synthetic"],
+    "bandai": ["data=bandai", f"data.root={DATA_ROOT / 'bandai-namco-motion-2' / 'data.zip'}",
+               "data.contents=[walk,walk-turn-left,walk-turn-right]"],
+}
+#: Variation figures of the report (``variance_ratio``: model / training data; ``variation_vs_style``: model /
+#: real clips of its own style).
+RATIOS = ("pose_sd", "v_sd", "step_sd")
+VS_STYLE = ("pose_across_sd", "v_sd", "step_sd", "diversity")
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--data", choices=sorted(DATA), default="synthetic",
+                        help="synthetic: the embedded set (smoke evidence only); bandai: dataset-2 walks (slow)")
+    parser.add_argument("--runs", type=Path, default=ROOT / "runs" / "benchmarks" / "style",
+                        help="folder of the per-seed reproduction runs (reused and resumed)")
+    parser.add_argument("--workers", type=int, default=2, help="training stages at once (the reproduction's workers)")
+
+
+def reproduce_seed(data: str, seed: int, out: Path, workers: int) -> dict[str, Any]:
+    """Run (or reuse) ``stylemotion-reproduce`` for ``seed`` into ``out``; returns its ``report.json``."""
+    from hydra import compose, initialize_config_dir
+    from hydra.core.global_hydra import GlobalHydra
+
+    from stylemotion.cli.schemas import register_schemas_for
+    from stylemotion.config import config_dir
+    from stylemotion.io.jsonfile import read_json_object
+    from stylemotion.training.reproduction import reproduce
+
+    register_schemas_for("reproduce")
+    GlobalHydra.instance().clear()
+    overrides = [*DATA[data], f"seed={seed}", f"out={out}", f"workers={workers}", "threads=1"]
+    with initialize_config_dir(config_dir(), version_base="1.3"):
+        cfg = compose("reproduce", overrides=overrides)
+        reproduce(cfg, say=lambda line: print(f"[seed {seed}] {line}", flush=True))
+    return read_json_object(out / "report" / "report.json", "the reproduction's report", "rerun the suite")
+
+
+def seed_figures(report: dict[str, Any]) -> dict[str, Any]:
+    """The figures of one seed's report: per primitive, Table 5.1's diagonal counts, recognition, variation."""
+    out: dict[str, Any] = {"primitives": {}}
+    for primitive, table in report["table_5_1"].items():
+        diag = table["diagonal"]
+        models = list(table["models"])
+        rows, columns = len(diag["rows"]), len(diag["columns"])  # names whose row / column minimum is their own
+        out["primitives"][primitive] = {
+            "models": len(models), "diagonal_rows": rows, "diagonal_columns": columns,
+            "recognition": {m: d["share"] for m, d in report["style_recognition"]["per_model_detail"][primitive].items()},
+            "classifier": {k: report["style_recognition"]["per_primitive"][primitive][k]
+                           for k in ("heldout_accuracy", "heldout_clips", "train_clips")},
+            "variance_ratio": {m: {k: v[k] for k in RATIOS} for m, v in report["variance_ratio"][primitive].items()
+                               if m != "training_data"},
+            "variation_vs_style": {m: {k: v.get(k) for k in VS_STYLE}
+                                   for m, v in report["variation_vs_style"][primitive].items()},
+        }
+    out["recognition_per_model"] = dict(report["style_recognition"]["per_model"])
+    out["classifier_heldout_accuracy"] = report["style_recognition"]["classifier_heldout_accuracy"]
+    out["split"] = report["meta"]["data"].get("split")
+    return out
+
+
+def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
+    import torch
+
+    torch.set_num_threads(1)
+    per_seed = {}
+    for seed in seeds:
+        out = args.runs / args.data / f"seed{seed}"
+        report = reproduce_seed(args.data, seed, out, args.workers)
+        per_seed[str(seed)] = seed_figures(report) | {"run": str(out.relative_to(ROOT) if out.is_relative_to(ROOT)
+                                                                   else out)}
+    first = next(iter(per_seed.values()))
+    primitives = list(first["primitives"])
+    summary: dict[str, Any] = {}
+    for p in primitives:
+        figs = [s["primitives"][p] for s in per_seed.values()]
+        models = list(figs[0]["variance_ratio"])
+        summary[p] = {
+            "models": figs[0]["models"],
+            "diagonal_rows": spread(f["diagonal_rows"] for f in figs),
+            "diagonal_columns": spread(f["diagonal_columns"] for f in figs),
+            "classifier_heldout_accuracy": spread(f["classifier"]["heldout_accuracy"] for f in figs),
+            "recognition": {m: spread(f["recognition"].get(m) for f in figs) for m in models},
+            "variance_ratio": {m: {k: spread(f["variance_ratio"][m][k] for f in figs) for k in RATIOS}
+                               for m in models},
+            "variation_vs_style": {m: {k: spread(f["variation_vs_style"].get(m, {}).get(k) for f in figs)
+                                       for k in VS_STYLE} for m in models},
+        }
+    styled = [m for m in first["recognition_per_model"] if m != "neutral"]
+    overall = {
+        "recognition_mean_styled": spread(sum(s["recognition_per_model"][m] for m in styled) / len(styled)
+                                          for s in per_seed.values()),
+        "classifier_heldout_accuracy": spread(s["classifier_heldout_accuracy"] for s in per_seed.values()),
+    }
+    split = first["split"] or {}
+    clips = {p: first["primitives"][p]["classifier"] for p in primitives}
+    return {"data": args.data,
+            "splits": {"data": {"kind": "by take", **split, "group_by": ["content", "style"]},
+                       "seed_varies": "model initialization, batches and samples (not the data or its split)",
+                       "classifier": "fitted on the train-split clips of every style; its accuracy and the samples' "
+                                     "recognition are read against it (held-out accuracy on the val+test clips)",
+                       "table_5_1": "each model's samples against each style's example clip (the CVAE's training "
+                                    "example; neutral: the mean of the neutral train clips) — not a held-out figure",
+                       "variation": "model samples against the neutral train clips (variance_ratio) and all real "
+                                    "clips of the model's style (variation_vs_style)",
+                       "clips": clips,
+                       "chosen_here": "nothing: α and the style-term options are the configs' defaults"},
+            "primitives": primitives, "summary": summary, "overall": overall, "per_seed": per_seed}
+
+
+def render(record: dict[str, Any]) -> dict[str, str]:
+    r = record["results"]
+    seeds = len(record.get("seeds", []))
+    label = ("**Synthetic data: a smoke test of the pipeline, not evidence that the method works.** "
+             if r["data"] == "synthetic" else "")
+    split = r["splits"]["data"]
+    split_line = (f"Data split by take (seed {split.get('seed')}, val {split.get('val_fraction')}, test "
+                  f"{split.get('test_fraction')}); the seed varies training and sampling only. The classifier is "
+                  "fitted on train-split clips and scored on val+test clips; Table 5.1 compares samples with the "
+                  "CVAE's own training example (not a held-out figure).")
+    prov = provenance_line(record)
+
+    rows = []
+    for p in r["primitives"]:
+        s = r["summary"][p]
+        rows.append([p, f"{s['models']}", f"{fmt_spread(s['diagonal_rows'], 2)} ({fmt_range(s['diagonal_rows'], 0)})",
+                     f"{fmt_spread(s['diagonal_columns'], 2)} ({fmt_range(s['diagonal_columns'], 0)})",
+                     f"{fmt_spread(s['classifier_heldout_accuracy'], 3)}"])
+    o = r["overall"]
+    headline = (f"{label}Style CVAEs ({r['data']}, {seeds} seeds): Table 5.1 diagonal and recognition.\n\n"
+                + md_table(["primitive", "models", "Table 5.1 rows on diagonal, mean ± sd (min–max)",
+                            "columns on diagonal", "classifier held-out accuracy"], rows)
+                + f"\n\nRecognition of the styled models' samples (mean over styles): "
+                  f"{fmt_spread(o['recognition_mean_styled'], 3)} (min–max {fmt_range(o['recognition_mean_styled'], 3)}). "
+                + split_line + " " + prov)
+
+    blocks = {"headline": headline}
+    recog_rows, ratio_rows, vs_rows = [], [], []
+    for p in r["primitives"]:
+        s = r["summary"][p]
+        for m, sp in s["recognition"].items():
+            recog_rows.append([p, m, fmt_spread(sp, 3), fmt_range(sp, 3)])
+        for m, ks in s["variance_ratio"].items():
+            ratio_rows.append([p, m, *(f"{fmt_spread(ks[k], 2)} ({fmt_range(ks[k], 2)})" for k in RATIOS)])
+        for m, ks in s["variation_vs_style"].items():
+            vs_rows.append([p, m, *(f"{fmt_spread(ks[k], 2)} ({fmt_range(ks[k], 2)})" for k in VS_STYLE)])
+    blocks["recognition"] = (f"{label}Share of each model's samples the style classifier assigns to the model's "
+                             f"style ({r['data']}, {seeds} seeds).\n\n"
+                             + md_table(["primitive", "model", "mean ± sd", "min–max"], recog_rows)
+                             + f"\n\n{split_line} {prov}")
+    blocks["variation"] = (f"{label}Variation of the samples relative to the neutral training clips "
+                           f"(pose_SD, V_SD, step_SD of the model / of the training data; mean ± sd (min–max) over "
+                           f"{seeds} seeds, {r['data']}).\n\n"
+                           + md_table(["primitive", "model", "pose_SD ratio", "V_SD ratio", "step_SD ratio"], ratio_rows)
+                           + f"\n\n{split_line} {prov}")
+    blocks["variation_vs_style"] = (f"{label}Variation of each model relative to all real clips of its own style "
+                                    f"(pose_across_SD, V_SD, step_SD and diversity of the samples / of the real "
+                                    f"clips; mean ± sd (min–max) over {seeds} seeds, {r['data']}).\n\n"
+                                    + md_table(["primitive", "model", "pose_across_SD", "V_SD", "step_SD",
+                                                "diversity"], vs_rows)
+                                    + f"\n\n{split_line} {prov}")
+    per_seed_rows = [[k, p, f"{v['primitives'][p]['diagonal_rows']}/{v['primitives'][p]['models']}",
+                      f"{v['primitives'][p]['diagonal_columns']}/{v['primitives'][p]['models']}",
+                      fmt(v['primitives'][p]['classifier']['heldout_accuracy'], 3), v["run"]]
+                     for k, v in r["per_seed"].items() for p in r["primitives"]]
+    blocks["per_seed"] = (md_table(["seed", "primitive", "rows on diagonal", "columns on diagonal",
+                                    "classifier held-out accuracy", "run folder"], per_seed_rows) + f"\n\n{prov}")
+    return blocks
