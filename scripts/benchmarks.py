@@ -81,6 +81,18 @@ def machine() -> dict:
     return record
 
 
+def uncommitted() -> list[str]:
+    """Tracked files that differ from HEAD when the suite ran (a ``+dirty`` commit names which)."""
+    import subprocess
+
+    try:
+        out = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"], cwd=ROOT, capture_output=True,
+                             text=True, timeout=10, check=True).stdout
+    except (OSError, subprocess.SubprocessError):
+        return []
+    return sorted(line[3:] for line in out.splitlines() if line.strip())
+
+
 def results_path(name: str) -> Path:
     return RESULTS / f"{name}.json"
 
@@ -104,7 +116,8 @@ def run(argv: list[str]) -> int:
         raise BenchmarkError(f"suite {name} returned no 'splits' entry: every figure must say its split")
     record = {"suite": name, "description": suite.DESCRIPTION,
               "command": "python scripts/benchmarks.py run " + shlex.join([name, *argv[1:]]),
-              "commit": git_commit(ROOT), "started": started.isoformat(timespec="seconds"),
+              "commit": git_commit(ROOT), "uncommitted": uncommitted(),
+              "started": started.isoformat(timespec="seconds"),
               "seconds": round(time.perf_counter() - clock, 1), "seeds": list(args.seeds),
               "load_average_start": load, "load_average_end": load_average(), "machine": machine(),
               "results": results}
