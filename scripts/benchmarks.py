@@ -1,7 +1,7 @@
 """Every figure of BENCHMARKS.md and benchmarks/*.md, from one runner.
 
     python scripts/benchmarks.py run <suite> [--seeds 0 1 2] [suite options]
-    python scripts/benchmarks.py render [--check]
+    python scripts/benchmarks.py render [--check] [DOCUMENT ...]
     python scripts/benchmarks.py list
 
 ``run`` imports ``scripts/suites/<suite>.py`` and writes ``benchmarks/results/<suite>.json``: the suite's
@@ -155,10 +155,15 @@ def render(argv: list[str]) -> int:
 
     parser = argparse.ArgumentParser(prog="benchmarks.py render")
     parser.add_argument("--check", action="store_true", help="write nothing; exit 1 when a document would change")
+    parser.add_argument("documents", nargs="*", type=Path, help="only these documents (default: all)")
     args = parser.parse_args(argv)
+    chosen = [d.resolve() for d in args.documents]
+    unknown = [str(d) for d in chosen if d not in DOCUMENTS]
+    if unknown:
+        raise BenchmarkError(f"not a benchmark document: {', '.join(unknown)} (BENCHMARKS.md and benchmarks/*.md)")
     blocks: dict[str, dict[str, str]] = {}
     changed = []
-    for document in DOCUMENTS:
+    for document in chosen or DOCUMENTS:
         text = document.read_text(encoding="utf-8")
         new = rendered(text, document, blocks)
         if new != text:
