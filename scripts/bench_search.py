@@ -1,31 +1,20 @@
-"""Motion-database search benchmark (issue 13, Krüger ch. 2): one JSON object per line.
+"""Motion-database search SPEED (Krüger Table 2.1): k-NN ms per query, one JSON object per line.
 
-    python scripts/bench_search.py --out bench_search.jsonl                 # everything, on all of Bandai
-    python scripts/bench_search.py --parts table21 --features E15 --copies 1,2,3
+    python scripts/bench_search.py --out bench_search.jsonl                 # Table 2.1 on all of Bandai
+    python scripts/bench_search.py --features E15 --copies 1,2,3
     python scripts/bench_search.py --smoke --out /tmp/smoke.jsonl            # tiny synthetic run (seconds)
 
-Parts (``--parts``, comma-separated):
-
-* ``table21`` — Table 2.1: ms per query for ``--ks`` neighbours (16, 256), every feature set, exact engines
-  (``ckdtree``, ``pykdtree``, ``faiss`` flat, when installed) single (one query per call) and batched (all
-  queries in one call), the brute-force time of the same queries in the same run as the ratio's base, and
-  ``faiss-hnsw`` (approximate) with its recall against the exact neighbours. Database sizes: ``--copies``
-  copies of the dataset: copy 0 is the data, copy 1 its mirror image (left and right swapped, x negated),
-  copy c ≥ 2 copy ``c mod 2`` with every joint displaced by seeded Gaussian noise (σ ``--jitter`` m) —
-  rotated copies would not do: the features are invariant under rotation, so they would duplicate frames.
-  Query frames (``--queries``): ``heldout`` (default) random frames of the test takes, the database built from
-  the train and val takes; ``jitter`` random database frames of copy 0 with the same jitter (so none is in the
-  database; farther from the data than a real motion, which makes kd-trees visit many more cells).
-* ``lng`` — LNG vs subsequence DTW: ``--lng-queries`` random 1 s and as many 3 s queries cut from test takes
-  (``TakeSet.split`` with the data config's split) against the train takes; Spearman ρ between the LNG's and
-  DTW's best global costs, the share of queries where both return the same best segment (same take and
-  frames) and where the segments overlap, and the alignment time per query without the k-NN search.
-* ``rank`` — rank correlations between feature sets (Fig. 2.5/2.7): for ``--rank-frames`` random frames, the
-  ``--rank-k`` nearest frames under set A; Spearman ρ between their distances under A and under B, averaged.
-* ``retrieval`` — Table 2.2 in spirit: a ``--retrieval-seconds`` segment from the middle of every test take as
-  query against the train and val takes; precision of the top 10 and 50 matches by content per content and
-  feature set (E15, E15x3, EP17 by default); and how often walk-turn-left queries return walk-turn-right
-  matches and vice versa (the physics sets should confuse them less, §2.6.2).
+Only timing lives here; it must run alone on an idle machine, and its figures are not in benchmarks/search.md
+until they are re-measured so (the search's quality figures — LNG against DTW, retrieval, other captures,
+rank agreement — come from ``python scripts/benchmarks.py run search``). Table 2.1: ms per query for ``--ks``
+neighbours (16, 256), every feature set, exact engines (``ckdtree``, ``pykdtree``, ``faiss`` flat, when
+installed) single (one query per call) and batched (all queries in one call), the brute-force time of the same
+queries in the same run as the ratio's base, and ``faiss-hnsw`` (approximate) with its recall against the exact
+neighbours. Database sizes: ``--copies`` copies of the dataset: copy 0 is the data, copy 1 its mirror image
+(left and right swapped, x negated), copy c ≥ 2 copy ``c mod 2`` with every joint displaced by seeded Gaussian
+noise (σ ``--jitter`` m) — rotated copies would not do: the features are invariant under rotation, so they would
+duplicate frames. Query frames (``--queries``): ``heldout`` (default) random frames of the test takes, the
+database built from the train and val takes; ``jitter`` random database frames of copy 0 with the same jitter.
 
 Everything runs on this process' threads (``--workers`` for cKDTree and faiss); the machine's load is recorded.
 """
@@ -38,20 +27,17 @@ import os
 import platform
 import sys
 import time
-from collections.abc import Callable, Iterable
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
-from scipy.stats import spearmanr
 
 from stylemotion.datasets import TakeSet, load_dataset
 from stylemotion.datasets.base import Take
-from stylemotion.search import ENGINES, FrameIndex, MotionDatabase, feature_names, feature_spec, search_features
-from stylemotion.search.dtw import subsequence_dtw_features
-from stylemotion.search.lng import TakeBounds, lng_match
+from stylemotion.search import ENGINES, FrameIndex, MotionDatabase, feature_names, feature_spec
 from stylemotion.skeleton import CANONICAL_MIRROR
 
-PARTS = ("table21", "lng", "rank", "retrieval")
+PARTS = ("table21",)
 Emit = Callable[[dict[str, Any]], None]
 
 
@@ -212,129 +198,21 @@ def _split(takeset: TakeSet, args: argparse.Namespace) -> dict[str, list[Take]]:
     return takeset.split(seed=args.split_seed, val_fraction=args.val_fraction, test_fraction=args.test_fraction)
 
 
-def _random_queries(takes: list[Take], frames: int, count: int, rng: np.random.Generator) -> list[tuple[Take, int]]:
-    usable = [t for t in takes if t.num_frames >= frames]
-    if not usable:
-        return []
-    picks = rng.integers(0, len(usable), count)
-    return [(usable[p], int(rng.integers(0, usable[p].num_frames - frames + 1))) for p in picks]
-
-
-def lng_vs_dtw(takeset: TakeSet, args: argparse.Namespace, emit: Emit) -> None:
-    split = _split(takeset, args)
-    database = MotionDatabase.from_takeset(TakeSet(f"{takeset.name}-train", split["train"], takeset.fps))
-    bounds = TakeBounds.from_next_in_take(database.next_in_take, database.take_id)
-    rng = np.random.default_rng(args.seed)
-    for fs in args.lng_features:
-        index = FrameIndex(database, fs, workers=args.workers)
-        for seconds in (1.0, 3.0):
-            m = int(round(seconds * takeset.fps))
-            lng_costs, dtw_costs, same, overlap, no_path, align_ms, knn_ms = [], [], 0, 0, 0, [], []
-            for take, start in _random_queries(split["test"], m, args.lng_queries, rng):
-                features = index.features_of(take.positions[start:start + m])
-                knn_s, (d, i) = timed(index.query, features, args.lng_k)
-                lng_s, found = timed(lng_match, i, d, bounds, top=1)
-                reference = subsequence_dtw_features(features, index.features, bounds).best
-                knn_ms.append(1000 * knn_s)
-                align_ms.append(1000 * lng_s)
-                if not found:
-                    no_path += 1
-                    continue
-                best = found[0]
-                lng_costs.append(best.cost)
-                dtw_costs.append(reference.cost)
-                same += (best.start, best.end) == (reference.start, reference.end)
-                overlap += best.take == reference.take and best.start <= reference.end and reference.start <= best.end
-            done = len(lng_costs)
-            rho = float(spearmanr(lng_costs, dtw_costs).statistic) if done >= 3 else None
-            emit({"part": "lng", "dataset": takeset.name, "features": fs, "k": args.lng_k, "query_s": seconds,
-                  "query_frames": m, "queries": done + no_path, "no_path": no_path, "train_takes": database.num_takes,
-                  "train_frames": database.num_frames, "spearman_rho": rho,
-                  "same_best_segment": round(same / done, 4) if done else None,
-                  "overlapping_best_segment": round(overlap / done, 4) if done else None,
-                  "lng_cost_ge_dtw": bool(np.all(np.array(lng_costs) >= np.array(dtw_costs) - 1e-9)) if done else None,
-                  "align_ms_per_query": round(float(np.mean(align_ms)), 4) if align_ms else None,
-                  "knn_ms_per_query": round(float(np.mean(knn_ms)), 4) if knn_ms else None})
-
-
-def rank_correlations(takeset: TakeSet, args: argparse.Namespace, emit: Emit) -> None:
-    database = MotionDatabase.from_takeset(takeset)
-    rng = np.random.default_rng(args.seed)
-    frames = rng.choice(database.num_frames, size=min(args.rank_frames, database.num_frames), replace=False)
-    k = min(args.rank_k, database.num_frames)
-    indexes = {fs: FrameIndex(database, fs, workers=args.workers) for fs in args.features}
-    for a, ia in indexes.items():
-        _, near = ia.query(ia.features[frames], k)
-        for b, ib in indexes.items():
-            dist_b = np.linalg.norm(ib.features[near] - ib.features[frames][:, None, :], axis=-1)
-            dist_a = np.linalg.norm(ia.features[near] - ia.features[frames][:, None, :], axis=-1)
-            rhos = [spearmanr(x, y).statistic for x, y in zip(dist_a, dist_b)]
-            emit({"part": "rank", "dataset": takeset.name, "a": a, "b": b, "frames": len(frames), "k": k,
-                  "mean_spearman_rho": round(float(np.nanmean(rhos)), 4)})
-
-
-def retrieval(takeset: TakeSet, args: argparse.Namespace, emit: Emit) -> None:
-    split = _split(takeset, args)
-    database = MotionDatabase.from_takeset(TakeSet(f"{takeset.name}-train+val", split["train"] + split["val"],
-                                                   takeset.fps))
-    m = int(round(args.retrieval_seconds * takeset.fps))
-    queries = [t for t in split["test"] if t.num_frames >= m]
-    for fs in args.retrieval_features:
-        index = FrameIndex(database, fs, workers=args.workers)
-        per_content: dict[str, list[tuple[float | None, float | None, int]]] = {}
-        turns = {"walk-turn-left": [0, 0], "walk-turn-right": [0, 0]}  # [opposite-turn matches, all matches]
-        for take in queries:
-            start = (take.num_frames - m) // 2
-            found = search_features(index.features_of(take.positions[start:start + m]), index, args.lng_k, 50).matches
-            contents = [f.content for f in found]
-            p10 = _precision(contents[:10], take.content)
-            p50 = _precision(contents[:50], take.content)
-            per_content.setdefault(take.content, []).append((p10, p50, len(found)))
-            if take.content in turns:
-                other = "walk-turn-right" if take.content == "walk-turn-left" else "walk-turn-left"
-                turns[take.content][0] += contents.count(other)
-                turns[take.content][1] += len(contents)
-        for content, rows in sorted(per_content.items()):
-            emit({"part": "retrieval", "dataset": takeset.name, "features": fs, "k": args.lng_k, "content": content,
-                  "query_s": args.retrieval_seconds, "queries": len(rows),
-                  "precision_at_10": _mean(r[0] for r in rows), "precision_at_50": _mean(r[1] for r in rows),
-                  "mean_matches_returned": round(float(np.mean([r[2] for r in rows])), 2)})
-        emit({"part": "retrieval_turns", "dataset": takeset.name, "features": fs, "k": args.lng_k,
-              **{f"{c}_share_opposite_turn": round(n / total, 4) if total else None for c, (n, total) in turns.items()},
-              **{f"{c}_matches": total for c, (_, total) in turns.items()}})
-
-
-def _precision(contents: list[str], wanted: str) -> float | None:
-    return sum(c == wanted for c in contents) / len(contents) if contents else None
-
-
-def _mean(values: Iterable[float | None]) -> float | None:
-    kept = [v for v in values if v is not None]
-    return round(float(np.mean(kept)), 4) if kept else None
-
-
 def parse(argv: list[str] | None) -> argparse.Namespace:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--data", choices=("bandai", "synthetic"), default="bandai")
     parser.add_argument("--root", default=None, help="Bandai folder or data.zip (default: $STYLEMOTION_DATA/...)")
     parser.add_argument("--parts", default=",".join(PARTS), help=f"comma-separated subset of {','.join(PARTS)}")
-    parser.add_argument("--features", default=",".join(feature_names()), help="feature sets (table21, rank)")
+    parser.add_argument("--features", default=",".join(feature_names()), help="feature sets")
     parser.add_argument("--engines", default=",".join(ENGINES))
-    parser.add_argument("--ks", default="16,256", help="neighbours per query (table21)")
-    parser.add_argument("--copies", default="1,2,3", help="database sizes as copies of the data (table21)")
+    parser.add_argument("--ks", default="16,256", help="neighbours per query")
+    parser.add_argument("--copies", default="1,2,3", help="database sizes as copies of the data")
     parser.add_argument("--jitter", type=float, default=0.01, help="σ of the copies' and queries' joint noise, m")
     parser.add_argument("--queries", choices=("heldout", "jitter"), default="heldout",
                         help="table21 queries: test-take frames (database: train + val) or jittered database frames")
     parser.add_argument("--table-queries", type=int, default=2000)
     parser.add_argument("--single-queries", type=int, default=200)
     parser.add_argument("--brute-queries", type=int, default=200)
-    parser.add_argument("--lng-features", default="E15,E15x3,pca16")
-    parser.add_argument("--lng-queries", type=int, default=128, help="per query length (1 s and 3 s)")
-    parser.add_argument("--lng-k", type=int, default=256, help="neighbours per query frame (lng, retrieval)")
-    parser.add_argument("--rank-frames", type=int, default=1024)
-    parser.add_argument("--rank-k", type=int, default=512)
-    parser.add_argument("--retrieval-features", default="E15,E15x3,EP17")
-    parser.add_argument("--retrieval-seconds", type=float, default=2.0)
     parser.add_argument("--workers", type=int, default=1, help="threads of cKDTree/faiss (-1: all cores)")
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--split-seed", type=int, default=0)
@@ -349,13 +227,11 @@ def parse(argv: list[str] | None) -> argparse.Namespace:
         args.data, args.takes_per_pair, args.duration_s = "synthetic", 3, 4.0
         args.features, args.ks, args.copies = "E15,E15x3,pca8,EP17", "4,16", "1,2,3"
         args.table_queries, args.single_queries, args.brute_queries = 40, 10, 20
-        args.lng_queries, args.lng_k, args.rank_frames, args.rank_k = 4, 64, 32, 16
-        args.lng_features, args.retrieval_seconds = "E15", 1.0
     args.parts = [p for p in args.parts.split(",") if p]
     unknown = sorted(set(args.parts) - set(PARTS))
     if unknown:
         parser.error(f"--parts: unknown {unknown}; valid: {list(PARTS)}")
-    for key in ("features", "engines", "lng_features", "retrieval_features"):
+    for key in ("features", "engines"):
         setattr(args, key, [v for v in getattr(args, key).split(",") if v])
     args.ks = [int(v) for v in args.ks.split(",")]
     args.copies = [int(v) for v in args.copies.split(",")]
@@ -380,10 +256,8 @@ def main(argv: list[str] | None = None) -> int:
               "fps": takeset.fps, "parts": args.parts, "engines_available": available_engines(),
               "machine": platform.machine(), "cpus": os.cpu_count(), "python": platform.python_version(),
               "workers": args.workers, "argv": sys.argv[1:]})
-        for part, run in (("table21", table21), ("lng", lng_vs_dtw), ("rank", rank_correlations),
-                          ("retrieval", retrieval)):
-            if part in args.parts:
-                run(takeset, args, emit)
+        if "table21" in args.parts:
+            table21(takeset, args, emit)
         emit({"part": "done", "seconds": round(time.perf_counter() - started, 2)})
     finally:
         if sink is not None:

@@ -205,3 +205,44 @@ def _backtrack(choice: np.ndarray, i: int, g: int, steps: tuple[Step, ...]) -> n
         dq, dg = steps[c - 1]
         i, g = i - dq, g - dg
     return np.array(out[::-1], dtype=np.int64)
+
+
+def best_subsequence_match(query: np.ndarray, database: np.ndarray, takes: TakeBounds | np.ndarray, *,
+                           upper_bound: float | None = None, first_takes: int = 8) -> tuple[Match | None, int]:
+    """The best :func:`subsequence_dtw_features` match (thesis steps, no normalization) of query ``(m, d)``
+    features in database ``(n, d)`` features, exactly, without sweeping takes that cannot hold it.
+
+    Every thesis step visits each query frame at least once, so a path inside take ``T`` costs at least
+    ``LB(T) = Σ_i min_{g ∈ T} C[i, g]``. The sweep runs on the ``first_takes`` takes of lowest bound (or
+    uses ``upper_bound``, e.g. the LNG's best cost, which can only be higher than DTW's), then on every
+    take whose bound does not exceed the best cost so far (a relative margin of 1e-9 covers rounding),
+    kept in database order so ties break as in the full sweep. Returns the match in the database's global
+    frames (``None`` without any path) and the number of takes swept. Tests: equal to the full sweep.
+    """
+    cost = feature_distances(query, database)
+    tb = TakeBounds.coerce(takes)
+    if tb.n != cost.shape[1]:
+        raise ValueError(f"takes describe {tb.n} database frames, the features have {cost.shape[1]}")
+    ends = np.flatnonzero(tb.remaining == 0)
+    starts = np.concatenate([[0], ends[:-1] + 1])
+    bound = np.minimum.reduceat(cost, starts, axis=1).sum(axis=0)  # (takes,)
+    order = np.argsort(bound, kind="stable")
+
+    def sweep(chosen: np.ndarray) -> Match | None:
+        chosen = np.sort(chosen)
+        frames = np.concatenate([np.arange(starts[t], ends[t] + 1) for t in chosen])
+        lengths = ends[chosen] - starts[chosen] + 1
+        found = subsequence_dtw(cost[:, frames], TakeBounds.from_lengths(lengths)).best
+        if found is None:
+            return None
+        path = found.path.copy()
+        path[:, 1] = frames[path[:, 1]]
+        return Match(int(frames[found.start]), int(frames[found.end]), found.cost, path,
+                     int(tb.take_id[frames[found.start]]))
+
+    limit = np.inf if upper_bound is None else float(upper_bound)
+    if not np.isfinite(limit):
+        first = sweep(order[:first_takes])
+        limit = np.inf if first is None else first.cost
+    chosen = np.flatnonzero(bound <= limit * (1 + 1e-9) + 1e-12) if np.isfinite(limit) else np.arange(len(starts))
+    return sweep(chosen), int(len(chosen))

@@ -1,0 +1,156 @@
+"""How well the search does, with its failures counted: the LNG against exact subsequence DTW, retrieval
+precision by content, and the helpers the benchmark suite ``search`` (scripts/suites/search.py) and the tests
+share.
+
+Conventions (docs/search.md, "How the search is measured"):
+
+* A query for which the LNG finds **no path** is a miss, never dropped: it shares the same best segment with
+  DTW "no", and in Spearman's ρ its LNG cost is ``+inf`` — the worst rank, ties among misses sharing their
+  average rank (:func:`spearman_with_misses`).
+* **Precision@n** counts a missing match as a wrong one: the number of the first ``n`` matches with the
+  wanted label, divided by ``n`` however many were found (:func:`precision_at`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from scipy.stats import rankdata
+
+from stylemotion.search.dtw import best_subsequence_match
+from stylemotion.search.index import FrameIndex
+from stylemotion.search.lng import TakeBounds, lng_match
+
+#: A query whose mean joint speed (all 21 joints, world frame) is below this is a "still pose" query, m/s.
+#: Bandai's takes begin and end standing; standing sway stays below it, a waving hand alone lifts the mean
+#: above it. A label for reporting, not a tuned setting.
+STILL_SPEED_M_S = 0.1
+
+
+def spearman_with_misses(lng_costs: Sequence[float | None], dtw_costs: Sequence[float]) -> float | None:
+    """Spearman's ρ between the LNG's and DTW's best costs over all queries; a query without an LNG path
+    (``None`` or ``inf``) takes the worst LNG rank (misses tie). ``None`` for fewer than 3 queries or when
+    one side is constant."""
+    lng = np.array([np.inf if c is None else float(c) for c in lng_costs])
+    dtw = np.asarray(dtw_costs, dtype=float)
+    if lng.shape != dtw.shape:
+        raise ValueError(f"{lng.size} LNG costs but {dtw.size} DTW costs")
+    if lng.size < 3:
+        return None
+    a, b = rankdata(lng), rankdata(dtw)
+    if np.ptp(a) == 0 or np.ptp(b) == 0:
+        return None
+    return float(np.corrcoef(a, b)[0, 1])
+
+
+def precision_at(labels: Sequence[str], wanted: str, n: int) -> float:
+    """Share of the first ``n`` found ``labels`` equal to ``wanted``, missing ones (fewer than ``n`` found)
+    counted wrong."""
+    if n < 1:
+        raise ValueError(f"n must be ≥ 1, got {n}")
+    return sum(label == wanted for label in list(labels)[:n]) / n
+
+
+def mean_joint_speed(positions: np.ndarray, fps: float) -> float:
+    """Mean speed of all joints over ``positions (frames, J, 3)`` metres, m/s (0 for one frame)."""
+    p = np.asarray(positions, dtype=np.float64)
+    if len(p) < 2:
+        return 0.0
+    return float(np.linalg.norm(np.diff(p, axis=0), axis=-1).mean() * fps)
+
+
+def random_segments(lengths: Sequence[int], frames: int, count: int, rng: np.random.Generator
+                    ) -> list[tuple[int, int]]:
+    """``count`` random ``(take, start)`` pairs (takes numbered as in ``lengths``) of segments of ``frames``
+    frames: a take drawn uniformly among those long enough, then a start uniformly inside it."""
+    usable = [t for t, n in enumerate(lengths) if n >= frames]
+    if not usable:
+        return []
+    picks = rng.integers(0, len(usable), count)
+    return [(usable[p], int(rng.integers(0, lengths[usable[p]] - frames + 1))) for p in picks]
+
+
+@dataclass(frozen=True)
+class LNGvsDTW:
+    """One query: the DTW best match (``dtw_*``, global frames, always found for queries no longer than a
+    take) and per ``k`` the LNG's best (``lng[k]``: ``(start, end, cost)`` or ``None`` for no path)."""
+
+    dtw_start: int
+    dtw_end: int
+    dtw_cost: float
+    dtw_take: int
+    lng: dict[int, tuple[int, int, float, int] | None]
+    takes_swept: int
+
+    def record(self, k: int) -> dict[str, Any]:
+        """The comparison at ``k``: ``no_path``, ``same_segment``, ``overlap``, ``cost_ratio`` (LNG / DTW,
+        ``None`` without a path), ``lng_cost``, ``dtw_cost``."""
+        found = self.lng[k]
+        if found is None:
+            return {"no_path": True, "same_segment": False, "overlap": False, "cost_ratio": None,
+                    "lng_cost": None, "dtw_cost": self.dtw_cost}
+        start, end, cost, take = found
+        return {"no_path": False, "same_segment": (start, end) == (self.dtw_start, self.dtw_end),
+                "overlap": take == self.dtw_take and start <= self.dtw_end and self.dtw_start <= end,
+                "cost_ratio": cost / self.dtw_cost if self.dtw_cost > 0 else (1.0 if cost == 0 else None),
+                "lng_cost": cost, "dtw_cost": self.dtw_cost}
+
+
+def compare_lng_dtw(features: np.ndarray, index: FrameIndex, takes: TakeBounds, ks: Sequence[int]) -> LNGvsDTW:
+    """The LNG's best match of query ``features (m, d)`` at each of ``ks`` neighbours per frame (one k-NN
+    query for the largest; the first ``k`` columns are the ``k`` nearest) against exact subsequence DTW over
+    every database frame with the same steps (:func:`~stylemotion.search.dtw.best_subsequence_match`)."""
+    ks = sorted(set(int(k) for k in ks))
+    dist, ind = index.query(features, ks[-1])
+    dist, ind = np.atleast_2d(dist), np.atleast_2d(ind)
+    lng: dict[int, tuple[int, int, float, int] | None] = {}
+    for k in ks:
+        found = lng_match(ind[:, :k], dist[:, :k], takes, top=1)
+        lng[k] = (found[0].start, found[0].end, found[0].cost, found[0].take) if found else None
+    upper = min((v[2] for v in lng.values() if v is not None), default=None)
+    best, swept = best_subsequence_match(features, index.features, takes, upper_bound=upper)
+    if best is None:
+        raise ValueError("no DTW path: the query is longer than every take of the database")
+    return LNGvsDTW(best.start, best.end, best.cost, best.take, lng, swept)
+
+
+def summarize_lng(records: Sequence[dict[str, Any]]) -> dict[str, Any]:
+    """Figures over queries' :meth:`LNGvsDTW.record` s: counts, no-path count, same/overlapping best segment
+    shares and Spearman ρ over **all** queries (no path = miss), cost ratio mean/p95/max over the queries
+    with a path (their count beside)."""
+    n = len(records)
+    ratios = np.array([r["cost_ratio"] for r in records if r["cost_ratio"] is not None], dtype=float)
+    return {"queries": n, "no_path": sum(r["no_path"] for r in records),
+            "same_segment": float(np.mean([r["same_segment"] for r in records])) if n else None,
+            "overlap": float(np.mean([r["overlap"] for r in records])) if n else None,
+            "spearman_rho": spearman_with_misses([r["lng_cost"] for r in records], [r["dtw_cost"] for r in records]),
+            "cost_ratio_n": int(ratios.size),
+            "cost_ratio_mean": float(ratios.mean()) if ratios.size else None,
+            "cost_ratio_p95": float(np.percentile(ratios, 95)) if ratios.size else None,
+            "cost_ratio_max": float(ratios.max()) if ratios.size else None,
+            "lng_never_below_dtw": bool(np.all(ratios >= 1 - 1e-9)) if ratios.size else None}
+
+
+def rank_agreement(indexes: dict[str, FrameIndex], frames: np.ndarray, k: int) -> dict[str, dict[str, float]]:
+    """Fig. 2.5/2.7 of the thesis: for each frame of ``frames`` (global indices), its ``k`` nearest frames under
+    feature set A; Spearman's ρ between those frames' distances under A and under B, averaged over the frames.
+    ``indexes``: feature set → index over the same database. Returns ``{A: {B: mean ρ}}`` (ties share ranks)."""
+    out: dict[str, dict[str, float]] = {}
+    for a, ia in indexes.items():
+        _, near = ia.query(ia.features[frames], k)
+        near = np.atleast_2d(near)
+        ranks = {}
+        for b, ib in indexes.items():
+            dist = np.linalg.norm(ib.features[near] - ib.features[frames][:, None, :], axis=-1)
+            ranks[b] = rankdata(dist, axis=1)
+        ra = ranks[a] - ranks[a].mean(axis=1, keepdims=True)
+        out[a] = {}
+        for b, rb in ranks.items():
+            rb = rb - rb.mean(axis=1, keepdims=True)
+            denom = np.sqrt((ra ** 2).sum(axis=1) * (rb ** 2).sum(axis=1))
+            rho = np.where(denom > 0, (ra * rb).sum(axis=1) / np.where(denom > 0, denom, 1), np.nan)
+            out[a][b] = float(np.nanmean(rho))
+    return out
