@@ -9,7 +9,7 @@ from typing import Any
 from stylemotion.datasets.bandai import load_bandai
 from stylemotion.datasets.base import Take, TakeSet
 from stylemotion.datasets.bvh_folder import load_bvh_folder
-from stylemotion.datasets.loading import ConversionSettings, check_positive
+from stylemotion.datasets.loading import DEFAULT_MAX_FRAMES, ConversionSettings, check_positive
 from stylemotion.datasets.retarget import check_retarget, retarget_takeset
 from stylemotion.io.errors import UserInputError
 
@@ -49,6 +49,10 @@ register_dataset("bandai")(load_bandai)
 register_dataset("bvh_folder")(load_bvh_folder)
 
 
+#: Most frames the synthetic generator makes in one data set (≈ 2.5 GB of float32 positions).
+MAX_SYNTHETIC_FRAMES = 10_000_000
+
+
 @register_dataset("synthetic")
 def load_synthetic(
     takes_per_pair: int = 4, seed: int = 0, fps: float = 30.0, duration_s: float = 8.0,
@@ -60,6 +64,16 @@ def load_synthetic(
     check_positive(takes_per_pair, "data.takes_per_pair", integer=True, allow_none=False)
     check_positive(fps, "data.fps", integer=False, allow_none=False)
     check_positive(duration_s, "data.duration_s", integer=False, allow_none=False)
+    from stylemotion.datasets.synthetic import CONTENTS, STYLES
+
+    pairs = len(contents if contents is not None else CONTENTS) * len(styles if styles is not None else STYLES)
+    frames = float(takes_per_pair) * pairs * float(duration_s) * float(fps)
+    if float(duration_s) * float(fps) > DEFAULT_MAX_FRAMES or frames > MAX_SYNTHETIC_FRAMES:
+        raise DatasetOptionError(
+            f"data.takes_per_pair={takes_per_pair}, data.duration_s={duration_s}, data.fps={fps}: "
+            f"{frames:,.0f} frames in all ({float(duration_s) * float(fps):,.0f} per take) is more than the synthetic "
+            f"generator makes ({MAX_SYNTHETIC_FRAMES:,} in all, {DEFAULT_MAX_FRAMES:,} per take); ask for fewer or "
+            f"shorter takes")
     generated = generate_takes(takes_per_pair=takes_per_pair, seed=seed, fps=fps, duration_s=duration_s,
                                styles=styles, contents=contents)
     takes = [Take(g.name, g.positions, g.fps, dict(g.labels), source=f"synthetic(seed={seed})")

@@ -238,3 +238,12 @@ def test_default_set_is_fast():
     generated = generate_takes()
     assert len(generated) == len(STYLES) * len(CONTENTS) * 4
     assert time.perf_counter() - start < 10.0
+
+
+@pytest.mark.parametrize("options", [{"duration_s": 1e9}, {"takes_per_pair": 10**7}, {"fps": 1e7}])
+def test_sizes_beyond_the_generator_are_refused_before_anything_is_generated(options) -> None:
+    """An absurd size from a config is one line naming the keys, never an allocation of terabytes."""
+    from stylemotion.datasets.registry import DatasetOptionError, load_dataset
+
+    with pytest.raises(DatasetOptionError, match="data.takes_per_pair=.*data.duration_s=.*more than the synthetic"):
+        load_dataset("synthetic", **options)
