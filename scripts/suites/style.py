@@ -41,24 +41,69 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--runs", type=Path, default=ROOT / "runs" / "benchmarks" / "style",
                         help="folder of the per-seed reproduction runs (reused and resumed)")
     parser.add_argument("--workers", type=int, default=2, help="training stages at once (the reproduction's workers)")
+    parser.add_argument("--primitives", nargs="+", default=None,
+                        help="stance primitives (default: the reproduction's, both walk stances)")
+    parser.add_argument("--sample-styles", type=int, default=None, metavar="K",
+                        help="train CVAEs for K styles only, a seeded choice (numpy default_rng(0)) fixed across seeds "
+                             "(default: every style, as the thesis)")
 
 
-def reproduce_seed(data: str, seed: int, out: Path, workers: int) -> dict[str, Any]:
-    """Run (or reuse) ``stylemotion-reproduce`` for ``seed`` into ``out``; returns its ``report.json``."""
+def compose_reproduce(overrides: list[str]):
+    """The ``reproduce`` config composed with ``overrides`` (Hydra's global config search left initialized)."""
     from hydra import compose, initialize_config_dir
     from hydra.core.global_hydra import GlobalHydra
 
     from stylemotion.cli.schemas import register_schemas_for
     from stylemotion.config import config_dir
-    from stylemotion.io.jsonfile import read_json_object
-    from stylemotion.training.reproduction import reproduce
 
     register_schemas_for("reproduce")
     GlobalHydra.instance().clear()
+    initialize_config_dir(config_dir(), version_base="1.3")
+    return compose("reproduce", overrides=overrides)
+
+
+def sample_styles(data: str, k: int | None) -> list[str] | None:
+    """``k`` of the data's non-neutral styles, a seeded choice (``default_rng(0)``, the same for every seed),
+    sorted; None (every style) when ``k`` is None or not smaller than their number."""
+    if k is None:
+        return None
+    import numpy as np
+    from omegaconf import OmegaConf
+
+    from stylemotion.datasets import build_dataset
+
+    cfg = compose_reproduce(DATA[data])
+    styles = [s for s in build_dataset(OmegaConf.to_container(cfg.data, resolve=True)).label_values("style")
+              if s != cfg.evaluation.neutral_style]
+    if k >= len(styles):
+        return None
+    return sorted(np.random.default_rng(0).choice(styles, k, replace=False).tolist())
+
+
+def setup_tag(primitives: list[str] | None, styles: list[str] | None) -> str:
+    """The run folder's name for a setup: ``full``, or the primitives and styles it was narrowed to."""
+    parts = [*(primitives or []), *(styles or [])]
+    return "_".join(parts) if parts else "full"
+
+
+def reproduce_seed(data: str, seed: int, out: Path, workers: int, primitives: list[str] | None = None,
+                   styles: list[str] | None = None) -> dict[str, Any]:
+    """Run (or reuse) ``stylemotion-reproduce`` for ``seed`` into ``out``; returns its ``report.json``."""
+    from hydra.core.global_hydra import GlobalHydra
+
+    from stylemotion.io.jsonfile import read_json_object
+    from stylemotion.training.reproduction import reproduce
+
     overrides = [*DATA[data], f"seed={seed}", f"out={out}", f"workers={workers}", "threads=1"]
-    with initialize_config_dir(config_dir(), version_base="1.3"):
-        cfg = compose("reproduce", overrides=overrides)
+    if primitives:
+        overrides.append(f"primitives=[{','.join(primitives)}]")
+    if styles:
+        overrides.append(f"styles=[{','.join(styles)}]")
+    cfg = compose_reproduce(overrides)
+    try:
         reproduce(cfg, say=lambda line: print(f"[seed {seed}] {line}", flush=True))
+    finally:
+        GlobalHydra.instance().clear()
     return read_json_object(out / "report" / "report.json", "the reproduction's report", "rerun the suite")
 
 
@@ -71,7 +116,8 @@ def seed_figures(report: dict[str, Any]) -> dict[str, Any]:
         rows, columns = len(diag["rows"]), len(diag["columns"])  # names whose row / column minimum is their own
         out["primitives"][primitive] = {
             "models": len(models), "diagonal_rows": rows, "diagonal_columns": columns,
-            "recognition": {m: d["share"] for m, d in report["style_recognition"]["per_model_detail"][primitive].items()},
+            "recognition": {m: d["share"]
+                            for m, d in report["style_recognition"]["per_model_detail"][primitive].items()},
             "classifier": {k: report["style_recognition"]["per_primitive"][primitive][k]
                            for k in ("heldout_accuracy", "heldout_clips", "train_clips")},
             "variance_ratio": {m: {k: v[k] for k in RATIOS} for m, v in report["variance_ratio"][primitive].items()
@@ -89,10 +135,11 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
     import torch
 
     torch.set_num_threads(1)
+    styles = sample_styles(args.data, args.sample_styles)
     per_seed = {}
     for seed in seeds:
-        out = args.runs / args.data / f"seed{seed}"
-        report = reproduce_seed(args.data, seed, out, args.workers)
+        out = args.runs / args.data / setup_tag(args.primitives, styles) / f"seed{seed}"
+        report = reproduce_seed(args.data, seed, out, args.workers, args.primitives, styles)
         per_seed[str(seed)] = seed_figures(report) | {"run": str(out.relative_to(ROOT) if out.is_relative_to(ROOT)
                                                                    else out)}
     first = next(iter(per_seed.values()))
@@ -120,7 +167,11 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
     }
     split = first["split"] or {}
     clips = {p: first["primitives"][p]["classifier"] for p in primitives}
-    return {"data": args.data,
+    subsample = {"primitives": args.primitives, "styles": styles,
+                 "how": None if not (args.primitives or styles) else
+                 "CVAE styles: a seeded choice (numpy default_rng(0)) of the data's styles, the same for every seed"
+                 if styles else "primitives narrowed on the command line"}
+    return {"data": args.data, "subsample": subsample,
             "splits": {"data": {"kind": "by take", **split, "group_by": ["content", "style"]},
                        "seed_varies": "model initialization, batches and samples (not the data or its split)",
                        "classifier": "fitted on the train-split clips of every style; its accuracy and the samples' "
@@ -140,6 +191,12 @@ def render(record: dict[str, Any]) -> dict[str, str]:
     label = ("**Synthetic data: a smoke test of the pipeline, not evidence that the method works.** "
              if r["data"] == "synthetic" else "")
     split = r["splits"]["data"]
+    sub = r.get("subsample") or {}
+    if sub.get("styles") or sub.get("primitives"):
+        label += ("**Subsampled to fit the machine** (not the thesis' full setup: a smaller Table 5.1 is easier): "
+                  + (f"CVAE styles {', '.join(sub['styles'])} (a seeded choice, the same for every seed)"
+                     if sub.get("styles") else "every style")
+                  + (f", primitives {', '.join(sub['primitives'])}" if sub.get("primitives") else "") + ". ")
     split_line = (f"Data split by take (seed {split.get('seed')}, val {split.get('val_fraction')}, test "
                   f"{split.get('test_fraction')}); the seed varies training and sampling only. The classifier is "
                   "fitted on train-split clips and scored on val+test clips; Table 5.1 compares samples with the "
@@ -157,7 +214,8 @@ def render(record: dict[str, Any]) -> dict[str, str]:
                 + md_table(["primitive", "models", "Table 5.1 rows on diagonal, mean ± sd (min–max)",
                             "columns on diagonal", "classifier held-out accuracy"], rows)
                 + f"\n\nRecognition of the styled models' samples (mean over styles): "
-                  f"{fmt_spread(o['recognition_mean_styled'], 3)} (min–max {fmt_range(o['recognition_mean_styled'], 3)}). "
+                  f"{fmt_spread(o['recognition_mean_styled'], 3)} "
+                  f"(min–max {fmt_range(o['recognition_mean_styled'], 3)}). "
                 + split_line + " " + prov)
 
     blocks = {"headline": headline}
@@ -177,7 +235,8 @@ def render(record: dict[str, Any]) -> dict[str, str]:
     blocks["variation"] = (f"{label}Variation of the samples relative to the neutral training clips "
                            f"(pose_SD, V_SD, step_SD of the model / of the training data; mean ± sd (min–max) over "
                            f"{seeds} seeds, {r['data']}).\n\n"
-                           + md_table(["primitive", "model", "pose_SD ratio", "V_SD ratio", "step_SD ratio"], ratio_rows)
+                           + md_table(["primitive", "model", "pose_SD ratio", "V_SD ratio", "step_SD ratio"],
+                                      ratio_rows)
                            + f"\n\n{split_line} {prov}")
     blocks["variation_vs_style"] = (f"{label}Variation of each model relative to all real clips of its own style "
                                     f"(pose_across_SD, V_SD, step_SD and diversity of the samples / of the real "

@@ -20,7 +20,8 @@ from stylemotion.training.fit import objective
 TINY = ["experiment=smoke", "data=synthetic", "data.takes_per_pair=3", "data.duration_s=4.0",
         "data.styles=[normal,elderly]", "data.contents=[walk,run]"]
 #: A finished run whose val and test scores differ (so reading the wrong split shows).
-METRICS = {"best_score": 0.5, "val": {"val/mpjpe": 0.5, "val/style": 7.0}, "test": {"test/mpjpe": 0.1, "test/style": 1.0}}
+METRICS = {"best_score": 0.5, "val": {"val/mpjpe": 0.5, "val/style": 7.0},
+           "test": {"test/mpjpe": 0.1, "test/style": 1.0}}
 
 
 def cfg(**values):
