@@ -228,7 +228,7 @@ def search(data: Mapping[str, Any], query: str, out: str | os.PathLike, *, featu
         say(f"no match: no path through the k-NN graph of the {q.positions.shape[0]} query frames; raise k (now {k})")
     elif len(records) < top and k < database.num_frames:
         say(f"{len(records)} of top={top} found: the {k} nearest frames of each query frame hold few paths; a larger k "
-            f"finds more (on Bandai, 3 s queries: 1.9 matches per query at k=256, 6.8 at k=1024)")
+            f"finds more (benchmarks/search.md)")
     say(f"{len(records)} match(es) written to {out}" + (f"; best: {records[0]['take']} "
                                                          f"{records[0]['start']}-{records[0]['end']} cost "
                                                          f"{records[0]['cost']:.4g}" if records else ""))

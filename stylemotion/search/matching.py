@@ -35,11 +35,12 @@ import numpy as np
 from stylemotion.search.index import FrameIndex
 from stylemotion.search.lng import THESIS_STEPS, Match, Normalization, Step, lng_match
 
-#: Neighbours per query frame by default: Table 2.1's larger k. With the thesis' steps a match needs every query
-#: frame's neighbours to hold the next frame of the same take; measured on Bandai's normal walks and runs (145
-#: takes, 21,791 frames), 1 s queries with their own take excluded found a match for 1 of 20 queries at k = 16, 13
-#: of 20 at k = 64 and 20 of 20 (ten matches each) at k = 256, in ~10 ms per query.
-DEFAULT_K = 256
+#: Neighbours per query frame by default. With the thesis' steps a match needs every query frame's neighbours to
+#: hold the next frame of the same take, so a small k often finds no path. Chosen among 64, 256 and 1024 on 1 s
+#: queries cut from Bandai's validation takes against its train takes (the smallest k for which the LNG returns
+#: exact DTW's best segment for 95 % of the queries; else the highest share) by
+#: ``python scripts/benchmarks.py run search``; the test figures are in benchmarks/search.md.
+DEFAULT_K = 1024
 #: Keys of a match's record in ``matches.json``, in order.
 MATCH_KEYS = ("take", "content", "style", "start", "end", "cost")
 

@@ -20,7 +20,7 @@ from stylemotion.datasets.loading import ConversionSettings, load_canonical_posi
 from stylemotion.datasets.registry import load_dataset
 from stylemotion.io.outputs import OutputExistsError
 from stylemotion.io.sources import FileSource
-from stylemotion.search import MATCH_KEYS
+from stylemotion.search import DEFAULT_K, MATCH_KEYS
 from stylemotion.search.command import SearchInputError, search
 
 SYNTHETIC = {"name": "synthetic", "takes_per_pair": 1, "seed": 0, "fps": 30, "duration_s": 8.0}
@@ -52,7 +52,7 @@ def test_a_take_query_finds_its_own_frames_first_and_exports_them(tmp_path: Path
     assert matches[0] == {"take": TAKE, "content": "walk", "style": "normal", "start": 30, "end": 90, "cost": 0.0}
     assert [m["cost"] for m in matches] == sorted(m["cost"] for m in matches)
     report = json.loads((out / "search.json").read_text())
-    assert report["matches"] == matches and report["k"] == 256 and report["features"] == "E15"
+    assert report["matches"] == matches and report["k"] == DEFAULT_K and report["features"] == "E15"
     assert report["query"] == {"value": f"{TAKE}:30-90", "kind": "take", "take": TAKE, "start": 30, "end": 90,
                                "fps": 30.0}
     assert report["excluded_takes"] == [] and report["provenance"]["command"].startswith("stylemotion-search query=")
