@@ -10,7 +10,8 @@ root translation, of the time warping, …):
   ``1/N ‖f_k(Y) − f_k(W⁻¹ V′V′ᵀ W Y)‖²`` with the eigenfunctions ``V′`` recomputed from ``W Y`` at every
   evaluation, by L-BFGS-B (scipy); initialized, as the thesis does, with whichever of FPCA and
   normalized FPCA has the smaller joint-space error. The best weights seen are kept, so SFPCA is never
-  worse than that start on its training data.
+  worse than that start on its training data. Given a ``selection_error`` (the same error on validation
+  clips), the weights kept are whichever of the start and that best-on-train has the lower validation error.
 """
 
 from __future__ import annotations
@@ -84,6 +85,7 @@ def zscore_weights(vectors: np.ndarray, groups: np.ndarray) -> np.ndarray:
 
 def fit_reduction(vectors: np.ndarray, groups: np.ndarray, latent_dim: int, method: str,
                   joint_error: Callable[[np.ndarray], float] | None = None, max_iterations: int = 30,
+                  selection_error: Callable[[Callable[[np.ndarray], np.ndarray]], float] | None = None,
                   ) -> tuple[FunctionalPCA, dict[str, float]]:
     """Fit one of :data:`METHODS`.
 
@@ -95,6 +97,9 @@ def fit_reduction(vectors: np.ndarray, groups: np.ndarray, latent_dim: int, meth
         joint_error: reconstructed vectors ``(n, D)`` → mean squared joint-space error (m²) against the
             clips' own functional data (needed by ``sfpca``).
         max_iterations: L-BFGS-B iterations of ``sfpca``.
+        selection_error: ``sfpca`` only: given a fitted PCA's ``reconstruct ∘ project`` (``(m, D)`` → ``(m, D)``),
+            its mean squared joint-space error on validation clips; chooses between the start and the optimized
+            weights (never consulted by the optimizer).
 
     Returns:
         The PCA and a record (``joint_mse_start``/``joint_mse`` for ``sfpca``, evaluations).
@@ -139,6 +144,16 @@ def fit_reduction(vectors: np.ndarray, groups: np.ndarray, latent_dim: int, meth
     weights = weights / weights.max()  # the error does not depend on the overall scale
     record = {"joint_mse_fpca": starts["fpca"][1], "joint_mse_normalized": starts["normalized"][1],
               "start": start_name, "joint_mse": best["f"], "evaluations": best["evaluations"]}
+    if selection_error is not None:
+        def rebuild(w: np.ndarray):
+            model = pca(vectors, group_scale(w, groups), latent_dim)
+            return lambda v: model.reconstruct(model.project(v))
+
+        val = {"start": float(selection_error(rebuild(start))), "optimized": float(selection_error(rebuild(weights)))}
+        record.update(val_mse_start=val["start"], val_mse_optimized=val["optimized"],
+                      kept="optimized" if val["optimized"] <= val["start"] else "start")
+        if record["kept"] == "start":
+            weights, record["joint_mse"] = start / start.max(), start_error
     log.info("SFPCA: joint MSE %.3g (start %s %.3g) after %d evaluations", best["f"], start_name, start_error,
              best["evaluations"])
     return pca(vectors, group_scale(weights, groups), latent_dim), record

@@ -383,9 +383,11 @@ def joint_error_function(data: FunctionalData, basis: SplineBasis, vectors: np.n
     return error
 
 
-def fit_primitive(clips: Sequence[Clip], settings: FitSettings | None = None, meta: dict[str, Any] | None = None
-                  ) -> MorphableModel:
-    """Fit a :class:`MorphableModel` to the clips of one primitive (see the module doc)."""
+def fit_primitive(clips: Sequence[Clip], settings: FitSettings | None = None, meta: dict[str, Any] | None = None,
+                  validation: Sequence[Clip] | None = None) -> MorphableModel:
+    """Fit a :class:`MorphableModel` to the clips of one primitive (see the module doc). With ``validation``
+    clips (never the reported ones), SFPCA keeps whichever of its start and its optimized weights reconstructs
+    them better (:func:`~stylemotion.morphable.fpca.fit_reduction`'s ``selection_error``)."""
     settings = settings or FitSettings()
     if len(clips) <= settings.latent_dim:
         raise ValueError(f"{len(clips)} clips cannot give {settings.latent_dim} latent dimensions (PCA of n clips has "
@@ -400,8 +402,17 @@ def fit_primitive(clips: Sequence[Clip], settings: FitSettings | None = None, me
     basis = SplineBasis(k)
     vectors, groups, names = coefficient_vectors(data, basis)
     error = joint_error_function(data, basis, vectors)
+    select = None
+    if validation and settings.reduction == "sfpca":
+        from stylemotion.morphable.heldout import encode_heldout, heldout_error_function
+
+        held = encode_heldout(data, clips[data.reference], basis, validation)
+        val_error = heldout_error_function(data, basis, held)
+
+        def select(rebuild) -> float:
+            return val_error(rebuild(held.vectors))
     reduction, record = fit_reduction(vectors, groups, settings.latent_dim, settings.reduction, error,
-                                      settings.sfpca_iterations)
+                                      settings.sfpca_iterations, selection_error=select)
     latent = reduction.project(vectors)
     gmm = fit_gmm(latent, settings.max_components, settings.seed)
     first = clips[0]
@@ -416,6 +427,21 @@ def fit_primitive(clips: Sequence[Clip], settings: FitSettings | None = None, me
              first.primitive, len(clips), data.length, k, settings.latent_dim, gmm.num_components,
              fit_record["joint_rmse_m"])
     return MorphableModel(data.channels, basis, reduction, gmm, data.length, data.fps, meta)
+
+
+def refit_mixture(model: MorphableModel, clips: Sequence[Clip], seed: int) -> MorphableModel:
+    """``model`` with its mixture refitted (EM seeded by ``seed``) on the codes of its training ``clips``; the
+    functional data and the reduction are deterministic, so this is what another fitting seed changes. No tree."""
+    settings = FitSettings(**model.meta["settings"])
+    data = functional_data(clips, settings.representation)
+    if data.length != model.length:
+        raise ValueError(f"clips give a {data.length}-frame timeline, the model has {model.length}: not its clips")
+    vectors, _, _ = coefficient_vectors(data, model.basis)
+    gmm = fit_gmm(model.reduction.project(vectors), settings.max_components, int(seed))
+    meta = json.loads(json.dumps(model.meta))
+    meta["settings"]["seed"] = int(seed)
+    meta["fit"]["gmm_components"] = gmm.num_components
+    return MorphableModel(model.channels, model.basis, model.reduction, gmm, model.length, model.fps, meta)
 
 
 def reconstruction_error(model: MorphableModel, clips: Sequence[Clip]) -> float:

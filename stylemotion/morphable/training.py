@@ -3,7 +3,8 @@
 The run folder (``runs/train/morphable_graph/<run id>/``, or each sweep job's) receives
 ``config_resolved.yaml``, ``run.json`` (version, commit, command), ``model.npz`` (the model and its
 space-partitioning tree, :meth:`~stylemotion.morphable.model.MorphableModel.save`), ``metrics.json``
-(the fit record, held-out reconstruction error, seconds) and ``samples/samples.gif`` +
+(the fit record, val and test reconstruction error, seconds; SFPCA's kept weights chosen on val, a sweep
+minimizes the val error) and ``samples/samples.gif`` +
 ``samples/last_frames.png`` (16 samples, as the VAE runs show them). A folder that already holds a
 ``model.npz`` is refused unless ``force=true``. Clips come from the ``clips`` DataModule (the take-based
 split of ``data``), the primitive and style from ``primitive`` and ``style``.
@@ -75,7 +76,8 @@ def run(cfg: DictConfig) -> dict[str, Any]:
         settings = FitSettings(**model_cfg)
         model = fit_primitive(datamodule.clips["train"], settings,
                               meta={"data": str(cfg.data.get("name")), "seed": int(cfg.seed),
-                                    "variant": variant_name(None if turn is None else str(turn))})
+                                    "variant": variant_name(None if turn is None else str(turn))},
+                              validation=datamodule.clips.get("val") or None)
     except (TypeError, ValueError) as err:  # a bad model.* value, too few clips, a mixture that cannot be fitted
         raise ConfigError(f"experiment=morphable_graph, {action}_{primitive}: {err}") from err
     if tree_cfg.get("samples", 0):
@@ -149,6 +151,7 @@ def _write_samples(model: MorphableModel, folder: Path, seed: int, data_name: st
 
 
 def objective(metrics: dict[str, Any]) -> float | None:
-    """What a sweep minimizes: the held-out joint RMSE (test, else val)."""
-    value = metrics.get("test/joint_rmse_m", metrics.get("val/joint_rmse_m"))
+    """What a sweep minimizes: the validation joint RMSE (``val/joint_rmse_m``); None without val clips. Never the
+    test figure: a sweep that optimized it would report a test error chosen on test."""
+    value = metrics.get("val/joint_rmse_m")
     return None if value is None or not np.isfinite(value) else float(value)

@@ -1,0 +1,204 @@
+"""Held-out measures of a Morphable Graph primitive: reductions scored on clips they were not fitted to, keyframe
+solves over a set of targets, and the choice of a setting on validation data.
+
+* :func:`compare_reductions` — FPCA / normalized FPCA / SFPCA fitted on the training clips' coefficient vectors,
+  their joint-space RMSE on the training clips and on held-out parts (``val``, ``test``). Held-out clips are
+  aligned by DTW to the training reference clip (the one :func:`~stylemotion.morphable.model.functional_data`
+  aligns the training clips to), encoded with the training channels and the same spline basis, projected and
+  reconstructed. SFPCA's weights are optimized on the training clips only; with a ``val`` part, the weights kept
+  are those of {its start (FPCA or normalized), L-BFGS-B's best on train} with the lower validation error
+  (:func:`~stylemotion.morphable.fpca.fit_reduction`'s ``selection_error``), so no figure on ``test`` chose them.
+* :func:`keyframe_errors` — the hand (any joint) driven to position targets at the primitive's last frame by
+  :func:`~stylemotion.morphable.synthesis.solve_constraints`: error after MAP per target, failures (missed by more
+  than the solver's tolerance) counted.
+* :func:`choose_constraint_scale` — ``σ_c`` candidates scored on validation targets (median error after MAP, ties
+  by fewer failures), the choice reported on test targets.
+"""
+
+from __future__ import annotations
+
+import warnings
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from stylemotion.morphable.bspline import SplineBasis
+from stylemotion.morphable.fpca import METHODS, FunctionalPCA, fit_reduction
+from stylemotion.morphable.model import (
+    FunctionalData,
+    MorphableModel,
+    choose_coefficients,
+    coefficient_vectors,
+    functional_data,
+    joint_error_function,
+)
+from stylemotion.morphable.warping import dtw_warp, resample
+from stylemotion.primitives.segmentation import Clip
+from stylemotion.representation import JOINT_DIMS
+from stylemotion.skeleton import CANONICAL_JOINTS
+
+__all__ = ["HeldOutVectors", "encode_heldout", "heldout_error_function", "compare_reductions", "keyframe_errors",
+           "choose_constraint_scale", "user_motion_clips"]
+
+
+@dataclass
+class HeldOutVectors:
+    """Coefficient vectors of clips not used to fit, on the training data's canonical timeline.
+
+    Attributes:
+        vectors: ``(n, (C + 1) K)`` spline coefficients (spatial channels, then the warp), as
+            :func:`~stylemotion.morphable.model.coefficient_vectors`.
+        playback_fps: ``(n,)`` rate at which the canonical timeline lasts each clip's duration.
+    """
+
+    vectors: np.ndarray
+    playback_fps: np.ndarray
+
+
+def encode_heldout(data: FunctionalData, reference: Clip, basis: SplineBasis, clips: Sequence[Clip]) -> HeldOutVectors:
+    """``clips`` aligned by DTW to ``reference`` (the training reference clip, ``train[data.reference]``) and
+    encoded with the training channels and ``basis``."""
+    if not clips:
+        raise ValueError("no held-out clip to encode")
+    ref = reference.frames[:, JOINT_DIMS]
+    vectors, rates = [], []
+    for clip in clips:
+        warp = dtw_warp(ref, clip.frames[:, JOINT_DIMS])
+        aligned = resample(data.channels.encode(clip.positions, clip.frames), warp)
+        vectors.append(np.concatenate([basis.fit(aligned), basis.fit(warp[:, None])], axis=0).ravel())
+        rates.append((data.length - 1) * data.fps / warp[-1])
+    return HeldOutVectors(np.stack(vectors), np.asarray(rates, dtype=np.float64))
+
+
+def heldout_error_function(data: FunctionalData, basis: SplineBasis, held: HeldOutVectors):
+    """Reconstructed held-out vectors ``(n, D)`` → mean squared joint distance (m²) to FK of their own spline
+    fit (eq. 3.8's error on clips the reduction never saw)."""
+    size = data.channels.size + 1
+
+    def positions(vecs: np.ndarray) -> np.ndarray:
+        spatial = vecs.reshape(len(vecs), size, basis.num_coefficients)[:, :-1]
+        return data.channels.positions(basis.evaluate(spatial, data.length), held.playback_fps)
+
+    target = positions(held.vectors)
+
+    def error(reconstructed: np.ndarray) -> float:
+        return float(((positions(reconstructed) - target) ** 2).sum(-1).mean())
+
+    return error
+
+
+def _selection(vectors: np.ndarray, error):
+    """SFPCA's ``selection_error``: a PCA's ``reconstruct ∘ project`` → its error on ``vectors``."""
+    def select(rebuild) -> float:
+        return error(rebuild(vectors))
+
+    return select
+
+
+def compare_reductions(train: Sequence[Clip], heldout: Mapping[str, Sequence[Clip]], dims: Sequence[int],
+                       methods: Sequence[str] = METHODS, num_coefficients: int | None = None,
+                       rmse_cutoff_m: float = 0.01, iterations: int = 30, representation: str = "quaternion",
+                       given: Mapping[str, FunctionalPCA] | None = None) -> dict[str, Any]:
+    """Joint-space RMSE (m) of each reduction at each latent size, on ``train`` and on each held-out part.
+
+    Args:
+        train: clips the reductions are fitted to.
+        heldout: ``{part: clips}`` (e.g. ``val``, ``test``); a ``val`` part also chooses SFPCA's kept weights.
+        dims: latent sizes (each below ``len(train)``).
+        num_coefficients: ``K``, or None for the 1 cm cut-off on the training clips.
+        iterations: SFPCA's L-BFGS-B iterations.
+        given: ``{method: reduction}`` already fitted to the same training clips with the same ``K`` (e.g. a
+            model's), scored at its own latent size instead of being fitted again.
+
+    Returns:
+        ``{"K", "timeline", "clips": {part: n}, "rows": [{"dims", "method", "rmse_m": {part: m}, "sfpca": record}]}``.
+    """
+    data = functional_data(train, representation)
+    k = num_coefficients or choose_coefficients(data, rmse_cutoff_m)[0]
+    basis = SplineBasis(k)
+    vectors, groups, _ = coefficient_vectors(data, basis)
+    errors = {"train": joint_error_function(data, basis, vectors)}
+    held = {part: encode_heldout(data, train[data.reference], basis, clips) for part, clips in heldout.items() if clips}
+    for part, h in held.items():
+        errors[part] = heldout_error_function(data, basis, h)
+    rows = []
+    for d in dims:
+        for method in methods:
+            select = _selection(held["val"].vectors, errors["val"]) if method == "sfpca" and "val" in held else None
+            pca, record = fit_reduction(vectors, groups, d, method, errors["train"], iterations,
+                                        selection_error=select)
+            rmse = {"train": float(np.sqrt(errors["train"](pca.reconstruct(pca.project(vectors)))))}
+            for part, h in held.items():
+                rmse[part] = float(np.sqrt(errors[part](pca.reconstruct(pca.project(h.vectors)))))
+            rows.append({"dims": int(d), "method": method, "rmse_m": rmse,
+                         **({"sfpca": record} if method == "sfpca" else {})})
+    for method, pca in (given or {}).items():
+        rmse = {"train": float(np.sqrt(errors["train"](pca.reconstruct(pca.project(vectors)))))}
+        for part, h in held.items():
+            rmse[part] = float(np.sqrt(errors[part](pca.reconstruct(pca.project(h.vectors)))))
+        rows.append({"dims": pca.latent_dim, "method": method, "rmse_m": rmse, "given": True})
+    return {"K": k, "timeline": data.length, "clips": {"train": len(train), **{p: len(c) for p, c in heldout.items()}},
+            "rows": rows}
+
+
+def keyframe_errors(model: MorphableModel, targets: np.ndarray, joint: str, constraint_scale_m: float,
+                    **settings: Any) -> dict[str, Any]:
+    """``joint`` driven to each of ``targets`` ``(n, 3)`` (m, the primitive's own frame) at the last frame.
+
+    Returns ``{"errors_m": [n], "tree_errors_m": [n], "failures": k}``: the error after the MAP solve and of the
+    tree's candidate per target; a failure is a target still missed by more than the solver's ``tolerance_m``.
+    """
+    from stylemotion.morphable.constraints import KeyframeConstraint
+    from stylemotion.morphable.synthesis import MapSettings, UnreachableConstraintWarning, solve_constraints
+
+    map_settings = MapSettings(constraint_scale_m=constraint_scale_m, **settings)
+    errors, tree, failures = [], [], 0
+    for target in np.asarray(targets, dtype=np.float64):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", UnreachableConstraintWarning)
+            result = solve_constraints(model, [KeyframeConstraint("position", target, joint=joint)], map_settings)
+        errors.append(float(result.errors_m[0]))
+        tree.append(float(result.start_errors_m[0]))
+        failures += bool(result.unreachable)
+    return {"errors_m": errors, "tree_errors_m": tree, "failures": failures}
+
+
+def choose_constraint_scale(model: MorphableModel, val_targets: np.ndarray, candidates: Sequence[float],
+                            joint: str) -> dict[str, Any]:
+    """The ``σ_c`` of ``candidates`` (m) with the lowest median error after MAP on ``val_targets`` (ties: fewer
+    failures, then the larger σ_c). Returns ``{"candidates": [{"scale_m", "median_m", "p95_m", "max_m",
+    "failures"}], "chosen_m"}``."""
+    if joint not in CANONICAL_JOINTS:
+        raise ValueError(f"unknown joint {joint!r}; one of {CANONICAL_JOINTS}")
+    scores = []
+    for scale in candidates:
+        found = keyframe_errors(model, val_targets, joint, float(scale))
+        e = np.asarray(found["errors_m"])
+        scores.append({"scale_m": float(scale), "median_m": float(np.median(e)), "p95_m": float(np.percentile(e, 95)),
+                       "max_m": float(e.max()), "failures": int(found["failures"])})
+    best = min(scores, key=lambda s: (round(s["median_m"], 5), s["failures"], -s["scale_m"]))
+    return {"candidates": scores, "chosen_m": best["scale_m"]}
+
+
+def user_motion_clips(files: Sequence[str | Path], takeset, action: str = "walk", content: str = "walk",
+                      fps: float = 30.0) -> list[Clip]:
+    """Primitive clips of recordings from other captures: each BVH file read by the one reader of user motion
+    (:mod:`stylemotion.datasets.user_motion`: any skeleton a joint map names, resampled to ``fps``), put on
+    ``takeset``'s skeleton (:func:`~stylemotion.datasets.user_motion.on_run_skeleton`) and segmented as the data
+    sets are (:func:`~stylemotion.primitives.segmentation.segment_takes`), labelled ``content``, style ``other``."""
+    from stylemotion.datasets.base import Take
+    from stylemotion.datasets.loading import ConversionSettings
+    from stylemotion.datasets.user_motion import convert_example, on_run_skeleton, parse_example
+    from stylemotion.io.outputs import safe_name
+    from stylemotion.primitives.segmentation import segment_takes
+
+    takes = []
+    for i, file in enumerate(files):
+        example = on_run_skeleton(convert_example(parse_example(str(file)), ConversionSettings(fps=fps)), takeset)
+        name = safe_name(f"other_{content}_{Path(file).stem}")
+        takes.append(Take(name, np.asarray(example.positions, np.float32), fps,
+                          {"content": content, "style": "other", "take": f"{i:03d}"}, str(file)))
+    return segment_takes(takes).select(action)
