@@ -200,14 +200,34 @@ def annotate_distances(distances: ClassDistances, tau: float, keyframes: bool, m
     bar = np.stack(bars)
     best = np.argmin(bar, axis=0)
     minimum = bar[best, np.arange(bar.shape[1])]
-    labels = np.where(np.isfinite(minimum), best, -1)
-    if min_run > 1:
-        edges = np.flatnonzero(np.diff(np.r_[-2, labels, -2]) != 0)
-        for a, b in zip(edges[:-1], edges[1:]):
-            if labels[a] >= 0 and b - a < min_run:
-                labels[a:b] = -1
-                minimum[a:b] = np.inf
+    labels = drop_short_runs(np.where(np.isfinite(minimum), best, -1), min_run)
+    minimum = np.where(labels >= 0, minimum, np.inf)
     return Annotation(labels, minimum, distances.classes, tuple(sorted(hits, key=lambda h: (h.start, h.label))))
+
+
+def drop_short_runs(labels: np.ndarray, min_run: int) -> np.ndarray:
+    """``labels`` ``(frames,)`` int (-1 = none) with every labelled run shorter than ``min_run`` frames set to
+    -1 (a copy; ``min_run`` ≤ 1 changes nothing)."""
+    labels = np.array(labels, dtype=np.int64)
+    if min_run > 1 and labels.size:
+        edges = np.flatnonzero(np.diff(np.r_[-2, labels, -2]) != 0)
+        lengths = np.diff(edges)
+        short = (lengths < min_run) & (labels[edges[:-1]] >= 0)
+        labels[np.repeat(short, lengths)] = -1
+    return labels
+
+
+def with_keyframes(distances: ClassDistances, document: np.ndarray, templates: Sequence[MotionTemplate],
+                   count: int, tolerance: float) -> ClassDistances:
+    """``distances`` with the key-frame preselection redone for ``count`` key frames at ``tolerance`` (the
+    subsequence DTW is reused; ``document``: the ``(frames, features)`` features it was computed from)."""
+    by_label = {t.label: t for t in templates}
+    keeps = []
+    for p, label in enumerate(distances.classes):
+        template = by_label[label]
+        matches = keyframe_matches(template, np.asarray(document), keyframe_columns(template, count), tolerance)
+        keeps.append(keys_in_order(matches, distances.start[p]) & np.isfinite(distances.delta[p]))
+    return ClassDistances(distances.classes, distances.delta, distances.start, np.stack(keeps))
 
 
 def annotate_features(document: np.ndarray, templates: Sequence[MotionTemplate],
@@ -220,27 +240,27 @@ def annotate_features(document: np.ndarray, templates: Sequence[MotionTemplate],
 
 def segments(labels: Sequence[str] | np.ndarray) -> list[tuple[int, int, str]]:
     """Maximal runs of one non-empty label: ``(start, end_exclusive, label)``."""
-    out: list[tuple[int, int, str]] = []
-    labels = list(labels)
-    i = 0
-    while i < len(labels):
-        j = i
-        while j < len(labels) and labels[j] == labels[i]:
-            j += 1
-        if labels[i] not in ("", None):
-            out.append((i, j, str(labels[i])))
-        i = j
-    return out
+    names = ["" if lab is None else str(lab) for lab in labels]
+    if not names:
+        return []
+    values, codes = np.unique(np.asarray(names, dtype=object), return_inverse=True)
+    edges = np.flatnonzero(np.diff(np.r_[-1, codes, -1]) != 0)
+    return [(int(a), int(b), str(values[codes[a]])) for a, b in zip(edges[:-1], edges[1:]) if values[codes[a]] != ""]
 
 
 def frame_scores(truth: Sequence[str], predicted: Sequence[str]) -> dict[str, float | int]:
-    """Frame-level precision/recall/F (P1, R1, F1) of labelled frames; ``""`` means unlabelled."""
+    """Frame-level precision/recall/F (P1, R1, F1) of labelled frames; ``""`` means unlabelled. Also the
+    counts behind the misses: ``unlabelled1`` (frames of a class left without a label), ``confused1`` (given
+    another class) and ``spurious1`` (frames of no class, e.g. blends, given one)."""
     t, p = np.asarray(list(truth), dtype=object), np.asarray(list(predicted), dtype=object)
     if t.shape != p.shape:
         raise ValueError(f"truth has {t.shape[0]} frames, prediction {p.shape[0]}")
     relevant, retrieved = t != "", p != ""
     correct = int((relevant & retrieved & (t == p)).sum())
-    return _prf(correct, int(retrieved.sum()), correct, int(relevant.sum()), "1")
+    return {**_prf(correct, int(retrieved.sum()), correct, int(relevant.sum()), "1"),
+            "unlabelled1": int((relevant & ~retrieved).sum()),
+            "confused1": int((relevant & retrieved & (t != p)).sum()),
+            "spurious1": int((~relevant & retrieved).sum())}
 
 
 def segment_scores(truth: Sequence[str], predicted: Sequence[str]) -> dict[str, float | int]:

@@ -65,3 +65,38 @@ def random_document(pool: Sequence[tuple[str, str, str, np.ndarray]], fps: float
         chosen.append(take)
         total += take[3].shape[0] + blend_frames
     return join_takes(chosen, fps, blend_frames)
+
+
+def partition_documents(pool: Sequence[tuple[str, str, str, np.ndarray]], fps: float, seconds: float,
+                        rng: np.random.Generator, blend_frames: int = 8) -> list[Document]:
+    """Every take of ``pool`` exactly once, in an order drawn with ``rng``, cut into documents of at least
+    ``seconds`` (takes are added until a document is that long; a shorter remainder joins the last one)."""
+    if not pool:
+        raise ValueError("no takes to build documents from")
+    order = rng.permutation(len(pool))
+    groups: list[list[tuple[str, str, str, np.ndarray]]] = [[]]
+    total = 0
+    for i in order:
+        if total >= seconds * fps:
+            groups.append([])
+            total = 0
+        groups[-1].append(pool[int(i)])
+        total += pool[int(i)][3].shape[0] + blend_frames
+    if len(groups) > 1 and total < seconds * fps:
+        groups[-2].extend(groups.pop())
+    return [join_takes(group, fps, blend_frames) for group in groups]
+
+
+def part_scores(document: Document, predicted: Sequence[str]) -> list[dict[str, float | str]]:
+    """Per take of ``document``: ``recall`` (fraction of its frames labelled with its content) and
+    ``precision`` (fraction of its labelled frames that carry its content; 0 where none is labelled)."""
+    labels = np.asarray(list(predicted), dtype=object)
+    if labels.shape[0] != len(document.labels):
+        raise ValueError(f"{labels.shape[0]} predicted labels for a document of {len(document.labels)} frames")
+    out = []
+    for name, content, _style, start, end in document.parts:
+        span = labels[start:end]
+        right, labelled = int((span == content).sum()), int((span != "").sum())
+        out.append({"take": name, "content": content, "recall": right / max(end - start, 1),
+                    "precision": right / labelled if labelled else 0.0})
+    return out

@@ -61,11 +61,27 @@ def choose_examples(takes: Sequence[Take], per_class: int, seed: int) -> dict[st
     return chosen
 
 
+def tensor_examples(takes: Sequence[Take], content: str, repetitions: int | None = None,
+                    seed: int = 0) -> dict[str, list[np.ndarray]]:
+    """Style → ``(frames, 21, 3)`` motions of ``content`` for its tensor: the same number of takes per style,
+    ``repetitions`` (None or more than every style has: as many as every style has), drawn with ``seed`` from
+    the takes sorted by name (kept in name order); styles with under two takes are left out."""
+    rng = np.random.default_rng(seed)
+    by_style: dict[str, list[Take]] = {}
+    for take in sorted(takes, key=lambda t: t.name):
+        if take.content == content:
+            by_style.setdefault(take.style, []).append(take)
+    usable = {s: v for s, v in sorted(by_style.items()) if len(v) >= 2}
+    counts = [len(v) for v in usable.values()] or [0]
+    r = min(min(counts), repetitions or min(counts))
+    return {s: [v[i].positions for i in sorted(rng.permutation(len(v))[:r])] for s, v in usable.items()}
+
+
 def learn_model(train: Sequence[Take], fps: float, per_class: int = 9, seed: int = 0,
                 tensor_repetitions: int | None = None, tensors: bool = True) -> AnnotationModel:
-    """Templates from ``per_class`` train takes of each content; tensors from all train takes of a content
-    (``tensor_repetitions`` per style, None: as many as every style has; styles with under two train takes
-    are left out, and a class with under two such styles gets no tensor).
+    """Templates from ``per_class`` train takes of each content; tensors from the train takes of a content
+    (``tensor_repetitions`` per style, None: as many as every style has, drawn with ``seed``:
+    :func:`tensor_examples`; a class with under two styles of two takes gets no tensor).
 
     Raises:
         TemplateInputError: a content with fewer than two train takes (naming it and the count).
@@ -79,15 +95,9 @@ def learn_model(train: Sequence[Take], fps: float, per_class: int = 9, seed: int
     skipped: dict[str, str] = {}
     if tensors:
         for content in examples:
-            by_style: dict[str, list[np.ndarray]] = {}
-            for take in sorted(train, key=lambda t: t.name):
-                if take.content == content:
-                    by_style.setdefault(take.style, []).append(take.positions)
-            usable = {s: v for s, v in by_style.items() if len(v) >= 2}
-            counts = [len(v) for v in usable.values()] or [0]
-            r = min(min(counts), tensor_repetitions or min(counts))
+            usable = tensor_examples(train, content, tensor_repetitions, seed)
             try:
-                learned[content] = build_tensor(content, usable, fps, r)[0]
+                learned[content] = build_tensor(content, usable, fps)[0]
             except TensorInputError as exc:
                 skipped[content] = str(exc)
     record = {"examples": {c: [t.name for t in takes] for c, takes in examples.items()},

@@ -18,18 +18,20 @@ untruncated tensor returns example ``(s, r)``.
 Parametrization (eq. 3.6): a segment is warped to the reference length and ``(β, γ)`` minimize the squared
 distance of all its coordinates to ``M``, each weight in ``[−0.2, 1.2]``. ``M`` is linear in ``β`` for fixed
 ``γ`` and vice versa, so the problem is solved by alternating bounded linear least squares
-(``scipy.optimize.lsq_linear``) from uniform weights. The segment's style is the largest ``β``.
+(``scipy.optimize.lsq_linear``, on the QR triangle of each block's matrix) from uniform weights. The
+segment's style is the largest ``β``.
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 import tensorly as tl
 from scipy.optimize import lsq_linear
-from tensorly.tenalg import mode_dot, multi_mode_dot
+from tensorly.tenalg import multi_mode_dot
 
 from stylemotion.annotate.templates import resample_length, warp_to
 from stylemotion.io.errors import UserInputError
@@ -87,6 +89,18 @@ class MotionTensor:
         """``Ψ = Φ ×_1 U_1 ×_2 U_2``: ``(63, frames, rank_style, rank_rep)``."""
         return multi_mode_dot(self.core, [self.factors[0], self.factors[1]], modes=[0, 1])
 
+    @cached_property
+    def examples(self) -> np.ndarray:
+        """``Ψ ×_3 U_3 ×_4 U_4``: ``(63 · frames, styles, repetitions)``, the examples as the (possibly
+        truncated) tensor reproduces them; eq. 3.5 is ``Σ_s Σ_r β_s γ_r`` of its columns."""
+        e = multi_mode_dot(self.psi, [self.factors[2], self.factors[3]], modes=[2, 3])
+        return np.ascontiguousarray(e.reshape(-1, e.shape[2], e.shape[3]))
+
+    def reconstruction(self) -> np.ndarray:
+        """``(styles, repetitions, frames, 63)``: every example as this tensor synthesizes it (unit weights)."""
+        e = self.examples.reshape(DOF, self.frames, len(self.styles), self.repetitions)
+        return np.ascontiguousarray(np.transpose(e, (2, 3, 1, 0)))
+
     def synthesize(self, style_weights: np.ndarray, repetition_weights: np.ndarray) -> np.ndarray:
         """Eq. 3.5: ``(frames, 63)`` coordinates for ``β`` ``(styles,)`` and ``γ`` ``(repetitions,)``."""
         b = np.asarray(style_weights, dtype=np.float64) @ self.factors[2]
@@ -109,22 +123,23 @@ class MotionTensor:
     def parametrize(self, positions: np.ndarray, rounds: int = 10) -> Parametrization:
         """Eq. 3.6 for a segment ``(n ≥ 2, 21, 3)``: the bounded weights and the style they pick."""
         target = self.warp(positions).T.reshape(-1)                  # (63 · frames,)
-        psi = self.psi
+        e = self.examples                                            # (63 · frames, styles, repetitions)
         s, r = len(self.styles), self.repetitions
         beta, gamma = np.full(s, 1.0 / s), np.full(r, 1.0 / r)
-        u3, u4 = self.factors[2], self.factors[3]
         for _ in range(rounds):
-            g = gamma @ u4
-            a = mode_dot(psi, g, mode=3)                             # (63, frames, rank_s)
-            a = (a.reshape(-1, a.shape[-1]) @ u3.T)                  # columns: one per style
-            beta = lsq_linear(a, target, bounds=WEIGHT_BOUNDS, method="bvls").x
-            b = beta @ u3
-            a = mode_dot(psi, b, mode=2)
-            a = a.reshape(-1, a.shape[-1]) @ u4.T
-            gamma = lsq_linear(a, target, bounds=WEIGHT_BOUNDS, method="bvls").x
-        fitted = self.synthesize(beta, gamma)
-        residual = float(np.sqrt(np.mean((fitted.T.reshape(-1) - target) ** 2)))
+            beta = _bounded_least_squares(e @ gamma, target)          # columns: one per style
+            gamma = _bounded_least_squares(np.einsum("dsr,s->dr", e, beta), target)
+        fitted = np.einsum("dsr,s,r->d", e, beta, gamma)
+        residual = float(np.sqrt(np.mean((fitted - target) ** 2)))
         return Parametrization(self.styles[int(np.argmax(beta))], beta, gamma, residual)
+
+
+def _bounded_least_squares(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``argmin ‖a x − b‖`` with every ``x`` in :data:`WEIGHT_BOUNDS` (BVLS), ``a`` ``(n, k)`` tall: solved on
+    the ``k × k`` triangle of ``a``'s QR factorization, whose objective differs from the full one by a
+    constant."""
+    q, tri = np.linalg.qr(a)
+    return lsq_linear(tri, q.T @ b, bounds=WEIGHT_BOUNDS, method="bvls").x
 
 
 @dataclass(frozen=True)
@@ -138,12 +153,19 @@ class Parametrization:
     rms: float
 
 
+def left_singular_vectors(x: np.ndarray) -> np.ndarray:
+    """``U`` ``(d, min(d, n))`` of the thin SVD of ``x`` ``(d, n)``. A wide ``x`` (an unfolding: ``n`` up to
+    ``63 · frames · repetitions``) is first reduced by the QR factorization ``xᵀ = Q R`` (``x = Rᵀ Qᵀ``
+    has the left singular vectors of ``Rᵀ``), so no ``(d, n)`` right factor is formed."""
+    x = np.asarray(x, dtype=np.float64)
+    if x.shape[1] > x.shape[0]:
+        x = np.linalg.qr(x.T, mode="r").T
+    return np.linalg.svd(x, full_matrices=False)[0]
+
+
 def n_mode_svd(tensor: np.ndarray) -> tuple[np.ndarray, tuple[np.ndarray, ...]]:
     """Full N-mode SVD (eq. 3.3): ``(Φ, (U_1, ..., U_N))`` with ``U_n`` ``(d_n, min(d_n, ∏ others))``."""
-    factors = []
-    for mode in range(tensor.ndim):
-        u, _, _ = np.linalg.svd(tl.unfold(tensor, mode), full_matrices=False)
-        factors.append(u)
+    factors = [left_singular_vectors(tl.unfold(tensor, mode)) for mode in range(tensor.ndim)]
     core = multi_mode_dot(tensor, factors, modes=list(range(tensor.ndim)), transpose=True)
     return core, tuple(factors)
 
