@@ -77,12 +77,12 @@ def marker_frames(markers: np.ndarray, joints: Sequence[str]) -> tuple[np.ndarra
 
 def to_local(points: np.ndarray, rotation: np.ndarray, origin: np.ndarray) -> np.ndarray:
     """World points ``(..., j, 3)`` → marker-frame coordinates with ``rotation (..., 3, 3)``, ``origin (..., 3)``."""
-    return np.einsum("...ji,...kj->...ki", rotation, points - origin[..., None, :])
+    return np.matmul(points - origin[..., None, :], rotation)  # local_k = Rᵀ (p_k − o), as rows: (p − o) R
 
 
 def to_world(points: np.ndarray, rotation: np.ndarray, origin: np.ndarray) -> np.ndarray:
     """Inverse of :func:`to_local`."""
-    return np.einsum("...ij,...kj->...ki", rotation, points) + origin[..., None, :]
+    return np.matmul(points, np.swapaxes(rotation, -1, -2)) + origin[..., None, :]
 
 
 @dataclass

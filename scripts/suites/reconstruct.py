@@ -1,0 +1,422 @@
+"""Suite ``reconstruct``: full poses from six markers (Krüger §2.5.2), motion from keyframes (dynamic motion graphs,
+§4.3) and motion completion / texturing (§4.2) on Bandai, chosen on validation takes and reported on test takes.
+
+Per seed: Bandai is split by take (``TakeSet.split(seed, 0.1, 0.1)``, grouped by content and style: the split
+every training command uses); the train takes are the motion database, val takes choose, test takes report.
+Queries are drawn at random (seeded) from the val / test takes, markers get seeded uniform noise.
+
+* **Markers** (hands, feet, head, hips, ± ``--noise-mm``): ``k`` chosen on the val queries (mean per-joint error,
+  pooled over the two Bandai databases), reported on the test queries against (a) every train take — the query's
+  content and style (and actors: Bandai shares one skeleton) are in it, easier than the thesis — (b) the train takes
+  without the query's content (the thesis' "CMU without collection 86") and (c) other captures: the three walks of
+  ``other-skeletons`` read by :func:`stylemotion.reconstruct.read_markers` (what ``stylemotion-reconstruct
+  markers=<file.bvh>`` reads) against every train take. The nearest-neighbour baseline beside each.
+* **Keyframes**: keys every 1, 2, 4 s of walk, turn and run takes; ``duration_weight`` chosen on val key pairs
+  (:func:`~stylemotion.reconstruct.benchmark.pairs_score`: mean |duration error|, a failed pair counting its whole
+  spacing), joined / attempted and duration error reported on test key pairs. No cleaning (it does not change
+  which pairs join or their duration).
+* **Completion and texturing** (fixed settings, nothing tuned): the upper body of test takes from their legs, and
+  6-frame key splines textured, against the nearest-neighbour baseline and the spline.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import time
+from collections import Counter
+from typing import Any
+
+import numpy as np
+from suites.common import DATA_ROOT, fmt, fmt_spread, md_table, provenance_line, spread, take_split_record
+
+DESCRIPTION = ("reconstruction from six markers (same-actor database, without the query's content, other captures), "
+               "keyframes (dynamic motion graphs) and completion/texturing on Bandai; k and duration_weight chosen "
+               "on val takes")
+VAL_FRACTION, TEST_FRACTION = 0.1, 0.1
+OTHER_CAPTURES = ("walk_21joint_60fps.bvh", "female-walk_21joint_60fps.bvh", "xia_neutral_01_000_31joint_120fps.bvh")
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--contents", nargs="+", default=["walk", "run", "wave-both-hands", "raise-up-both-hands"],
+                        help="marker queries' contents")
+    parser.add_argument("--takes", type=int, default=2, help="marker queries per content, in val and in test")
+    parser.add_argument("--k", type=int, nargs="+", default=[32, 64, 128], help="candidates of k")
+    parser.add_argument("--noise-mm", type=float, default=1.0, help="uniform marker noise, ± mm (thesis: 1)")
+    parser.add_argument("--key-contents", nargs="+", default=["walk", "walk-turn-left", "walk-turn-right", "run"])
+    parser.add_argument("--key-takes", type=int, default=2, help="keyframe test takes per content")
+    parser.add_argument("--key-val-takes", type=int, default=1, help="keyframe val takes per content")
+    parser.add_argument("--spacings", type=float, nargs="+", default=[1.0, 2.0, 4.0],
+                        help="seconds between test keys")
+    parser.add_argument("--val-spacings", type=float, nargs="+", default=[2.0, 4.0],
+                        help="seconds between val keys (where the timing term matters; 1 s pairs barely differ)")
+    parser.add_argument("--duration-weights", type=float, nargs="+", default=[0.0, 1.0, 3.0, 10.0, 30.0],
+                        help="candidates of DynamicMotionGraph.duration_weight (0: the thesis, no timing term)")
+    parser.add_argument("--texture-takes", type=int, default=1,
+                        help="completion/texturing: test takes per content (walk, wave-both-hands); 0 skips it")
+    parser.add_argument("--texture-frames", type=int, default=60, help="first frames of each texturing query")
+    parser.add_argument("--texture-every", type=int, default=6, help="texturing: frames between keys")
+
+
+# -- run ----------------------------------------------------------------------------------------------------
+
+
+def _markers_section(args, bandai, parts, rng) -> dict[str, Any]:
+    from stylemotion.reconstruct import DEFAULT_MARKERS, SparseReconstructor, read_markers
+    from stylemotion.reconstruct.benchmark import (
+        choose_queries,
+        choose_setting,
+        database_of,
+        error_figures,
+        joint_error_table,
+        noisy_markers,
+    )
+
+    fps = bandai.fps
+    queries = {part: choose_queries(parts[part], args.contents, args.takes, rng) for part in ("val", "test")}
+    markers = {part: [noisy_markers(q.positions, DEFAULT_MARKERS, args.noise_mm, rng, fps) for q in qs]
+               for part, qs in queries.items()}
+    # databases: "same" = every train take; "without" = per content, the train takes without it
+    recs = {("same", None): SparseReconstructor(database_of("bandai-train", parts["train"], fps), DEFAULT_MARKERS,
+                                                "E15", max(args.k))}
+    for content in args.contents:
+        takes = [t for t in parts["train"] if t.content != content]
+        recs[("without", content)] = SparseReconstructor(database_of(f"bandai-train-without-{content}", takes, fps),
+                                                         DEFAULT_MARKERS, "E15", max(args.k))
+
+    def errors(db: str, part: str, k: int, baseline: bool = False) -> list[tuple[str, np.ndarray]]:
+        out = []
+        for query, m in zip(queries[part], markers[part]):
+            rec = recs[(db, None if db == "same" else query.content)]
+            rec.k = k  # k is read per query; the index does not depend on it
+            pose = rec.nearest_neighbour(m) if baseline else rec.reconstruct(m).positions
+            out.append((query.content, joint_error_table(pose, query.positions)))
+        return out
+
+    val_scores = {}
+    for k in args.k:
+        tables = [e for db in ("same", "without") for _, e in errors(db, "val", k)]
+        val_scores[k] = error_figures(tables)["mean_cm"]
+    k = choose_setting(val_scores)
+    test: dict[str, Any] = {}
+    for db in ("same", "without"):
+        for name, baseline in (("ours", False), ("nn", True)):
+            found = errors(db, "test", k, baseline)
+            test[f"{db}/{name}"] = error_figures([e for _, e in found])
+            test[f"{db}/{name}"]["by_content"] = {c: error_figures([e for cc, e in found if cc == c])["mean_cm"]
+                                                  for c in args.contents}
+    # other captures: the reader of a user's file, against every train take
+    same = recs[("same", None)]
+    same.k = k
+    other: dict[str, list] = {"ours": [], "nn": []}
+    other_takes = []
+    for name in OTHER_CAPTURES:
+        tracks = read_markers(DATA_ROOT / "other-skeletons" / name, fps=fps)
+        m = tracks.positions + rng.uniform(-1.0, 1.0, tracks.positions.shape) * args.noise_mm / 1000.0
+        other["ours"].append(joint_error_table(same.reconstruct(m).positions, tracks.full))
+        other["nn"].append(joint_error_table(same.nearest_neighbour(m), tracks.full))
+        other_takes.append({"file": name, "frames": int(tracks.num_frames),
+                            "mean_cm": float(other["ours"][-1].mean()), "nn_mean_cm": float(other["nn"][-1].mean())})
+    test["other/ours"], test["other/nn"] = error_figures(other["ours"]), error_figures(other["nn"])
+    test["other/files"] = other_takes
+    return {"val_queries": [q.name for q in queries["val"]], "test_queries": [q.name for q in queries["test"]],
+            "val_frames": int(sum(q.num_frames for q in queries["val"])),
+            "test_frames": int(sum(q.num_frames for q in queries["test"])),
+            "database_frames": {"same": same.database.num_frames,
+                                **{f"without {c}": recs[("without", c)].database.num_frames for c in args.contents}},
+            "val_mean_cm_by_k": {str(c): s for c, s in val_scores.items()}, "k": int(k), "test": test}
+
+
+def _keyframes_section(args, bandai, parts, rng) -> dict[str, Any]:
+    from stylemotion.reconstruct.benchmark import (
+        choose_queries,
+        choose_setting,
+        database_of,
+        key_pairs,
+        pair_outcome,
+        pairs_figures,
+        pairs_score,
+    )
+    from stylemotion.reconstruct.keyframes import DynamicMotionGraph
+
+    fps = bandai.fps
+    graph = DynamicMotionGraph(database_of("bandai-train", parts["train"], fps), clean=False)
+    pairs = {}
+    for part, count, spacings in (("val", args.key_val_takes, args.val_spacings),
+                                  ("test", args.key_takes, args.spacings)):
+        takes = choose_queries(parts[part], args.key_contents, count, rng)
+        pairs[part] = {"takes": [t.name for t in takes],
+                       "pairs": [(t.content, p) for t in takes for s in spacings
+                                 for p in key_pairs(t.positions, fps, s)]}
+    val_scores, val_figures = {}, {}
+    for weight in args.duration_weights:
+        graph.duration_weight = float(weight)
+        outcomes = [pair_outcome(graph, a, b) for _, (a, b) in pairs["val"]["pairs"]]
+        val_scores[weight], val_figures[str(weight)] = pairs_score(outcomes), pairs_figures(outcomes)
+    weight = choose_setting(val_scores)
+    graph.duration_weight = float(weight)
+    outcomes = [(c, pair_outcome(graph, a, b)) for c, (a, b) in pairs["test"]["pairs"]]
+    by_spacing = {f"{s:g}": pairs_figures([o for _, o in outcomes if abs(o["spacing_s"] - s) < 1e-6])
+                  for s in args.spacings}
+    by_content = {c: pairs_figures([o for cc, o in outcomes if cc == c]) for c in args.key_contents}
+    return {"val_takes": pairs["val"]["takes"], "test_takes": pairs["test"]["takes"],
+            "val_score_s_by_weight": {str(w): s for w, s in val_scores.items()}, "val_figures": val_figures,
+            "duration_weight": float(weight), "test": {"all": pairs_figures([o for _, o in outcomes]),
+                                                        "by_spacing": by_spacing, "by_content": by_content},
+            "settings": graph.settings()}
+
+
+def _texture_section(args, bandai, parts, rng) -> dict[str, Any]:
+    from stylemotion.reconstruct.benchmark import choose_queries, database_of, joint_error_table
+    from stylemotion.reconstruct.texture import LEG_JOINTS, MotionTexturer, key_spline
+    from stylemotion.skeleton import CANONICAL_JOINTS, JOINT_INDEX
+    from stylemotion.synthesis.quality import skating
+
+    fps = bandai.fps
+    database = database_of("bandai-train", parts["train"], fps)
+    upper = [JOINT_INDEX[j] for j in CANONICAL_JOINTS if j not in LEG_JOINTS]
+    takes = choose_queries(parts["test"], ["walk", "wave-both-hands"], args.texture_takes, rng)
+    complete, texture = MotionTexturer(database, "complete"), MotionTexturer(database, "texture")
+    rows = []
+    for take in takes:
+        truth = np.asarray(take.positions[: args.texture_frames], np.float64)
+        legs = truth.copy()
+        legs[:, upper] = np.nan
+        done = complete.apply(legs)
+        spline = key_spline(truth, args.texture_every)
+        textured = texture.apply(spline).positions
+        rows.append({"take": take.name, "content": take.content, "frames": len(truth),
+                     "complete_upper_cm": float(joint_error_table(done.positions, truth)[:, upper].mean()),
+                     "nn_upper_cm": float(joint_error_table(done.nearest_neighbour, truth)[:, upper].mean()),
+                     "spline_cm": float(joint_error_table(spline, truth).mean()),
+                     "textured_cm": float(joint_error_table(textured, truth).mean()),
+                     "skating": {"take": skating(truth, fps)[0], "spline": skating(spline, fps)[0],
+                                 "textured": skating(textured, fps)[0]}})
+    frames = np.array([r["frames"] for r in rows], float)
+
+    def avg(key: str, sub: str | None = None) -> float:
+        values = [r[key][sub] if sub else r[key] for r in rows]
+        return float(np.average(values, weights=frames))
+
+    return {"takes": [r["take"] for r in rows], "rows": rows,
+            "complete_upper_cm": avg("complete_upper_cm"), "nn_upper_cm": avg("nn_upper_cm"),
+            "spline_cm": avg("spline_cm"), "textured_cm": avg("textured_cm"),
+            "skating_take": avg("skating", "take"), "skating_spline": avg("skating", "spline"),
+            "skating_textured": avg("skating", "textured")}
+
+
+def _mode(choices: list[Any], scores: list[dict]) -> Any:
+    """The most frequent per-seed choice; a tie goes to the lowest validation score averaged over seeds."""
+    counts = Counter(choices)
+    top = max(counts.values())
+    tied = [c for c in counts if counts[c] == top]
+    return min(tied, key=lambda c: float(np.mean([s[str(c)] for s in scores])))
+
+
+def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
+    os.environ.setdefault("OMP_NUM_THREADS", "1")
+    try:
+        import torch
+
+        torch.set_num_threads(1)
+    except ImportError:  # pragma: no cover - torch is a dependency, but the suite does not need it
+        pass
+    from stylemotion.datasets.registry import load_dataset
+
+    bandai = load_dataset("bandai", root=str(DATA_ROOT / "bandai-namco-motion-2" / "data.zip"))
+    per_seed, splits = [], []
+    for seed in seeds:
+        parts = bandai.split(seed, VAL_FRACTION, TEST_FRACTION, group_by=("content", "style"))
+        splits.append(take_split_record(parts, seed, VAL_FRACTION, TEST_FRACTION))
+        rng = np.random.default_rng(seed)
+        record: dict[str, Any] = {"seed": seed, "seconds": {}}
+        sections = [("markers", _markers_section), ("keyframes", _keyframes_section)]
+        if args.texture_takes > 0:
+            sections.append(("texture", _texture_section))
+        for name, section in sections:
+            started = time.perf_counter()
+            record[name] = section(args, bandai, parts, rng)
+            record["seconds"][name] = round(time.perf_counter() - started, 1)
+        per_seed.append(record)
+        print(f"seed {seed}: k {record['markers']['k']}, duration_weight {record['keyframes']['duration_weight']}",
+              flush=True)
+    k = _mode([r["markers"]["k"] for r in per_seed], [r["markers"]["val_mean_cm_by_k"] for r in per_seed])
+    weight = _mode([r["keyframes"]["duration_weight"] for r in per_seed],
+                   [r["keyframes"]["val_score_s_by_weight"] for r in per_seed])
+    return {"splits": {"kind": "by take, one split per seed", "choose": "val", "report": "test",
+                       "database": "train", "per_seed": splits,
+                       "other_captures": "the three walks of other-skeletons (other actors, studios, skeletons), "
+                                         "never in any split; database = the seed's train takes"},
+            "settings": {"contents": args.contents, "takes_per_content": args.takes, "k_candidates": args.k,
+                         "noise_mm": args.noise_mm, "key_contents": args.key_contents, "key_takes": args.key_takes,
+                         "key_val_takes": args.key_val_takes,
+                         "spacings_s": args.spacings, "val_spacings_s": args.val_spacings,
+                         "duration_weight_candidates": args.duration_weights,
+                         "texture_takes": args.texture_takes, "texture_frames": args.texture_frames,
+                         "texture_every": args.texture_every, "features": "E15", "markers": "DEFAULT_MARKERS"},
+            "choice": {"k": int(k), "duration_weight": float(weight),
+                       "rule": "each seed chooses on its val takes; the default is the most frequent choice"},
+            "per_seed": per_seed}
+
+
+# -- render -------------------------------------------------------------------------------------------------
+
+
+def _over_seeds(r: dict, path: list[str]) -> dict[str, Any]:
+    values = []
+    for seed in r["per_seed"]:
+        node: Any = seed
+        for key in path:
+            node = node.get(key) if isinstance(node, dict) else None
+        values.append(node)
+    return spread(values)
+
+
+def _cm(r: dict, path: list[str], digits: int = 2) -> str:
+    return fmt_spread(_over_seeds(r, path), digits)
+
+
+def _s(r: dict, path: list[str]) -> str:
+    return fmt_spread(_over_seeds(r, path), 3)
+
+
+def _pct(r: dict, path: list[str]) -> str:
+    s = _over_seeds(r, path)
+    return fmt_spread({**s, **{k: s[k] * 100 for k in ("mean", "sd") if k in s}}, 1) + " %"
+
+
+def _conditions() -> list[tuple[str, str, str]]:
+    return [("same", "Bandai train takes (the query's content, style and skeleton in it)", "easier: same actors, "
+             "content and style in the database"),
+            ("without", "Bandai train takes without the query's content (CMU⁻ analogue)", "like the thesis' CMU⁻"),
+            ("other", "other captures: 3 other-skeleton walks vs Bandai train takes", "harder: other actors, "
+             "skeletons and joint conventions")]
+
+
+def render(record: dict[str, Any]) -> dict[str, str]:
+    r = record["results"]
+    s = r["settings"]
+    prov = provenance_line(record)
+    n = len(r["per_seed"])
+
+    # headline
+    rows = []
+    for key, what, note in _conditions():
+        rows.append([f"6 markers → 21 joints: {what}", note,
+                     f"{_cm(r, ['markers', 'test', f'{key}/ours', 'mean_cm'])} cm",
+                     f"{_cm(r, ['markers', 'test', f'{key}/ours', 'p95_cm'])} / "
+                     f"{_cm(r, ['markers', 'test', f'{key}/ours', 'max_cm'])} cm",
+                     f"{_cm(r, ['markers', 'test', f'{key}/nn', 'mean_cm'])} cm"])
+    for spacing in s["spacings_s"]:
+        sp = f"{spacing:g}"
+        joined = sum(x["keyframes"]["test"]["by_spacing"][sp]["joined"] for x in r["per_seed"])
+        tried = sum(x["keyframes"]["test"]["by_spacing"][sp]["attempted"] for x in r["per_seed"])
+        rows.append([f"keyframes {sp} s apart (walk, turns, run): joined / attempted {joined} / {tried}",
+                     "query takes not in the database",
+                     f"|duration error| {_s(r, ['keyframes', 'test', 'by_spacing', sp, 'duration_error_s', 'mean'])} s",
+                     f"{_s(r, ['keyframes', 'test', 'by_spacing', sp, 'duration_error_s', 'p95'])} / "
+                     f"{_s(r, ['keyframes', 'test', 'by_spacing', sp, 'duration_error_s', 'max'])} s", "—"])
+    if all("texture" in x for x in r["per_seed"]):
+        rows.append(["completion: upper body from hips and legs", "same actors, content and style in the database",
+                     f"{_cm(r, ['texture', 'complete_upper_cm'])} cm", "—",
+                     f"{_cm(r, ['texture', 'nn_upper_cm'])} cm"])
+    headline = (md_table(["task (test takes)", "like for like", "ours: mean ± sd over seeds",
+                          "p95 / max", "nearest-neighbour baseline"], rows)
+                + f"\n\nk = {r['choice']['k']} and duration_weight = {fmt(r['choice']['duration_weight'], 0)} chosen "
+                  f"on val takes ({n} seeds: split, query takes and marker noise); errors per joint and frame, "
+                  f"markers ± {fmt(s['noise_mm'], 1)} mm. {prov}")
+
+    # markers: per database, per content
+    mrows = []
+    for key, what, note in _conditions():
+        for name, label in (("ours", "ours (local linear model)"), ("nn", "nearest neighbour")):
+            base = ["markers", "test", f"{key}/{name}"]
+            first = [what, note] if name == "ours" else ["", ""]
+            row = [*first, label, _cm(r, base + ["mean_cm"]), _cm(r, base + ["p95_cm"]), _cm(r, base + ["max_cm"])]
+            for c in s["contents"]:
+                row.append("" if key == "other" else _cm(r, base + ["by_content", c]))
+            mrows.append(row)
+    seed0 = r["per_seed"][0]["markers"]
+    markers = (md_table(["database", "like for like", "method", "mean cm", "p95 cm", "max cm", *s["contents"]], mrows)
+               + f"\n\nTest queries per seed: {s['takes_per_content']} takes of each of {', '.join(s['contents'])} "
+                 f"drawn at random from the seed's test takes ({seed0['test_frames']:,} frames for seed "
+                 f"{r['per_seed'][0]['seed']}); other captures: {', '.join(OTHER_CAPTURES)} "
+                 f"({sum(f['frames'] for f in seed0['test']['other/files'])} frames at 30 fps). Database frames "
+                 f"(seed {r['per_seed'][0]['seed']}): {seed0['database_frames']['same']:,} (all train takes). "
+                 f"Values: mean ± sd over {n} seeds of the pooled figure. {prov}")
+
+    # per joint (same and without, ours)
+    from stylemotion.skeleton import CANONICAL_JOINTS
+
+    jrows = []
+    for joint in CANONICAL_JOINTS:
+        row = [joint]
+        for key in ("same", "without", "other"):
+            base = ["markers", "test", f"{key}/ours", "per_joint", joint]
+            row += [_cm(r, base + ["mean_cm"]), fmt(_over_seeds(r, base + ["p95_cm"]).get("mean"), 1),
+                    fmt(_over_seeds(r, base + ["max_cm"]).get("max"), 1)]
+        jrows.append(row)
+    per_joint = (md_table(["joint", "same: mean cm", "p95", "max", "without content: mean cm", "p95", "max",
+                           "other captures: mean cm", "p95", "max"], jrows)
+                 + f"\n\nMean ± sd over {n} seeds; p95: mean over seeds; max: over all seeds. {prov}")
+
+    # choices
+    krows = [[str(k)] + [fmt(x["markers"]["val_mean_cm_by_k"][str(k)], 3) for x in r["per_seed"]]
+             for k in s["k_candidates"]]
+    krows.append(["chosen"] + [str(x["markers"]["k"]) for x in r["per_seed"]])
+    wrows = []
+    for w in s["duration_weight_candidates"]:
+        row = [fmt(w, 0)]
+        for x in r["per_seed"]:
+            f = x["keyframes"]["val_figures"][str(w)]
+            row.append(f"{fmt(x['keyframes']['val_score_s_by_weight'][str(w)], 3)} ({f['joined']}/{f['attempted']})")
+        wrows.append(row)
+    wrows.append(["chosen"] + [fmt(x["keyframes"]["duration_weight"], 0) for x in r["per_seed"]])
+    seeds_cols = [f"seed {x['seed']}" for x in r["per_seed"]]
+    choice = ("Validation mean per-joint error (cm) of each k (E15, both Bandai databases pooled):\n\n"
+              + md_table(["k", *seeds_cols], krows)
+              + "\n\nValidation score of each duration_weight (s: mean |duration error|, a failed pair counting its "
+                "whole spacing; joined / attempted val pairs):\n\n" + md_table(["duration_weight", *seeds_cols], wrows)
+              + f"\n\nDefaults (most frequent choice over seeds): k = {r['choice']['k']}, duration_weight = "
+                f"{fmt(r['choice']['duration_weight'], 0)}. {prov}")
+
+    # keyframes
+    krow = []
+    for spacing in s["spacings_s"]:
+        sp = f"{spacing:g}"
+        base = ["keyframes", "test", "by_spacing", sp]
+        joined = sum(x["keyframes"]["test"]["by_spacing"][sp]["joined"] for x in r["per_seed"])
+        tried = sum(x["keyframes"]["test"]["by_spacing"][sp]["attempted"] for x in r["per_seed"])
+        krow.append([f"{sp} s", f"{joined} / {tried}", _cm(r, base + ["failed"]),
+                     _s(r, base + ["duration_error_s", "mean"]), _s(r, base + ["duration_error_s", "p95"]),
+                     _s(r, base + ["duration_error_s", "max"]), _cm(r, base + ["key_error_cm"])])
+    crow = []
+    for c in s["key_contents"]:
+        joined = sum(x["keyframes"]["test"]["by_content"][c]["joined"] for x in r["per_seed"])
+        tried = sum(x["keyframes"]["test"]["by_content"][c]["attempted"] for x in r["per_seed"])
+        crow.append([c, f"{joined} / {tried}", _s(r, ["keyframes", "test", "by_content", c, "duration_error_s",
+                                                        "mean"])])
+    keyframes = (md_table(["spacing", "joined / attempted (all seeds)", "failed per seed", "|duration error| s",
+                           "p95 s", "max s", "key error cm"], krow)
+                 + "\n\n" + md_table(["content", "joined / attempted", "|duration error| s"], crow)
+                 + f"\n\nTest key pairs: {s['key_takes']} takes of each of {', '.join(s['key_contents'])} per seed, "
+                   f"drawn from the seed's test takes, keys every {', '.join(f'{x:g}' for x in s['spacings_s'])} s "
+                   f"from 0.2 s; duration_weight = the seed's val choice; database = the seed's train takes. "
+                   f"Duration error: frames of the joined path before retiming against the keys' time difference; "
+                   f"key error: the path's end frames against the keys (its nearest database poses). Mean ± sd over "
+                   f"{n} seeds. {prov}")
+    blocks = {"headline": headline, "markers": markers, "per_joint": per_joint, "choice": choice,
+              "keyframes": keyframes}
+    if all("texture" in x for x in r["per_seed"]):
+        trows = [["completion: upper body, cm per joint", _cm(r, ["texture", "complete_upper_cm"]),
+                  _cm(r, ["texture", "nn_upper_cm"])],
+                 [f"texturing keys every {s['texture_every']} frames, cm per joint",
+                  _cm(r, ["texture", "textured_cm"]), f"spline alone {_cm(r, ['texture', 'spline_cm'])}"],
+                 ["foot skating (share of contact frames): textured / spline / take",
+                  _pct(r, ['texture', 'skating_textured']),
+                  f"{_pct(r, ['texture', 'skating_spline'])} / {_pct(r, ['texture', 'skating_take'])}"]]
+        blocks["texture"] = (md_table(["", "ours", "baseline"], trows)
+                             + f"\n\nTest takes per seed: {s['texture_takes']} of each of walk and wave-both-hands, "
+                               f"first {s['texture_frames']} frames; database = the seed's train takes; fixed "
+                               f"settings (nothing tuned). Mean ± sd over {n} seeds. {prov}")
+    return blocks
