@@ -45,10 +45,14 @@ def test_keys_of_a_database_take_are_met_closely(split, graph):
     assert result.key_frames == [0, 30, 60, 90, 120] and len(result.positions) == 121
     mid_key_errors = [result.settings["intermediate_first_key_error_cm"]]
     mid_key_errors += [p["intermediate_key_error_cm"] for p in result.pairs]
-    assert np.mean(mid_key_errors) < 1.0  # the take's own frames are in the database (measured 0.26)
-    truth = take.positions[15:15 + 121]
-    assert _cm(result.positions, truth) < 2.5  # measured 1.56 cm per joint against the take itself
-    assert all(abs(p["duration_error_s"]) <= 0.1 for p in result.pairs)
+    truth = np.asarray(take.positions[15:15 + 121], dtype=np.float64)
+    # References from the take itself, not from this result: the take's own frames are in the database, so a key is
+    # met closer than half a frame of the take's motion (a neighbouring frame would be that far), and the whole
+    # result is closer to the take than the take is to itself one frame later.
+    one_frame = _cm(truth[1:], truth[:-1])
+    assert np.mean(mid_key_errors) < 0.5 * one_frame, (mid_key_errors, one_frame)
+    assert _cm(result.positions, truth) < _cm(np.asarray(take.positions[16:16 + 121]), truth)
+    assert all(abs(p["duration_error_s"]) <= 1.0 / FPS + 1e-9 for p in result.pairs)  # within a frame
 
 
 def test_held_out_keys_are_joined_exactly_and_cleaned(split, graph):
@@ -59,6 +63,12 @@ def test_held_out_keys_are_joined_exactly_and_cleaned(split, graph):
         np.testing.assert_allclose(result.positions[frame], key.pose, atol=1e-9)
     assert result.key_frames == [0, 60, 120, 180]
     assert all(p["iterations"] <= graph.max_iterations and p["connections"] >= 1 for p in result.pairs)
+    # reference: the motion the keys alone give (linear interpolation between them) is farther from the take
+    truth = np.asarray(take.positions[15:15 + len(result.positions)], dtype=np.float64)
+    linear = np.concatenate([(1 - w) * truth[a] + w * truth[b] for a, b in zip(result.key_frames[:-1],
+                                                                                 result.key_frames[1:])
+                             for w in [np.linspace(0.0, 1.0, b - a + 1)[:-1, None, None]]] + [truth[-1:]])
+    assert _cm(result.positions, truth) < _cm(linear, truth)
     # cleaning: less foot skating than the joined segments (measured 0.23 → 0.11), no frame-to-frame jump
     assert skating(result.positions, FPS)[0] < skating(result.intermediate, FPS)[0]
     assert np.linalg.norm(np.diff(result.positions, axis=0), axis=-1).max() < 0.3

@@ -102,14 +102,23 @@ def test_bad_settings_and_inputs_name_the_value(split, reconstructor):
 
 @pytest.mark.realdata
 def test_bandai_walk_from_six_markers(tmp_path):
+    """Regression on a fixed slice of Bandai (walks of two styles, split seed 0): the tolerance is set from the
+    validation takes of the same split (the worst val take's mean error, ×1.5), the check runs on a test take."""
     root = shared_data_dir(BANDAI_ZIP) / BANDAI_ZIP
     ts = load_dataset("bandai", root=root, contents=["walk"], styles=["normal", "active"], cache_dir=tmp_path,
                       workers=1)
-    parts = ts.split(0, 0.0, 0.2)
+    parts = ts.split(0, 0.2, 0.2)
     database = MotionDatabase.from_takeset(TakeSet("bandai", parts["train"], ts.fps))
     rec = SparseReconstructor(database, DEFAULT_MARKERS)
-    take = parts["test"][0]
-    markers = tracks_from_positions(take.positions[:150], DEFAULT_MARKERS, ts.fps).positions
-    ours = joint_errors_cm(rec.reconstruct(markers).positions, take.positions[:150])["mean_cm"]
-    baseline = joint_errors_cm(rec.nearest_neighbour(markers), take.positions[:150])["mean_cm"]
-    assert ours < baseline and ours < 5.0, (ours, baseline)
+    rng = np.random.default_rng(0)
+
+    def errors(take) -> tuple[float, float]:
+        truth = take.positions[:150]
+        markers = tracks_from_positions(truth, DEFAULT_MARKERS, ts.fps).positions
+        markers = markers + rng.uniform(-0.001, 0.001, markers.shape)
+        return (joint_errors_cm(rec.reconstruct(markers).positions, truth)["mean_cm"],
+                joint_errors_cm(rec.nearest_neighbour(markers), truth)["mean_cm"])
+
+    tolerance = 1.5 * max(errors(take)[0] for take in parts["val"][:2])
+    ours, baseline = errors(parts["test"][0])
+    assert ours < baseline and ours < tolerance, (ours, baseline, tolerance)
