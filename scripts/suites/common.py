@@ -81,7 +81,11 @@ def provenance_line(record: Mapping[str, Any]) -> str:
     m = record.get("machine", {})
     load = record.get("load_average_start") or ["?"]
     load_end = record.get("load_average_end") or ["?"]
-    return (f"Command: `{record['command']}` (commit {str(record['commit'])[:12]}, {record['started'][:10]}, "
+    commit = str(record["commit"])
+    dirty = len(record.get("uncommitted") or []) if commit.endswith("+dirty") else 0
+    commit = commit[:12] + (f" with {dirty} uncommitted file{'s' if dirty != 1 else ''}, listed in the results file"
+                            if dirty else "+dirty" if commit.endswith("+dirty") else "")
+    return (f"Command: `{record['command']}` (commit {commit}, {record['started'][:10]}, "
             f"{m.get('cpu', '?')}, {m.get('cores', '?')} cores, load {load[0]} → {load_end[0]}, seeds "
             f"{', '.join(map(str, record.get('seeds', [])))}, {record.get('seconds', '?')} s).")
 
