@@ -172,11 +172,13 @@ def annotate_from_config(cfg: DictConfig, say: Say = print, command: str = "") -
         raise AnnotateInputError("document= needs templates=<folder> (learn one with stylemotion-annotate "
                                  "data=<dataset> out=<folder>)")
     keyframes = plain.get("keyframes") or {}
-    settings = AnnotationSettings(tau=plain.get("tau", AnnotationSettings.tau),
-                                  keyframes=bool(keyframes.get("use", True)),
-                                  keyframe_count=positive_int(keyframes.get("count", 3), "keyframes.count"),
-                                  keyframe_tolerance=float(keyframes.get("tolerance", 0.1)),
-                                  min_run=int(plain.get("min_run", 30)))
+    default = AnnotationSettings()
+    settings = AnnotationSettings(tau=plain.get("tau", default.tau),
+                                  keyframes=bool(keyframes.get("use", default.keyframes)),
+                                  keyframe_count=positive_int(keyframes.get("count", default.keyframe_count),
+                                                              "keyframes.count"),
+                                  keyframe_tolerance=float(keyframes.get("tolerance", default.keyframe_tolerance)),
+                                  min_run=int(plain.get("min_run", default.min_run)))
     return annotate(str(plain["document"]), plain["templates"], plain["out"], settings=settings,
                     conversion=conversion_keys(plain),
                     force=force, say=say, command=command)

@@ -32,6 +32,7 @@ import numpy as np
 import tensorly as tl
 from scipy.optimize import lsq_linear
 from tensorly.tenalg import multi_mode_dot
+from threadpoolctl import threadpool_limits
 
 from stylemotion.annotate.templates import resample_length, warp_to
 from stylemotion.io.errors import UserInputError
@@ -126,9 +127,10 @@ class MotionTensor:
         e = self.examples                                            # (63 · frames, styles, repetitions)
         s, r = len(self.styles), self.repetitions
         beta, gamma = np.full(s, 1.0 / s), np.full(r, 1.0 / r)
-        for _ in range(rounds):
-            beta = _bounded_least_squares(e @ gamma, target)          # columns: one per style
-            gamma = _bounded_least_squares(np.einsum("dsr,s->dr", e, beta), target)
+        with threadpool_limits(limits=1):       # small QRs: extra BLAS threads only contend on a busy machine
+            for _ in range(rounds):
+                beta = _bounded_least_squares(e @ gamma, target)      # columns: one per style
+                gamma = _bounded_least_squares(np.einsum("dsr,s->dr", e, beta), target)
         fitted = np.einsum("dsr,s,r->d", e, beta, gamma)
         residual = float(np.sqrt(np.mean((fitted - target) ** 2)))
         return Parametrization(self.styles[int(np.argmax(beta))], beta, gamma, residual)
@@ -165,7 +167,8 @@ def left_singular_vectors(x: np.ndarray) -> np.ndarray:
 
 def n_mode_svd(tensor: np.ndarray) -> tuple[np.ndarray, tuple[np.ndarray, ...]]:
     """Full N-mode SVD (eq. 3.3): ``(Φ, (U_1, ..., U_N))`` with ``U_n`` ``(d_n, min(d_n, ∏ others))``."""
-    factors = [left_singular_vectors(tl.unfold(tensor, mode)) for mode in range(tensor.ndim)]
+    with threadpool_limits(limits=1):       # thin factorizations: extra BLAS threads only contend
+        factors = [left_singular_vectors(tl.unfold(tensor, mode)) for mode in range(tensor.ndim)]
     core = multi_mode_dot(tensor, factors, modes=list(range(tensor.ndim)), transpose=True)
     return core, tuple(factors)
 
