@@ -140,8 +140,14 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
     for seed in seeds:
         out = args.runs / args.data / setup_tag(args.primitives, styles) / f"seed{seed}"
         report = reproduce_seed(args.data, seed, out, args.workers, args.primitives, styles)
-        per_seed[str(seed)] = seed_figures(report) | {"run": str(out.relative_to(ROOT) if out.is_relative_to(ROOT)
-                                                                   else out)}
+        from stylemotion.io.jsonfile import read_json_object
+
+        stages = read_json_object(out / "reproduce.json", "the reproduction's summary", "rerun the suite")["stages"]
+        per_seed[str(seed)] = seed_figures(report) | {
+            "run": str(out.relative_to(ROOT) if out.is_relative_to(ROOT) else out),
+            # training time of the stages (also when an earlier command trained them and this one reused them)
+            "stage_minutes": round(sum(float(st.get("seconds") or 0) for st in stages) / 60, 1),
+            "stage_status": sorted({str(st.get("status")) for st in stages})}
     first = next(iter(per_seed.values()))
     primitives = list(first["primitives"])
     summary: dict[str, Any] = {}
@@ -248,6 +254,10 @@ def render(record: dict[str, Any]) -> dict[str, str]:
                       f"{v['primitives'][p]['diagonal_columns']}/{v['primitives'][p]['models']}",
                       fmt(v['primitives'][p]['classifier']['heldout_accuracy'], 3), v["run"]]
                      for k, v in r["per_seed"].items() for p in r["primitives"]]
+    minutes = [v.get("stage_minutes") for v in r["per_seed"].values()]
     blocks["per_seed"] = (md_table(["seed", "primitive", "rows on diagonal", "columns on diagonal",
-                                    "classifier held-out accuracy", "run folder"], per_seed_rows) + f"\n\n{prov}")
+                                    "classifier held-out accuracy", "run folder"], per_seed_rows)
+                          + f"\n\nTraining stages took {', '.join(fmt(m, 1) for m in minutes)} min per seed (seeds run "
+                          f"concurrently on a loaded machine: no timing figure; the command's own seconds below count "
+                          f"only what it did not reuse). {prov}")
     return blocks
