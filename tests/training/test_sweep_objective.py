@@ -1,5 +1,5 @@
 """Sweeps choose on validation: :func:`stylemotion.training.fit.objective` reads ``val/…`` values only, and a real
-two-trial Optuna multirun (``+hparams_search=autoencoder`` on tiny synthetic data) reports as its best value the
+two-trial Optuna multirun (``hparams_search=autoencoder`` on tiny synthetic data) reports as its best value the
 lowest validation score of its trials — a number recomputed here from each trial's ``metrics.json``, and not the
 test score — while the ``cvae_style`` search composes with knobs the style CVAE has."""
 
@@ -45,7 +45,7 @@ def test_an_optuna_multirun_minimizes_the_validation_metric(tmp_path: Path, caps
     from cli_runner import run_command
 
     sweep = tmp_path / "sweep"
-    done = run_command("train", "+hparams_search=autoencoder", *TINY, "hydra.sweeper.n_trials=2", "~logger",
+    done = run_command("train", "hparams_search=autoencoder", *TINY, "hydra.sweeper.n_trials=2", "~logger",
                        f"hydra.sweep.dir={sweep}", capsys=capsys, monkeypatch=monkeypatch, cwd=tmp_path)
     assert done.returncode == 0, done.stderr[-2000:]
     trials = [json.loads(p.read_text()) for p in sorted(sweep.glob("*/metrics.json"))]
@@ -60,7 +60,7 @@ def test_an_optuna_multirun_minimizes_the_validation_metric(tmp_path: Path, caps
 
 def test_the_style_cvae_search_composes_with_knobs_the_model_has() -> None:
     with initialize_config_dir(config_dir(), version_base="1.3"):
-        c = compose("train", overrides=["+hparams_search=cvae_style", "experiment=style_cvae", "autoencoder_ckpt=x"],
+        c = compose("train", overrides=["hparams_search=cvae_style", "experiment=style_cvae", "autoencoder_ckpt=x"],
                     return_hydra_config=True)
     assert c.hydra.sweeper._target_.endswith("OptunaSweeper")
     assert list(c.hydra.sweeper.direction) == ["minimize", "minimize"]
