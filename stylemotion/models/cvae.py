@@ -19,11 +19,12 @@ samples agree.
 α (``style_weight``) is 5 by default. The thesis' 200 is far too strong in our units (the Gram is
 divided by the number of time steps): on Bandai walk stances every sample collapses onto the
 example. α = 5 keeps the style (Table 5.1 diagonal, classifier recognition) and most of the
-variation; see ``benchmarks/evaluation.md`` and ``configs/model/style_cvae.yaml``.
+variation; see ``docs/style.md`` (which data chose α) and ``configs/model/style_cvae.yaml``.
 
-Two departures from the thesis, off by default (``benchmarks/evaluation.md``, "Issue 12: the style
-term"): ``style_term=margin`` replaces α·d by ``α · mean (max(0, d − τ)/τ)²`` with τ =
-``style_margin`` × the median Gram distance of the content training clips to their mean Gram, a
+Two departures from the thesis, off by default (measured in issue 12; history in
+``git show 1c0f1b8:benchmarks/evaluation.md``, "Issue 12: the style term"): ``style_term=margin`` replaces
+α·d by ``α · mean (max(0, d − τ)/τ)²`` with τ = ``style_margin`` × the median Gram distance of the content
+training clips to their mean Gram, a
 dimensionless term that leaves samples free inside a ball the size of the neutral data's own spread;
 ``style_centred`` takes the Gram of features centred over time (a covariance), so each channel's mean
 over the clip — where speed and turning live, and, as measured, most of what makes a style

@@ -73,7 +73,8 @@ class FollowSettings:
         prior_weight: ``λ_prior``. At 1 the codes are pulled towards the prior's mode ‖z‖ = 0, far
             inside its typical shell ‖z‖ ≈ √latent_dim, and the stylized models (whose codes vary
             less in step length and turning than the neutral one) miss the path by 0.15–0.26 m; 0.3
-            keeps ‖z‖ at 2–4 and the deviation at 0.05–0.11 m (Bandai, benchmarks/synthesis.md).
+            keeps ‖z‖ at 2–4 and the deviation at 0.05–0.11 m (Bandai, chosen on the reported S-curve,
+            one seed: a validation re-choice is pending; benchmarks/synthesis.md).
         pose_scale_m: ``σ_pose``, metres.
         speed_scale_mps: ``σ_v``, m/s.
         blend_frames: frames over which each transition is blended (:mod:`.stitching`).
