@@ -10,9 +10,9 @@ solves over a set of targets, and the choice of a setting on validation data.
   (:func:`~stylemotion.morphable.fpca.fit_reduction`'s ``selection_error``), so no figure on ``test`` chose them.
 * :func:`keyframe_errors` — the hand (any joint) driven to position targets at the primitive's last frame by
   :func:`~stylemotion.morphable.synthesis.solve_constraints`: error after MAP per target, failures (missed by more
-  than the solver's tolerance) counted.
-* :func:`choose_constraint_scale` — ``σ_c`` candidates scored on validation targets (median error after MAP, ties
-  by fewer failures), the choice reported on test targets.
+  than the solver's tolerance, or met by a code less likely than 99 % of the mixture's own samples) counted.
+* :func:`choose_constraint_scale` — ``σ_c`` candidates scored on validation targets (fewest failures — missed, or
+  met by a code off the model —, ties by the median error after MAP), the choice reported on test targets.
 """
 
 from __future__ import annotations
@@ -41,7 +41,7 @@ from stylemotion.representation import JOINT_DIMS
 from stylemotion.skeleton import CANONICAL_JOINTS
 
 __all__ = ["HeldOutVectors", "encode_heldout", "heldout_error_function", "compare_reductions", "keyframe_errors",
-           "choose_constraint_scale", "user_motion_clips"]
+           "choose_constraint_scale", "off_model_threshold", "user_motion_clips"]
 
 
 @dataclass
@@ -144,43 +144,59 @@ def compare_reductions(train: Sequence[Clip], heldout: Mapping[str, Sequence[Cli
             "rows": rows}
 
 
+def off_model_threshold(model: MorphableModel, samples: int = 10_000, seed: int = 0, percentile: float = 99.0
+                        ) -> float:
+    """``−ln p(s)`` above which a code is *off the model*: the ``percentile`` of the mixture's own samples."""
+    return float(np.percentile(-model.gmm.log_prob(model.gmm.sample(samples, seed)), percentile))
+
+
 def keyframe_errors(model: MorphableModel, targets: np.ndarray, joint: str, constraint_scale_m: float,
-                    **settings: Any) -> dict[str, Any]:
+                    off_model: float | None = None, **settings: Any) -> dict[str, Any]:
     """``joint`` driven to each of ``targets`` ``(n, 3)`` (m, the primitive's own frame) at the last frame.
 
-    Returns ``{"errors_m": [n], "tree_errors_m": [n], "failures": k}``: the error after the MAP solve and of the
-    tree's candidate per target; a failure is a target still missed by more than the solver's ``tolerance_m``.
+    Returns ``{"errors_m": [n], "tree_errors_m": [n], "neg_log_prior": [n], "missed": k, "off_model": k,
+    "failures": k}``: the error after the MAP solve and of the tree's candidate per target, and ``−ln p`` of the
+    solution. A failure is a target still missed by more than the solver's ``tolerance_m`` (``missed``), or met
+    by a code less likely than ``off_model`` (default :func:`off_model_threshold`: a motion the model does not
+    hold — a small σ_c reaches far targets by leaving the mixture).
     """
     from stylemotion.morphable.constraints import KeyframeConstraint
     from stylemotion.morphable.synthesis import MapSettings, UnreachableConstraintWarning, solve_constraints
 
     map_settings = MapSettings(constraint_scale_m=constraint_scale_m, **settings)
-    errors, tree, failures = [], [], 0
+    limit = off_model_threshold(model) if off_model is None else float(off_model)
+    errors, tree, prior, missed, off = [], [], [], 0, 0
     for target in np.asarray(targets, dtype=np.float64):
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", UnreachableConstraintWarning)
             result = solve_constraints(model, [KeyframeConstraint("position", target, joint=joint)], map_settings)
         errors.append(float(result.errors_m[0]))
         tree.append(float(result.start_errors_m[0]))
-        failures += bool(result.unreachable)
-    return {"errors_m": errors, "tree_errors_m": tree, "failures": failures}
+        prior.append(float(result.neg_log_prior))
+        missed += bool(result.unreachable)
+        off += (not result.unreachable) and result.neg_log_prior > limit
+    return {"errors_m": errors, "tree_errors_m": tree, "neg_log_prior": prior, "missed": missed, "off_model": off,
+            "failures": missed + off, "off_model_threshold": limit}
 
 
 def choose_constraint_scale(model: MorphableModel, val_targets: np.ndarray, candidates: Sequence[float],
                             joint: str) -> dict[str, Any]:
-    """The ``σ_c`` of ``candidates`` (m) with the lowest median error after MAP on ``val_targets`` (ties: fewer
-    failures, then the larger σ_c). Returns ``{"candidates": [{"scale_m", "median_m", "p95_m", "max_m",
+    """The ``σ_c`` of ``candidates`` (m) with the fewest failures on ``val_targets`` (missed by more than the
+    tolerance, or met off the model: :func:`keyframe_errors`), ties by the lower median error after MAP, then the
+    larger σ_c. Returns ``{"candidates": [{"scale_m", "median_m", "p95_m", "max_m", "missed", "off_model",
     "failures"}], "chosen_m"}``."""
     if joint not in CANONICAL_JOINTS:
         raise ValueError(f"unknown joint {joint!r}; one of {CANONICAL_JOINTS}")
+    limit = off_model_threshold(model)
     scores = []
     for scale in candidates:
-        found = keyframe_errors(model, val_targets, joint, float(scale))
+        found = keyframe_errors(model, val_targets, joint, float(scale), off_model=limit)
         e = np.asarray(found["errors_m"])
         scores.append({"scale_m": float(scale), "median_m": float(np.median(e)), "p95_m": float(np.percentile(e, 95)),
-                       "max_m": float(e.max()), "failures": int(found["failures"])})
-    best = min(scores, key=lambda s: (round(s["median_m"], 5), s["failures"], -s["scale_m"]))
-    return {"candidates": scores, "chosen_m": best["scale_m"]}
+                       "max_m": float(e.max()), "missed": int(found["missed"]), "off_model": int(found["off_model"]),
+                       "failures": int(found["failures"])})
+    best = min(scores, key=lambda s: (s["failures"], round(s["median_m"], 5), -s["scale_m"]))
+    return {"candidates": scores, "chosen_m": best["scale_m"], "off_model_threshold": limit}
 
 
 def user_motion_clips(files: Sequence[str | Path], takeset, action: str = "walk", content: str = "walk",
