@@ -1,7 +1,7 @@
 """What ``stylemotion-reconstruct`` runs: full poses from a few marker tracks (Krüger §2.5.2).
 
     stylemotion-reconstruct markers=tracks.csv data=bandai out=runs/reconstruct/mine
-    stylemotion-reconstruct markers=synthetic_walk_normal_000 features=E15x3 k=64 'joints=[Hand_L,Hand_R,Hips]'
+    stylemotion-reconstruct markers=synthetic_walk_normal_000 features=E15x3 k=128 'joints=[Hand_L,Hand_R,Hips]'
 
 ``markers`` is a BVH (``file.bvh[:start-end]``, any skeleton a joint map names; its canonical joints become the
 markers), an NPZ as ``stylemotion-convert`` writes it, a CSV of marker tracks
@@ -86,7 +86,7 @@ def load_tracks(text: str, takeset: TakeSet, joints: Sequence[str] | None,
 
 
 def reconstruct_command(data: Mapping[str, Any], markers: str, out: str | os.PathLike, *, features: str = "E15",
-                        k: int = 64, joints: Sequence[str] | None = None, noise_mm: float = 0.0, seed: int = 0,
+                        k: int = 128, joints: Sequence[str] | None = None, noise_mm: float = 0.0, seed: int = 0,
                         exclude_markers_take: bool = True, model: Mapping[str, Any] | None = None,
                         conversion: Mapping[str, Any] | None = None, force: bool = False, gif: bool = True,
                         say: Say = print, command: str = "") -> dict[str, Any]:

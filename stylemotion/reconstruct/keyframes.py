@@ -229,7 +229,7 @@ class DynamicMotionGraph:
     def __init__(self, database: MotionDatabase, k: int = 16, b: int = 4, max_iterations: int = 12,
                  voxel_m: float = 0.1, min_segment_frames: int = 4, max_segment_s: float = 1.0,
                  max_turn_deg: float = 30.0, max_pose_m: float = 0.15, max_velocity_m_s: float = 0.6,
-                 blend_frames: int = 10, duration_weight: float = 10.0, facing_weight_m: float = 1.0,
+                 blend_frames: int = 10, duration_weight: float = 30.0, facing_weight_m: float = 1.0,
                  key_weight: float = 10.0, extra_iterations: int = 1,
                  retime: bool = True, clean: bool = True,
                  index: FrameIndex | None = None, texturer: MotionTexturer | None = None):

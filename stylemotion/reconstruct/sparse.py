@@ -20,7 +20,7 @@ Per frame ``t`` of the marker tracks:
    the components that explain ``variance`` of their spread. With ``weighted`` (default) each neighbour
    counts ``1 / (d + marker_sd)²`` (d its feature distance) in the mean and covariance — our addition: it
    makes a pose that is in the database come back exactly (the plain mean of k neighbours pulls it
-   towards their average) and lowered the synthetic error from 1.18 to 1.09 cm at k = 64.
+   towards their average). ``k`` (default 128) was chosen on Bandai val takes (suite ``reconstruct``).
 4. **Pose.** The coefficients ``c`` minimizing, with pose ``x = μ + Uᵀc`` in the marker frame,
    ``‖S x − m‖² / marker_sd² + prior_weight · Σ c_i² / σ_i² + ‖x − x_prev‖² / smooth_sd²``
    (S picks the markers, m their coordinates, σ_i² the PCA variances, x_prev the previous result in this
@@ -124,7 +124,7 @@ class SparseReconstructor:
         engine, workers: the k-NN engine (:class:`FrameIndex`).
     """
 
-    def __init__(self, database: MotionDatabase, joints: Sequence[str], features: str = "E15", k: int = 64,
+    def __init__(self, database: MotionDatabase, joints: Sequence[str], features: str = "E15", k: int = 128,
                  variance: float = 0.99, marker_sd: float = 0.002, smooth_sd: float = 0.1,
                  prior_weight: float = 1.0, iterations: int = 1, weighted: bool = True, engine: str = "ckdtree",
                  workers: int = 1):
