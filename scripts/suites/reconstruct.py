@@ -41,7 +41,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--contents", nargs="+", default=["walk", "run", "wave-both-hands", "raise-up-both-hands"],
                         help="marker queries' contents")
     parser.add_argument("--takes", type=int, default=2, help="marker queries per content, in val and in test")
-    parser.add_argument("--k", type=int, nargs="+", default=[32, 64, 128], help="candidates of k")
+    parser.add_argument("--k", type=int, nargs="+", default=[64, 128, 256], help="candidates of k")
     parser.add_argument("--noise-mm", type=float, default=1.0, help="uniform marker noise, ± mm (thesis: 1)")
     parser.add_argument("--key-contents", nargs="+", default=["walk", "walk-turn-left", "walk-turn-right", "run"])
     parser.add_argument("--key-takes", type=int, default=2, help="keyframe test takes per content")
@@ -50,7 +50,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="seconds between test keys")
     parser.add_argument("--val-spacings", type=float, nargs="+", default=[2.0, 4.0],
                         help="seconds between val keys (where the timing term matters; 1 s pairs barely differ)")
-    parser.add_argument("--duration-weights", type=float, nargs="+", default=[0.0, 1.0, 3.0, 10.0, 30.0],
+    parser.add_argument("--duration-weights", type=float, nargs="+", default=[0.0, 1.0, 3.0, 10.0, 30.0, 100.0],
                         help="candidates of DynamicMotionGraph.duration_weight (0: the thesis, no timing term)")
     parser.add_argument("--texture-takes", type=int, default=1,
                         help="completion/texturing: test takes per content (walk, wave-both-hands); 0 skips it")
