@@ -41,7 +41,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--contents", nargs="+", default=["walk", "run", "wave-both-hands", "raise-up-both-hands"],
                         help="marker queries' contents")
     parser.add_argument("--takes", type=int, default=2, help="marker queries per content, in val and in test")
-    parser.add_argument("--k", type=int, nargs="+", default=[64, 128, 256], help="candidates of k")
+    parser.add_argument("--k", type=int, nargs="+", default=[32, 64, 128], help="candidates of k")
     parser.add_argument("--noise-mm", type=float, default=1.0, help="uniform marker noise, ± mm (thesis: 1)")
     parser.add_argument("--key-contents", nargs="+", default=["walk", "walk-turn-left", "walk-turn-right", "run"])
     parser.add_argument("--key-takes", type=int, default=2, help="keyframe test takes per content")
@@ -50,7 +50,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="seconds between test keys")
     parser.add_argument("--val-spacings", type=float, nargs="+", default=[2.0, 4.0],
                         help="seconds between val keys (where the timing term matters; 1 s pairs barely differ)")
-    parser.add_argument("--duration-weights", type=float, nargs="+", default=[0.0, 1.0, 3.0, 10.0, 30.0, 100.0],
+    parser.add_argument("--duration-weights", type=float, nargs="+", default=[0.0, 1.0, 3.0, 10.0, 30.0],
                         help="candidates of DynamicMotionGraph.duration_weight (0: the thesis, no timing term)")
     parser.add_argument("--texture-takes", type=int, default=1,
                         help="completion/texturing: test takes per content (walk, wave-both-hands); 0 skips it")
@@ -293,6 +293,18 @@ def _conditions() -> list[tuple[str, str, str]]:
              "skeletons and joint conventions")]
 
 
+def _edge(r: dict) -> str:
+    """A sentence when a default is the largest or smallest candidate (the grid did not bracket the optimum)."""
+    s, c = r["settings"], r["choice"]
+    edges = [name for name, value, grid in (("k", c["k"], s["k_candidates"]),
+                                             ("duration_weight", c["duration_weight"], s["duration_weight_candidates"]))
+             if len(grid) > 1 and value in (max(grid), min(grid))]
+    if not edges:
+        return ""
+    return (f" {' and '.join(edges)} {'lies' if len(edges) == 1 else 'lie'} at the edge of the candidates: values "
+            f"beyond them were not tried, so the optimum may lie there.")
+
+
 def render(record: dict[str, Any]) -> dict[str, str]:
     r = record["results"]
     s = r["settings"]
@@ -378,7 +390,7 @@ def render(record: dict[str, Any]) -> dict[str, str]:
               + "\n\nValidation score of each duration_weight (s: mean |duration error|, a failed pair counting its "
                 "whole spacing; joined / attempted val pairs):\n\n" + md_table(["duration_weight", *seeds_cols], wrows)
               + f"\n\nDefaults (most frequent choice over seeds): k = {r['choice']['k']}, duration_weight = "
-                f"{fmt(r['choice']['duration_weight'], 0)}. {prov}")
+                f"{fmt(r['choice']['duration_weight'], 0)}.{_edge(r)} {prov}")
 
     # keyframes
     krow = []
