@@ -111,12 +111,13 @@ def run(argv: list[str]) -> int:
         suite.add_arguments(parser)
     args = parser.parse_args(argv[1:])
     started, clock, load = datetime.now(timezone.utc), time.perf_counter(), load_average()
+    commit, changed = git_commit(ROOT), uncommitted()  # the code as the run starts
     results = suite.run(args, list(args.seeds))
     if "splits" not in results:
         raise BenchmarkError(f"suite {name} returned no 'splits' entry: every figure must say its split")
     record = {"suite": name, "description": suite.DESCRIPTION,
               "command": "python scripts/benchmarks.py run " + shlex.join([name, *argv[1:]]),
-              "commit": git_commit(ROOT), "uncommitted": uncommitted(),
+              "commit": commit, "uncommitted": changed,
               "started": started.isoformat(timespec="seconds"),
               "seconds": round(time.perf_counter() - clock, 1), "seeds": list(args.seeds),
               "load_average_start": load, "load_average_end": load_average(), "machine": machine(),
