@@ -12,7 +12,7 @@ from typing import Any
 
 import numpy as np
 
-from stylemotion.io.markdown import md_table
+from stylemotion.io.markdown import md_table as _md_table
 
 __all__ = ["spread", "fmt", "fmt_spread", "fmt_range", "md_table", "provenance_line", "take_split_record",
            "quantiles", "DATA_ROOT"]
@@ -29,6 +29,14 @@ def _data_root():
 
 
 DATA_ROOT = _data_root()
+
+
+def md_table(header: Sequence[str], rows: Sequence[Sequence[str]]) -> str:
+    """A Markdown table whose cells may hold ``|`` (escaped, so a cell never splits in two)."""
+    def cells(row: Sequence[str]) -> list[str]:
+        return [str(c).replace("|", "\\|") for c in row]
+
+    return _md_table(cells(header), [cells(r) for r in rows])
 
 
 def spread(values: Iterable[float | None]) -> dict[str, Any]:

@@ -325,7 +325,8 @@ def render(record: dict[str, Any]) -> dict[str, str]:
         tried = sum(x["keyframes"]["test"]["by_spacing"][sp]["attempted"] for x in r["per_seed"])
         rows.append([f"keyframes {sp} s apart (walk, turns, run): joined / attempted {joined} / {tried}",
                      "query takes not in the database",
-                     f"|duration error| {_s(r, ['keyframes', 'test', 'by_spacing', sp, 'duration_error_s', 'mean'])} s",
+                     "abs. duration error "
+                     f"{_s(r, ['keyframes', 'test', 'by_spacing', sp, 'duration_error_s', 'mean'])} s",
                      f"{_s(r, ['keyframes', 'test', 'by_spacing', sp, 'duration_error_s', 'p95'])} / "
                      f"{_s(r, ['keyframes', 'test', 'by_spacing', sp, 'duration_error_s', 'max'])} s", "—"])
     if all("texture" in x for x in r["per_seed"]):
@@ -408,9 +409,9 @@ def render(record: dict[str, Any]) -> dict[str, str]:
         tried = sum(x["keyframes"]["test"]["by_content"][c]["attempted"] for x in r["per_seed"])
         crow.append([c, f"{joined} / {tried}", _s(r, ["keyframes", "test", "by_content", c, "duration_error_s",
                                                         "mean"])])
-    keyframes = (md_table(["spacing", "joined / attempted (all seeds)", "failed per seed", "|duration error| s",
+    keyframes = (md_table(["spacing", "joined / attempted (all seeds)", "failed per seed", "abs. duration error, s",
                            "p95 s", "max s", "key error cm"], krow)
-                 + "\n\n" + md_table(["content", "joined / attempted", "|duration error| s"], crow)
+                 + "\n\n" + md_table(["content", "joined / attempted", "abs. duration error, s"], crow)
                  + f"\n\nTest key pairs: {s['key_takes']} takes of each of {', '.join(s['key_contents'])} per seed, "
                    f"drawn from the seed's test takes, keys every {', '.join(f'{x:g}' for x in s['spacings_s'])} s "
                    f"from 0.2 s; duration_weight = the seed's val choice; database = the seed's train takes. "
