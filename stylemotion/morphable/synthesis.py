@@ -61,7 +61,8 @@ class MapSettings:
         prior_weight: ``λ``.
         max_evaluations: objective evaluations LM may spend.
         tolerance_m: a constraint missed by more than this after the solve is reported.
-        lookahead_steps: ``T``, steps over which a primitive's variants are compared (§4.5.1; 1 = greedy).
+        lookahead_steps: ``T``, steps over which a primitive's variants are compared (§4.5.1; 1 = greedy, the
+            default: chosen among 1–3 on a validation path, a corner, by suite ``morphable --lookahead``).
     """
 
     candidates: int = 4
@@ -70,7 +71,7 @@ class MapSettings:
     prior_weight: float = 1.0
     max_evaluations: int = 300
     tolerance_m: float = 0.05
-    lookahead_steps: int = 2
+    lookahead_steps: int = 1
 
     def __post_init__(self) -> None:
         if self.candidates < 1 or self.tree_evaluations < 1 or self.max_evaluations < 1 or self.lookahead_steps < 1:
