@@ -19,7 +19,6 @@ from __future__ import annotations
 
 import warnings
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -27,67 +26,19 @@ import numpy as np
 
 from stylemotion.morphable.bspline import SplineBasis
 from stylemotion.morphable.fpca import METHODS, FunctionalPCA, fit_reduction
+from stylemotion.morphable.heldout_vectors import HeldOutVectors, encode_heldout, heldout_error_function
 from stylemotion.morphable.model import (
-    FunctionalData,
     MorphableModel,
     choose_coefficients,
     coefficient_vectors,
     functional_data,
     joint_error_function,
 )
-from stylemotion.morphable.warping import dtw_warp, resample
 from stylemotion.primitives.segmentation import Clip
-from stylemotion.representation import JOINT_DIMS
 from stylemotion.skeleton import CANONICAL_JOINTS
 
 __all__ = ["HeldOutVectors", "encode_heldout", "heldout_error_function", "compare_reductions", "keyframe_errors",
            "choose_constraint_scale", "off_model_threshold", "user_motion_clips"]
-
-
-@dataclass
-class HeldOutVectors:
-    """Coefficient vectors of clips not used to fit, on the training data's canonical timeline.
-
-    Attributes:
-        vectors: ``(n, (C + 1) K)`` spline coefficients (spatial channels, then the warp), as
-            :func:`~stylemotion.morphable.model.coefficient_vectors`.
-        playback_fps: ``(n,)`` rate at which the canonical timeline lasts each clip's duration.
-    """
-
-    vectors: np.ndarray
-    playback_fps: np.ndarray
-
-
-def encode_heldout(data: FunctionalData, reference: Clip, basis: SplineBasis, clips: Sequence[Clip]) -> HeldOutVectors:
-    """``clips`` aligned by DTW to ``reference`` (the training reference clip, ``train[data.reference]``) and
-    encoded with the training channels and ``basis``."""
-    if not clips:
-        raise ValueError("no held-out clip to encode")
-    ref = reference.frames[:, JOINT_DIMS]
-    vectors, rates = [], []
-    for clip in clips:
-        warp = dtw_warp(ref, clip.frames[:, JOINT_DIMS])
-        aligned = resample(data.channels.encode(clip.positions, clip.frames), warp)
-        vectors.append(np.concatenate([basis.fit(aligned), basis.fit(warp[:, None])], axis=0).ravel())
-        rates.append((data.length - 1) * data.fps / warp[-1])
-    return HeldOutVectors(np.stack(vectors), np.asarray(rates, dtype=np.float64))
-
-
-def heldout_error_function(data: FunctionalData, basis: SplineBasis, held: HeldOutVectors):
-    """Reconstructed held-out vectors ``(n, D)`` → mean squared joint distance (m²) to FK of their own spline
-    fit (eq. 3.8's error on clips the reduction never saw)."""
-    size = data.channels.size + 1
-
-    def positions(vecs: np.ndarray) -> np.ndarray:
-        spatial = vecs.reshape(len(vecs), size, basis.num_coefficients)[:, :-1]
-        return data.channels.positions(basis.evaluate(spatial, data.length), held.playback_fps)
-
-    target = positions(held.vectors)
-
-    def error(reconstructed: np.ndarray) -> float:
-        return float(((positions(reconstructed) - target) ** 2).sum(-1).mean())
-
-    return error
 
 
 def _selection(vectors: np.ndarray, error):

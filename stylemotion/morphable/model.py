@@ -404,7 +404,7 @@ def fit_primitive(clips: Sequence[Clip], settings: FitSettings | None = None, me
     error = joint_error_function(data, basis, vectors)
     select = None
     if validation and settings.reduction == "sfpca":
-        from stylemotion.morphable.heldout import encode_heldout, heldout_error_function
+        from stylemotion.morphable.heldout_vectors import encode_heldout, heldout_error_function
 
         held = encode_heldout(data, clips[data.reference], basis, validation)
         val_error = heldout_error_function(data, basis, held)
