@@ -37,6 +37,8 @@ def test_spreads_are_over_seeds(tiny_run, monkeypatch: pytest.MonkeyPatch, tmp_p
     shares = {0: 0.2, 1: 0.5, 2: 0.8}
 
     def fake(data, seed, out, workers, primitives=None, styles=None):
+        out.mkdir(parents=True, exist_ok=True)  # what the reproduction leaves beside its report
+        (out / "reproduce.json").write_text(json.dumps({"stages": [{"seconds": 30.0 * (seed + 1), "status": "done"}]}))
         copy = json.loads(json.dumps(report))
         for detail in copy["style_recognition"]["per_model_detail"][primitive].values():
             detail["share"] = shares[seed]
@@ -48,6 +50,7 @@ def test_spreads_are_over_seeds(tiny_run, monkeypatch: pytest.MonkeyPatch, tmp_p
     spread = results["summary"][primitive]["recognition"]["neutral"]
     assert spread["mean"] == pytest.approx(0.5) and spread["sd"] == pytest.approx(0.3)
     assert (spread["min"], spread["max"], spread["n"]) == (0.2, 0.8, 3)
+    assert [results["per_seed"][s]["stage_minutes"] for s in "012"] == [0.5, 1.0, 1.5]
     record = {"results": results, "seeds": [0, 1, 2], "command": "c", "commit": "x", "started": "2026-01-01",
               "machine": {}, "seconds": 0}
     blocks = style.render(record)
