@@ -139,15 +139,21 @@ def _share(n: int, fraction: float) -> int:
     return max(1, round(n * fraction)) if n >= 3 else 0
 
 
-def spread_over_styles(takes: Sequence[Take], contents: Sequence[str], per_content: int) -> list[Take]:
-    """``per_content`` takes of each content, taken in turn from each style (sorted by name within a style), so a
-    benchmark's queries cover every style rather than the first one alphabetically."""
+def spread_over_styles(takes: Sequence[Take], contents: Sequence[str], per_content: int,
+                       rng: np.random.Generator | None = None) -> list[Take]:
+    """``per_content`` takes of each content, taken in turn from each style, so a benchmark's queries cover every
+    style rather than the first one alphabetically. Without ``rng``: takes by name within a style, styles in name
+    order; with it: a random order of the takes and of the styles (the same draws for the same generator state)."""
     chosen: list[Take] = []
     for content in contents:
+        pool = sorted((t for t in takes if t.content == content), key=lambda t: t.name)
+        if rng is not None:
+            pool = [pool[i] for i in rng.permutation(len(pool))]
         by_style: dict[str, list[Take]] = {}
-        for take in sorted((t for t in takes if t.content == content), key=lambda t: t.name):
+        for take in pool:
             by_style.setdefault(take.style, []).append(take)
-        queues = [by_style[s] for s in sorted(by_style)]
+        order = sorted(by_style) if rng is None else list(rng.permutation(sorted(by_style)))
+        queues = [by_style[s] for s in order]
         picked: list[Take] = []
         while len(picked) < per_content and any(queues):
             for queue in queues:

@@ -17,7 +17,7 @@ from typing import Any
 
 import numpy as np
 
-from stylemotion.datasets import Take, TakeSet, load_dataset
+from stylemotion.datasets import Take, TakeSet, load_dataset, spread_over_styles
 from stylemotion.reconstruct.keyframes import DynamicMotionGraph, Keyframe, NoConnectionError
 from stylemotion.reconstruct.markers import tracks_from_positions
 from stylemotion.search.database import MotionDatabase
@@ -54,21 +54,7 @@ def choose_queries(takes: Sequence[Take], contents: Sequence[str], per_content: 
     missing = sorted(set(contents) - {t.content for t in takes})
     if missing:
         raise ValueError(f"no take of content(s) {missing}; the takes' contents: {sorted({t.content for t in takes})}")
-    chosen: list[Take] = []
-    for content in contents:
-        pool = sorted((t for t in takes if t.content == content), key=lambda t: t.name)
-        shuffled = [pool[i] for i in rng.permutation(len(pool))]
-        by_style: dict[str, list[Take]] = {}
-        for take in shuffled:
-            by_style.setdefault(take.style, []).append(take)
-        styles = [by_style[s] for s in rng.permutation(sorted(by_style))]
-        picked: list[Take] = []
-        while len(picked) < per_content and any(styles):
-            for queue in styles:
-                if queue and len(picked) < per_content:
-                    picked.append(queue.pop(0))
-        chosen += picked
-    return chosen
+    return spread_over_styles(takes, contents, per_content, rng)
 
 
 def noisy_markers(positions: np.ndarray, joints: Sequence[str], noise_mm: float, rng: np.random.Generator,
