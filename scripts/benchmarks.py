@@ -63,15 +63,13 @@ def load_suite(name: str) -> ModuleType:
 
 def machine() -> dict:
     """CPU model, core count, Python, and the versions of the numeric libraries that decide the figures."""
-    cpu = platform.processor() or "unknown"
     try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                cpu = line.split(":", 1)[1].strip()
-                break
-        flags = next((ln for ln in Path("/proc/cpuinfo").read_text().splitlines() if ln.startswith("flags")), "")
+        info = Path("/proc/cpuinfo").read_text().splitlines()
     except OSError:
-        flags = ""
+        info = []
+    cpu = next((ln.split(":", 1)[1].strip() for ln in info if ln.startswith("model name")),
+               platform.processor() or "unknown")
+    flags = next((ln for ln in info if ln.startswith("flags")), "")
     import numpy
 
     record = {"cpu": cpu, "cores": os.cpu_count(), "avx512": "avx512f" in flags.split(),

@@ -7,7 +7,9 @@ path). Protocol: docs/benchmarks.md.
 from __future__ import annotations
 
 import math
+import os
 from collections.abc import Iterable, Mapping, Sequence
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -18,17 +20,7 @@ __all__ = ["spread", "fmt", "fmt_spread", "fmt_range", "md_table", "provenance_l
            "quantiles", "DATA_ROOT"]
 
 #: Where the benchmark data lies (``$STYLEMOTION_DATA`` or ``../shared/data`` beside the repository).
-DATA_ROOT = None  # set below
-
-
-def _data_root():
-    import os
-    from pathlib import Path
-
-    return Path(os.environ.get("STYLEMOTION_DATA") or Path(__file__).resolve().parents[3] / "shared" / "data")
-
-
-DATA_ROOT = _data_root()
+DATA_ROOT = Path(os.environ.get("STYLEMOTION_DATA") or Path(__file__).resolve().parents[3] / "shared" / "data")
 
 
 def md_table(header: Sequence[str], rows: Sequence[Sequence[str]]) -> str:
