@@ -36,7 +36,7 @@ def test_spreads_are_over_seeds(tiny_run, monkeypatch: pytest.MonkeyPatch, tmp_p
     primitive = next(iter(report["table_5_1"]))
     shares = {0: 0.2, 1: 0.5, 2: 0.8}
 
-    def fake(data, seed, out, workers, primitives=None, styles=None):
+    def fake(data, seed, out, workers, primitives=None, styles=None, alpha=None):
         out.mkdir(parents=True, exist_ok=True)  # what the reproduction leaves beside its report
         (out / "reproduce.json").write_text(json.dumps({"stages": [{"seconds": 30.0 * (seed + 1), "status": "done"}]}))
         copy = json.loads(json.dumps(report))
@@ -56,3 +56,29 @@ def test_spreads_are_over_seeds(tiny_run, monkeypatch: pytest.MonkeyPatch, tmp_p
     blocks = style.render(record)
     assert {"headline", "recognition", "variation", "variation_vs_style", "per_seed"} <= set(blocks)
     assert "Synthetic data" in blocks["headline"] and "0.500 ± 0.300" in blocks["recognition"]
+
+
+def test_a_chosen_alpha_reaches_every_seed_and_its_table(tiny_run, monkeypatch: pytest.MonkeyPatch,
+                                                         tmp_path: Path) -> None:
+    report = json.loads((tiny_run.folder / "report" / "report.json").read_text())
+    passed = []
+
+    def fake(data, seed, out, workers, primitives=None, styles=None, alpha=None):
+        passed.append(alpha)
+        out.mkdir(parents=True, exist_ok=True)
+        (out / "reproduce.json").write_text(json.dumps({"stages": [{"seconds": 1.0, "status": "done"}]}))
+        return report
+
+    choice = {"candidates": [1.0, 5.0], "styles": ["a"], "seed": 100, "autoencoder_of_seed": 0, "chosen": 5.0,
+              "values": {"1": {"p/a": {"val/style": 2.0, "val/mpjpe": 0.01}},
+                         "5": {"p/a": {"val/style": 1.0, "val/mpjpe": 0.015}}},
+              "scores": {"1": 0.693, "5": 0.405}, "rule": "r"}
+    monkeypatch.setattr(style, "reproduce_seed", fake)
+    monkeypatch.setattr(style, "choose_alpha", lambda args, seed, primitives, styles: choice)
+    args = argparse.Namespace(data="synthetic", runs=tmp_path, workers=1, primitives=None, sample_styles=None,
+                              alphas=[1.0, 5.0])
+    results = style.run(args, [0, 1, 2])
+    assert passed == [5.0, 5.0, 5.0] and results["alpha_choice"] == choice
+    blocks = style.render({"results": results, "seeds": [0, 1, 2], "command": "c", "commit": "x",
+                           "started": "2026-01-01", "machine": {}, "seconds": 0})
+    assert "| **5** | 1.0000 / 0.0150 | 0.405 |" in blocks["alpha"] and "α = 5, chosen" in blocks["headline"]

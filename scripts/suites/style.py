@@ -46,6 +46,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--sample-styles", type=int, default=None, metavar="K",
                         help="train CVAEs for K styles only, a seeded choice (numpy default_rng(0)) fixed across seeds "
                              "(default: every style, as the thesis)")
+    parser.add_argument("--alphas", type=float, nargs="+", default=None, metavar="ALPHA",
+                        help="choose the style weight α among these on validation clips first "
+                             "(stylemotion/training/style_weight.py), then report every seed with the choice "
+                             "(default: no choice, the config's α)")
+    parser.add_argument("--alpha-styles", type=int, default=2, metavar="K",
+                        help="styles the α candidates are trained for (a seeded choice, numpy default_rng(1))")
+    parser.add_argument("--alpha-seed", type=int, default=100,
+                        help="training seed of the α candidates (not one of the reported seeds)")
 
 
 def compose_reproduce(overrides: list[str]):
@@ -86,25 +94,98 @@ def setup_tag(primitives: list[str] | None, styles: list[str] | None) -> str:
     return "_".join(parts) if parts else "full"
 
 
+def reproduce_overrides(data: str, seed: int, out: Path, workers: int, primitives: list[str] | None = None,
+                        styles: list[str] | None = None, alpha: float | None = None) -> list[str]:
+    """The ``reproduce`` overrides of one seed's run (``alpha``: the CVAEs' style weight, else the config's)."""
+    overrides = [*DATA[data], f"seed={seed}", f"out={out}", f"workers={workers}", "threads=1"]
+    if primitives:
+        overrides.append(f"primitives=[{','.join(primitives)}]")
+    if styles is not None:
+        overrides.append(f"styles=[{','.join(styles)}]")
+    if alpha is not None:
+        overrides.append(f"budget.cvae.style_weight={alpha}")
+    return overrides
+
+
 def reproduce_seed(data: str, seed: int, out: Path, workers: int, primitives: list[str] | None = None,
-                   styles: list[str] | None = None) -> dict[str, Any]:
+                   styles: list[str] | None = None, alpha: float | None = None) -> dict[str, Any]:
     """Run (or reuse) ``stylemotion-reproduce`` for ``seed`` into ``out``; returns its ``report.json``."""
     from hydra.core.global_hydra import GlobalHydra
 
     from stylemotion.io.jsonfile import read_json_object
     from stylemotion.training.reproduction import reproduce
 
-    overrides = [*DATA[data], f"seed={seed}", f"out={out}", f"workers={workers}", "threads=1"]
-    if primitives:
-        overrides.append(f"primitives=[{','.join(primitives)}]")
-    if styles:
-        overrides.append(f"styles=[{','.join(styles)}]")
-    cfg = compose_reproduce(overrides)
+    cfg = compose_reproduce(reproduce_overrides(data, seed, out, workers, primitives, styles, alpha))
     try:
         reproduce(cfg, say=lambda line: print(f"[seed {seed}] {line}", flush=True))
     finally:
         GlobalHydra.instance().clear()
     return read_json_object(out / "report" / "report.json", "the reproduction's report", "rerun the suite")
+
+
+def candidate_metrics(cfg, folder: Path) -> dict[str, float]:
+    """Train one α candidate (the ``train`` config ``cfg``) into ``folder``, or reuse its recorded result; returns
+    its validation metrics at the best ``val/loss`` epoch (``metrics.json``'s ``val``)."""
+    from stylemotion.io.jsonfile import read_json_object, write_json
+    from stylemotion.training.fit import run as train_run
+
+    record = folder / "candidate.json"
+    if record.is_file():
+        return dict(read_json_object(record, "an α candidate's record", f"delete {folder}")["val"])
+    train_run(cfg)
+    val = dict(read_json_object(folder / "metrics.json", "an α candidate's metrics", f"delete {folder}").get("val")
+               or {})
+    write_json(record, {"val": val})
+    return val
+
+
+def choose_alpha(args: argparse.Namespace, seed: int, primitives: list[str] | None,
+                 styles: list[str] | None) -> dict[str, Any]:
+    """Choose α among ``args.alphas`` on validation clips (stylemotion/training/style_weight.py): CVAEs of
+    ``args.alpha_styles`` seeded styles, trained with seed ``args.alpha_seed`` on the autoencoder of the reported
+    ``seed``'s run (trained here first, the same stage the seed's reproduction then reuses)."""
+    import numpy as np
+    from hydra.core.global_hydra import GlobalHydra
+    from omegaconf import OmegaConf
+
+    from stylemotion.training.reproduction import Reproduction, stage_train_config
+    from stylemotion.training.style_weight import METRICS, choose_style_weight, style_weight_scores
+
+    base = args.runs / args.data / setup_tag(primitives, styles)
+    cfg = compose_reproduce(reproduce_overrides(args.data, seed, base / f"seed{seed}", 1, primitives, []))
+    try:
+        repro = Reproduction(cfg)
+        repro.out.mkdir(parents=True, exist_ok=True)
+        repro.data_stage()
+        autoencoder = repro.stages[0]
+        repro.run_stage(2, autoencoder)
+        pool = styles or [s for s in repro.data_summary["styles"] if s != str(cfg.evaluation.neutral_style)]
+        chosen_styles = sorted(np.random.default_rng(1).choice(pool, min(args.alpha_styles, len(pool)),
+                                                               replace=False).tolist())
+        overrides = [o for o in OmegaConf.to_container(cfg.stages.cvae, resolve=True)
+                     if not str(o).startswith("model.style_weight=")]
+        if not cfg.budget.stage_samples:
+            overrides.append("callbacks.samples=null")
+        values: dict[float, dict[str, dict[str, float]]] = {}
+        for alpha in sorted(args.alphas):
+            for primitive in repro.primitives:
+                for style in chosen_styles:
+                    folder = base / "alpha" / f"seed{args.alpha_seed}" / f"alpha{alpha:g}" / f"{primitive}_{style}"
+                    train_cfg = stage_train_config([*overrides, f"model.style_weight={alpha}"],
+                                                   {"primitive": primitive, "style": style}, repro.data_cfg, folder,
+                                                   args.alpha_seed, 1, str(autoencoder.checkpoint))
+                    print(f"[α {alpha:g}] {primitive}/{style}", flush=True)
+                    val = candidate_metrics(train_cfg, folder)
+                    values.setdefault(alpha, {})[f"{primitive}/{style}"] = {m: val.get(m) for m in METRICS}
+    finally:
+        GlobalHydra.instance().clear()
+    scores = style_weight_scores(values)
+    chosen = choose_style_weight(values)
+    return {"candidates": sorted(args.alphas), "styles": chosen_styles, "seed": args.alpha_seed,
+            "autoencoder_of_seed": seed, "values": {f"{a:g}": v for a, v in values.items()},
+            "scores": {f"{a:g}": scores[a] for a in sorted(scores)}, "chosen": chosen,
+            "rule": "min over α of mean over styles of log(val/style ÷ min) + log(val/mpjpe ÷ min) "
+                    "(stylemotion/training/style_weight.py)"}
 
 
 def seed_figures(report: dict[str, Any]) -> dict[str, Any]:
@@ -136,10 +217,12 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
 
     torch.set_num_threads(1)
     styles = sample_styles(args.data, args.sample_styles)
+    alpha_choice = choose_alpha(args, seeds[0], args.primitives, styles) if getattr(args, "alphas", None) else None
+    alpha = alpha_choice["chosen"] if alpha_choice else None
     per_seed = {}
     for seed in seeds:
         out = args.runs / args.data / setup_tag(args.primitives, styles) / f"seed{seed}"
-        report = reproduce_seed(args.data, seed, out, args.workers, args.primitives, styles)
+        report = reproduce_seed(args.data, seed, out, args.workers, args.primitives, styles, alpha)
         from stylemotion.io.jsonfile import read_json_object
 
         stages = read_json_object(out / "reproduce.json", "the reproduction's summary", "rerun the suite")["stages"]
@@ -187,7 +270,9 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
                        "variation": "model samples against the neutral train clips (variance_ratio) and all real "
                                     "clips of the model's style (variation_vs_style)",
                        "clips": clips,
-                       "chosen_here": "nothing: α and the style-term options are the configs' defaults"},
+                       "chosen_here": (f"α = {alpha:g}, chosen on validation clips (alpha_choice)" if alpha_choice
+                                       else "nothing: α and the style-term options are the configs' defaults")},
+            "alpha_choice": alpha_choice,
             "primitives": primitives, "summary": summary, "overall": overall, "per_seed": per_seed}
 
 
@@ -222,9 +307,26 @@ def render(record: dict[str, Any]) -> dict[str, str]:
                 + f"\n\nRecognition of the styled models' samples (mean over styles): "
                   f"{fmt_spread(o['recognition_mean_styled'], 3)} "
                   f"(min–max {fmt_range(o['recognition_mean_styled'], 3)}). "
-                + split_line + " " + prov)
+                + split_line + " "
+                + (f"α = {r['alpha_choice']['chosen']:g}, chosen on validation clips by this command (block alpha). "
+                   if r.get("alpha_choice") else f"α: {r['splits'].get('chosen_here', 'the config default')}. ")
+                + prov)
 
     blocks = {"headline": headline}
+    choice = r.get("alpha_choice")
+    if choice:
+        names = sorted({n for per in choice["values"].values() for n in per})
+        alpha_rows = [[f"**{a}**" if float(a) == choice["chosen"] else a,
+                       *(f"{fmt(v[n]['val/style'], 4)} / {fmt(v[n]['val/mpjpe'], 4)}" if n in v else "failed"
+                         for n in names), fmt(choice["scores"][a], 3)]
+                      for a, v in choice["values"].items()]
+        blocks["alpha"] = (f"Style weight α chosen on **validation** clips before the seeds above were run: CVAEs of "
+                           f"{', '.join(names)} trained with seed {choice['seed']} (not a reported seed) on the "
+                           f"autoencoder of seed {choice['autoencoder_of_seed']}'s run; each cell is val/style (Gram "
+                           f"distance to the example) / val/mpjpe (m, reconstruction of held-out neutral clips) at "
+                           f"the best val/loss epoch. Rule (fixed before the run): {choice['rule']}. "
+                           f"Chosen: α = {choice['chosen']:g}.\n\n"
+                           + md_table(["α", *names, "score (lower is better)"], alpha_rows) + f"\n\n{prov}")
     recog_rows, ratio_rows, vs_rows = [], [], []
     for p in r["primitives"]:
         s = r["summary"][p]

@@ -1,0 +1,45 @@
+"""The α rule (stylemotion/training/style_weight.py) against hand-worked products of relative costs."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from stylemotion.training.style_weight import choose_style_weight, style_weight_scores
+
+
+def metrics(style: float, mpjpe: float) -> dict[str, float]:
+    return {"val/style": style, "val/mpjpe": mpjpe}
+
+
+def test_the_balanced_alpha_wins_and_scores_are_log_products() -> None:
+    # relative costs (style ÷ 1, mpjpe ÷ 1): α=1 → 4·1 = 4, α=5 → 2·1.5 = 3, α=50 → 1·4 = 4
+    values = {1.0: {"a": metrics(4, 1)}, 5.0: {"a": metrics(2, 1.5)}, 50.0: {"a": metrics(1, 4)}}
+    scores = style_weight_scores(values)
+    assert scores == pytest.approx({1.0: math.log(4), 5.0: math.log(3), 50.0: math.log(4)})
+    assert choose_style_weight(values) == 5.0
+
+
+def test_the_rule_is_scale_free_per_style_and_averages_styles() -> None:
+    # style b alone would choose α=50 (products 8, 4, 2); a alone α=5 (4, 3, 4); the mean of logs:
+    # α=1: (log 4 + log 8)/2 = log √32, α=5: log √12, α=50: log √8 → α=50
+    values = {1.0: {"a": metrics(4, 1), "b": metrics(8000, 0.001)},
+              5.0: {"a": metrics(2, 1.5), "b": metrics(2000, 0.002)},
+              50.0: {"a": metrics(1, 4), "b": metrics(1000, 0.002)}}
+    assert style_weight_scores(values)[50.0] == pytest.approx(math.log(math.sqrt(8)))
+    assert choose_style_weight(values) == 50.0
+
+
+def test_a_failed_candidate_is_never_chosen() -> None:
+    values = {1.0: {"a": metrics(4, 1), "b": metrics(4, 1)},
+              5.0: {"a": metrics(1, 1), "b": {"val/style": float("nan"), "val/mpjpe": 1.0}}}
+    assert style_weight_scores(values)[5.0] == math.inf
+    assert choose_style_weight(values) == 1.0
+    with pytest.raises(ValueError, match="every α candidate failed"):
+        choose_style_weight({1.0: {"a": {}}, 2.0: {"a": metrics(0, 1)}})
+
+
+def test_ties_go_to_the_smaller_alpha() -> None:
+    values = {10.0: {"a": metrics(1, 2)}, 2.0: {"a": metrics(2, 1)}}
+    assert choose_style_weight(values) == 2.0
