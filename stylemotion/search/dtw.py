@@ -19,6 +19,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from functools import reduce
+from typing import Literal
 
 import numpy as np
 from scipy.spatial.distance import cdist
@@ -37,6 +38,9 @@ from stylemotion.search.lng import (
     select_matches,
     skip_penalty,
 )
+
+Ties = Literal["total", "predecessor"]
+TIES: tuple[str, ...] = ("total", "predecessor")
 
 
 @dataclass(frozen=True, eq=False)
@@ -94,14 +98,20 @@ def _check_cost(cost: np.ndarray) -> np.ndarray:
 
 def subsequence_dtw(cost: np.ndarray, takes: TakeBounds | np.ndarray | None = None, *,
                     steps: tuple[Step, ...] = THESIS_STEPS, normalize: Normalization = "none", top: int = 1,
-                    skip_cost: float | None = None, keep_matrix: bool = False) -> DTWResult:
+                    skip_cost: float | None = None, keep_matrix: bool = False, ties: Ties = "total") -> DTWResult:
     """Subsequence DTW over a precomputed ``(m, n)`` feature distance matrix.
 
     ``takes``: :class:`TakeBounds` or ``next_in_take (n,)`` (default: one take); ``steps``/``normalize``/``top``/
     ``skip_cost`` as in :func:`~stylemotion.search.lng.lng_match` (by default a skipped query frame costs its
     row's largest distance, what the LNG charges when every frame is a neighbour); ``keep_matrix``: also
-    return the accumulated sums.
+    return the accumulated sums. ``ties``: which predecessor a cell's path takes, the first (source, then the
+    steps as given) whose ``C[i, g] + predecessor`` equals the cell's total (``"total"``, the LNG's rule, so
+    the two agree exactly), or the first of least predecessor sum (``"predecessor"``, the exact argmin;
+    annotation's motion-template matching). The two differ only where two predecessor sums differ by less
+    than the rounding of adding ``C[i, g]``: the totals are the same, a start frame may differ.
     """
+    if ties not in TIES:
+        raise ValueError(f"ties must be one of {TIES}, got {ties!r}")
     c = _check_cost(cost)
     m, n = c.shape
     tb = TakeBounds.from_lengths([n]) if takes is None else TakeBounds.coerce(takes)
@@ -118,7 +128,7 @@ def subsequence_dtw(cost: np.ndarray, takes: TakeBounds | np.ndarray | None = No
     depth = max(dq for dq, _ in steps)
     for i in range(m):
         d = c[i]
-        rows[i] = _row(i, d, steps, allowed, rows, choice[i], frames, skips)
+        rows[i] = _row(i, d, steps, allowed, rows, choice[i], frames, skips, ties)
         rows.pop(i - depth, None)
         if acc is not None:
             acc[i] = rows[i][0]
@@ -139,7 +149,7 @@ def subsequence_dtw_features(query: np.ndarray, database: np.ndarray, takes: Tak
 
 def _row(i: int, d: np.ndarray, steps: tuple[Step, ...], allowed: dict[int, np.ndarray],
          rows: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray]], choice: np.ndarray,
-         frames: np.ndarray, skips: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+         frames: np.ndarray, skips: np.ndarray, ties: Ties) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Row ``i``: ``(accumulated sums, start frames, path lengths)``, each ``(n,)``; fills ``choice (n,)``."""
     cands: list[np.ndarray | None] = [np.zeros_like(d) if i == 0 else None]
     for dq, dg in steps:
@@ -163,9 +173,12 @@ def _row(i: int, d: np.ndarray, steps: tuple[Step, ...], allowed: dict[int, np.n
     for c, dg in vertical:
         cands[c + 1] = np.where(allowed[dg], _shift(total, dg, np.inf), np.inf)
     reached = np.isfinite(total)
+    if ties == "predecessor":  # total == d + least exactly (rounding is monotonic)
+        least = reduce(np.minimum, [x for x in cands if x is not None], np.full_like(d, np.inf))
     for c, cand in enumerate(cands):
         if cand is not None:
-            choice[reached & (choice < 0) & (d + cand == total)] = c
+            same = (cand == least) if ties == "predecessor" else (d + cand == total)
+            choice[reached & (choice < 0) & same] = c
     return (total, *_bookkeep(i, choice, steps, rows, frames))
 
 

@@ -62,9 +62,12 @@ def brute_force_subsequence_dtw(cost: np.ndarray) -> tuple[np.ndarray, np.ndarra
     return d[-1] / m, start[-1]
 
 
-@pytest.mark.parametrize("m, n", [(1, 5), (4, 9), (7, 30), (12, 20)])
-def test_subsequence_dtw_equals_the_cell_by_cell_recursion(m, n):
-    cost = np.random.default_rng(m * 100 + n).random((m, n))
+@pytest.mark.parametrize("fractions", [False, True])
+@pytest.mark.parametrize("m, n", [(1, 5), (4, 9), (7, 30), (12, 20), (14, 73), (23, 74)])
+def test_subsequence_dtw_equals_the_cell_by_cell_recursion(m, n, fractions):
+    """Also on costs of a few fractions (like local_cost's), where predecessor sums tie after rounding."""
+    rng = np.random.default_rng(m * 100 + n)
+    cost = rng.integers(0, 8, (m, n)) / 21 if fractions else rng.random((m, n))
     delta, start = subsequence_dtw(cost)
     want_delta, want_start = brute_force_subsequence_dtw(cost)
     assert np.array_equal(np.isinf(delta), np.isinf(want_delta))

@@ -141,6 +141,7 @@ def test_feature_distances_are_euclidean():
         ({"cost": np.ones((2, 5)), "steps": ((0, 0), (1, 1))}, "(0, 0)"),
         ({"cost": np.ones((2, 5)), "normalize": "mean"}, "mean"),
         ({"cost": np.ones((2, 5)), "top": 0}, "top"),
+        ({"cost": np.ones((2, 5)), "ties": "last"}, "last"),
     ],
 )
 def test_bad_inputs_raise(kwargs, message):
@@ -153,3 +154,35 @@ def test_bad_features_raise():
         feature_distances(np.ones((3, 2)), np.ones((4, 3)))
     with pytest.raises(ValueError, match="non-finite"):
         feature_distances(np.full((3, 2), np.nan), np.ones((4, 2)))
+
+
+def _argmin_starts(cost: np.ndarray, steps) -> np.ndarray:
+    """Start frame of the best path ending at each last-row cell, written cell by cell with the exact argmin
+    of the predecessor sums (first of least in step order; skipped query frames free)."""
+    m, n = cost.shape
+    acc, start = np.full((m, n), np.inf), np.full((m, n), -1)
+    acc[0], start[0] = cost[0], np.arange(n)
+    for i in range(1, m):
+        for g in range(n):
+            options = [(acc[i - dq, g - dg], start[i - dq, g - dg]) if i >= dq and g >= dg else (np.inf, -1)
+                       for dq, dg in steps]
+            best, s = min(options, key=lambda o: o[0])
+            if np.isfinite(best):
+                acc[i, g], start[i, g] = cost[i, g] + best, s
+    return start[-1]
+
+
+def test_ties_by_predecessor_take_the_exact_argmin_where_by_total_may_not():
+    """Costs of a few fractions tie after rounding: ``ties="predecessor"`` follows the exact argmin on every
+    matrix, ``"total"`` (the LNG's rule) picks another start on some; both give the same totals."""
+    steps = ((1, 1), (2, 1), (1, 2))
+    rng = np.random.default_rng(11)
+    differed = 0
+    for _ in range(60):
+        cost = rng.integers(0, 8, (int(rng.integers(5, 15)), 40)) / int(rng.integers(3, 43))
+        by_pred = subsequence_dtw(cost, steps=steps, skip_cost=0.0, ties="predecessor")
+        by_total = subsequence_dtw(cost, steps=steps, skip_cost=0.0)
+        assert np.array_equal(by_pred.end_starts, _argmin_starts(cost, steps))
+        assert np.array_equal(by_pred.end_costs, by_total.end_costs)
+        differed += not np.array_equal(by_total.end_starts, by_pred.end_starts)
+    assert differed > 0
