@@ -57,6 +57,7 @@ def load_suite(name: str) -> ModuleType:
         raise BenchmarkError(f"no suite {name!r}; suites: {', '.join(suite_names())}")
     spec = importlib.util.spec_from_file_location(f"suites.{name}", path)
     module = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = module  # a suite's dataclasses look their module up there
     spec.loader.exec_module(module)
     return module
 
