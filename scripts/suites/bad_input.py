@@ -363,13 +363,15 @@ def make_inputs(paths: Inputs, seed: int, say: Callable[[str], None]) -> dict[st
     steps = [("repro", ["stylemotion-reproduce", *tiny_overrides(earlier / "repro")]),
              ("train", ["stylemotion-train", *SMOKE, f"hydra.run.dir={earlier / 'train'}"]),
              ("search", ["stylemotion-search", *DATA, f"query={TAKE}:0-30", f"out={earlier / 'search'}"]),
-             ("templates", ["stylemotion-annotate", *DATA, "per_class=1", f"out={earlier / 'templates'}"])]
+             ("templates", ["stylemotion-annotate", *DATA, "per_class=2", f"out={earlier / 'templates'}"])]
     for name, argv in steps:
         if not (earlier / name / ".done").exists():
             say(f"finished result earlier/{name}: {argv[0]} (the tiny reproduce run takes about a minute)")
             if (earlier / name).exists():
                 shutil.rmtree(earlier / name)
-            _must_run([*argv, f"hydra.run.dir={earlier / 'hydra' / name}"], earlier)
+            hydra = [] if any(a.startswith("hydra.run.dir=") for a in argv) else [
+                f"hydra.run.dir={earlier / 'hydra' / name}"]
+            _must_run([*argv, *hydra], earlier)
             (earlier / name / ".done").write_text("")
     _write_checkpoints(inputs, earlier / "repro", decoy)
     (inputs / "report_cut").mkdir()
@@ -718,7 +720,7 @@ def build_cases(p: Inputs) -> list[Case]:
         ("/nonexistent/tpl",))
     add(an, "out_exists", [*DATA, doc, tpl, "out=out"], "refused", "out exists", ("out",),
         setup=_file("out/mine.txt"), earlier=("out",), out=())
-    add(an, "learn_into_templates", [*DATA, "per_class=1", "out=tpl"], "refused", "rerun into finished output",
+    add(an, "learn_into_templates", [*DATA, "per_class=2", "out=tpl"], "refused", "rerun into finished output",
         ("tpl",), setup=_copy(p.earlier / "templates", "tpl"), earlier=("tpl",), out=())
 
     # --- stylemotion-reconstruct --------------------------------------------------------------------------------

@@ -17,7 +17,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from stylemotion.io.atomic import atomic_write_bytes
-from stylemotion.io.errors import BvhError, LimitError, MotionDataError, MotionDataWarning
+from stylemotion.io.errors import BvhError, LimitError, MotionDataError
 from stylemotion.io.sources import check_file_size, regular_file_stat
 from stylemotion.motion import Motion
 from stylemotion.skeleton import Skeleton
@@ -232,11 +232,11 @@ def parse_bvh(data: bytes | str, source: str = "<memory>",
             its arrays (None: no limit).
 
     Raises:
-        BvhError: naming ``source`` and the line, for any malformed content.
+        BvhError: naming ``source`` and the line, for any malformed content (and a Frame Time in ms).
         LimitError: the motion is larger than ``max_joint_frames``.
 
-    Warns:
-        MotionDataWarning: the Frame Time looks like milliseconds (≥ 1 s over ≥ 10 frames).
+    A Frame Time that looks like milliseconds (≥ 1 s over ≥ 10 frames) is a :class:`BvhError`: read as
+    seconds, resampling would make a few seconds of motion a thousand times longer.
     """
     raw = normalize_text(data.encode() if isinstance(data, str) else data, source)
     match = re.search(rb"^[ \t]*MOTION[ \t]*$", raw, flags=re.MULTILINE)
@@ -292,12 +292,10 @@ def parse_bvh(data: bytes | str, source: str = "<memory>",
     values = _parse_rows(body, num_frames, num_channels, source, body_line)
     check_joint_frames(num_frames, skeleton.num_joints, max_joint_frames, source, "in the file")
     if frame_time >= _MS_FRAME_TIME_S and num_frames >= _MS_MIN_FRAMES:
-        warnings.warn(
-            f"{source}:{first_line + 1}: Frame Time {time_m.group(1)} s ({1.0 / frame_time:.3g} fps) over "
-            f"{num_frames} frames looks like milliseconds; BVH Frame Time is in seconds (for "
-            f"{frame_time:g} ms write Frame Time: {frame_time / 1000:g})",
-            MotionDataWarning, stacklevel=2,
-        )
+        # read as seconds, resampling would make a few seconds of motion a thousand times longer
+        raise BvhError(source, f"Frame Time {time_m.group(1)} s ({1.0 / frame_time:.3g} fps) over {num_frames} "
+                       f"frames looks like milliseconds; BVH Frame Time is in seconds (for {frame_time:g} ms "
+                       f"write Frame Time: {frame_time / 1000:g})", first_line + 1)
     return _motion_from_channels(skeleton, values, snap_fps(1.0 / frame_time), source)
 
 

@@ -301,6 +301,13 @@ def run(cfg: DictConfig, extra_callbacks: list[pl.Callback] | None = None,
     datamodule, model = build(cfg, datamodule_args)
     # a resume is checked against the configured model before the run folder is touched
     resumed_at = check_resume_checkpoint(ckpt_path, model) if ckpt_path is not None else None
+    finished = output_dir / "metrics.json"
+    if resumed_at is not None and finished.is_file() and nothing_left_to_train(ckpt_path, cfg.trainer):
+        # a finished run (a requeued job's ckpt_path=auto): not a new start, so not one of its files is touched
+        log.info("%s: the run had finished at step %d and its trainer limits are reached: nothing trained, "
+                 "%s kept as it is", ckpt_path, resumed_at, output_dir)
+        return {"trainer": None, "model": model, "datamodule": datamodule,
+                "metrics": read_json(finished, "metrics file of the finished run")}
     record = record_start(output_dir, cfg, ckpt_path)
     _write_text(output_dir / "config_resolved.yaml", OmegaConf.to_yaml(cfg, resolve=True))
     trainer: pl.Trainer = instantiate(cfg.trainer, callbacks=callbacks, logger=loggers or False,
@@ -314,7 +321,6 @@ def run(cfg: DictConfig, extra_callbacks: list[pl.Callback] | None = None,
     if cfg.get("train", True):
         # checkpoints hold tensors and plain values only, so they load without unpickling code
         trainer.fit(model, datamodule=datamodule, ckpt_path=ckpt_path, weights_only=True)
-        finished = output_dir / "metrics.json"
         if resumed_at is not None and trainer.global_step == resumed_at and finished.is_file():
             log.info("%s: the run had finished at step %d and its trainer limits are reached: nothing trained, "
                      "%s kept as it is", ckpt_path, resumed_at, finished)
@@ -384,6 +390,25 @@ def check_resume_checkpoint(ckpt_path: str, model: pl.LightningModule) -> int:
         raise ResumeCheckpointError(f"{where}: its weights do not fit the configured {type(model).__name__} — "
                                     + "; ".join(bad[:3]) + (" …" if len(bad) > 3 else ""))
     return step
+
+
+def nothing_left_to_train(ckpt_path: str, trainer_cfg: Mapping[str, Any]) -> bool:
+    """True when resuming from ``ckpt_path`` would train nothing: its completed epochs reach the trainer's
+    ``max_epochs``, its global step reaches ``max_steps``, or early stopping had stopped it."""
+    from stylemotion.models.checkpoints import read_checkpoint
+
+    checkpoint = read_checkpoint(ckpt_path, "checkpoint")
+    step = int(checkpoint.get("global_step") or 0)
+    progress = ((checkpoint.get("loops") or {}).get("fit_loop") or {}).get("epoch_progress") or {}
+    epochs = int(((progress.get("current") or {}).get("completed")) or checkpoint.get("epoch") or 0)
+    max_epochs, max_steps = trainer_cfg.get("max_epochs"), trainer_cfg.get("max_steps")
+    if max_steps is not None and max_steps >= 0 and step >= max_steps:
+        return True
+    if max_epochs is not None and max_epochs >= 0 and epochs >= max_epochs:
+        return True
+    stopped = [state.get("stopped_epoch") for name, state in (checkpoint.get("callbacks") or {}).items()
+               if str(name).startswith("EarlyStopping") and isinstance(state, Mapping)]
+    return any(isinstance(e, int) and e > 0 for e in stopped)
 
 
 def record_start(output_dir: Path, cfg: DictConfig, ckpt_path: str | None) -> dict[str, Any]:

@@ -4,6 +4,7 @@ out of the run folder."""
 
 from __future__ import annotations
 
+import json
 import shutil
 
 import pytest
@@ -13,7 +14,7 @@ from hydra import compose, initialize_config_dir
 
 from stylemotion.config import config_dir
 from stylemotion.io.outputs import UnsafePathError
-from stylemotion.training.fit import ResumeCheckpointError, run
+from stylemotion.training.fit import ResumeCheckpointError, nothing_left_to_train, run
 
 SMOKE = ["experiment=smoke", "data=synthetic", "data.takes_per_pair=3", "data.duration_s=4.0",
          "data.styles=[normal,elderly]", "data.contents=[walk,run]"]
@@ -65,12 +66,28 @@ def test_junk_truncated_and_foreign_checkpoints_are_refused_by_name(run_copy, tm
     assert _snapshot(run_copy) == before
 
 
-def test_resuming_a_finished_run_with_nothing_to_train_keeps_its_metrics(run_copy):
-    metrics = run_copy / "metrics.json"
-    before = (metrics.stat().st_mtime_ns, metrics.read_bytes())
-    result = run(_cfg(f"output_dir={run_copy}", "ckpt_path=auto"))
-    assert (metrics.stat().st_mtime_ns, metrics.read_bytes()) == before
+@pytest.mark.parametrize("ckpt_path", ["auto", "last"])
+def test_resuming_a_finished_run_with_nothing_to_train_touches_none_of_its_files(run_copy, ckpt_path):
+    before = _snapshot(run_copy)
+    result = run(_cfg(f"output_dir={run_copy}", f"ckpt_path={ckpt_path}"))
+    assert _snapshot(run_copy) == before  # metrics.json, config_resolved.yaml (run_id), run.json, checkpoints
+    assert result["metrics"] == json.loads((run_copy / "metrics.json").read_text())
     assert result["metrics"]["best_score"] is not None
+
+
+def test_what_is_left_to_train_is_read_from_the_checkpoint(finished):
+    last = str(finished / "checkpoints" / "last.ckpt")
+    state = torch.load(last, map_location="cpu", weights_only=True)
+    epochs, step = state["loops"]["fit_loop"]["epoch_progress"]["current"]["completed"], state["global_step"]
+    assert nothing_left_to_train(last, {"max_epochs": epochs, "max_steps": -1})
+    assert nothing_left_to_train(last, {"max_epochs": epochs + 5, "max_steps": step})
+    assert not nothing_left_to_train(last, {"max_epochs": epochs + 5, "max_steps": -1})
+
+
+def test_a_finished_run_given_more_epochs_trains_on(run_copy):
+    result = run(_cfg(f"output_dir={run_copy}", "ckpt_path=last", "trainer.max_epochs=4", "trainer.max_steps=-1"))
+    assert result["trainer"].current_epoch == 4
+    assert len(json.loads((run_copy / "run.json").read_text())["starts"]) == 2
 
 
 def test_force_refuses_a_checkpoint_folder_that_links_out_of_the_run(run_copy, tmp_path):

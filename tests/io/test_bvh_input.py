@@ -11,7 +11,7 @@ import pytest
 from conftest import TINY_BVH_FRAMES, line_of, tiny_bvh_text
 
 from stylemotion.io.bvh import format_bvh, parse_bvh, read_bvh
-from stylemotion.io.errors import BvhError, LimitError, MotionDataWarning
+from stylemotion.io.errors import BvhError, LimitError
 
 
 def deep_chain_text(depth: int, frames: int = 2) -> str:
@@ -88,14 +88,13 @@ def test_non_utf8_hierarchy_names_its_line(write_text):
     assert err.value.line == line_of(text, "JOINT Head") and "UTF-8" in err.value.detail
 
 
-def test_frame_time_in_milliseconds_warns_naming_the_file_and_line():
-    frames = TINY_BVH_FRAMES * 4  # 12 frames
+def test_frame_time_in_milliseconds_is_refused_naming_the_file_and_line():
+    frames = TINY_BVH_FRAMES * 4  # 12 frames: resampled to 30 fps they would be 12,000 (issue 26)
     text = tiny_bvh_text(frames, frame_time="33.3333")
-    with pytest.warns(MotionDataWarning, match="milliseconds") as record:
-        motion = parse_bvh(text, "ms.bvh")
-    assert motion.num_frames == 12
-    assert str(record[0].message).startswith(f"ms.bvh:{line_of(text, 'Frame Time:')}: ")
-    assert "0.0333333" in str(record[0].message)  # the value meant
+    with pytest.raises(BvhError, match="milliseconds") as err:
+        parse_bvh(text, "ms.bvh")
+    assert str(err.value).startswith(f"ms.bvh:{line_of(text, 'Frame Time:')}: ")
+    assert "0.0333333" in str(err.value)  # the value meant
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         parse_bvh(tiny_bvh_text(frames), "seconds.bvh")  # 30 fps: no warning
