@@ -165,7 +165,7 @@ def _bvh_variants(good: str, rng: random.Random) -> dict[str, bytes | None]:
 
 #: Variants a reader must accept (exit 0, finite output), and those that load but must warn (file named).
 VALID_BVH = {"good", "crlf"}
-WARN_BVH = {"zup", "millisecond"}
+WARN_BVH = {"zup"}
 
 
 def _special_files(inputs: Path, name: str) -> None:
@@ -445,8 +445,13 @@ def build_cases(p: Inputs) -> list[Case]:
            "frame_time_negative", "frame_time_nan", "frame_time_huge", "channels_wrong", "row_too_long",
            "offset_huge", "deep_nesting", "utf16", "unknown_skeleton", "folder", "fifo", "loop_link",
            "dangling_link", "dev_zero", "huge_file"]
+    #: the readers' kinds for the commands that load a database first (seconds per case)
     fewer = ["good", "zup", "millisecond", "empty", "binary", "cut_in_motion", "frames_huge", "number_nan",
-             "frame_time_zero", "unknown_skeleton", "fifo", "loop_link", "dev_zero"]
+             "unknown_skeleton", "fifo", "loop_link", "huge_file"]
+    fewest = ["good", "millisecond", "binary", "number_nan", "unknown_skeleton", "fifo"]
+    #: the viewer reads BVH files as convert does: the kinds of another path through the reader
+    viewed = ["good", "zup", "empty", "binary", "cut_in_motion", "frames_huge", "number_nan", "frame_time_zero",
+              "deep_nesting", "utf16", "folder", "fifo", "loop_link", "dev_zero", "huge_file"]
 
     def expect_of(name: str) -> tuple[str, tuple[str, ...]]:
         if name in VALID_BVH:
@@ -460,15 +465,19 @@ def build_cases(p: Inputs) -> list[Case]:
         names = (f"{name}.bvh",)
         add("stylemotion-convert", f"bvh_{name}", [i(f"{name}.bvh"), "out.npz"], expect, "BVH file", names,
             out=("out.npz",), warn=warn, timeout=90)
-        add("stylemotion-view", f"bvh_{name}", [i(f"{name}.bvh"), "--out", "out"], expect, "BVH file", names,
-            warn=warn, timeout=90)
-        add("stylemotion-search", f"bvh_{name}", [*DATA, f"query={i(name + '.bvh')}", "out=out"],
-            "either" if name == "one_frame" else expect, "BVH file", names, warn=warn)
+        if name in viewed:
+            add("stylemotion-view", f"bvh_{name}", [i(f"{name}.bvh"), "--out", "out"], expect, "BVH file", names,
+                warn=warn, timeout=90)
     for name in fewer:
         expect, warn = expect_of(name)
         names = (f"{name}.bvh",)
+        add("stylemotion-search", f"bvh_{name}", [*DATA, f"query={i(name + '.bvh')}", "out=out"], expect,
+            "BVH file", names, warn=warn)
         add("stylemotion-reconstruct", f"bvh_{name}", [*DATA, f"markers={i(name + '.bvh')}", "out=out", "gif=false"],
             expect, "BVH file", names, warn=warn)
+    for name in fewest:
+        expect, warn = expect_of(name)
+        names = (f"{name}.bvh",)
         add("stylemotion-texture", f"bvh_{name}", [*DATA, f"motion={i(name + '.bvh')}", "out=out", "gif=false"],
             expect, "BVH file", names, warn=warn)
         add("stylemotion-annotate", f"bvh_{name}",
@@ -477,7 +486,7 @@ def build_cases(p: Inputs) -> list[Case]:
         if name not in VALID_BVH | WARN_BVH:  # a valid example would train CVAEs (minutes): refusals only
             add("stylemotion-style", f"bvh_{name}",
                 [f"example={i(name + '.bvh')}", f"run={repro}", "name=mine", "out=out"], expect, "BVH file", names)
-    for name in ("good", "empty", "binary", "number_nan", "fifo", "frame_time_zero", "millisecond", "zup"):
+    for name in ("good", "binary", "fifo", "millisecond"):
         expect, warn = expect_of(name)
         add("stylemotion-keyframes", f"motion_{name}", [*DATA, f"keys={i(f'keys_motion_{name}.json')}", "out=out",
                                                         "gif=false"],
@@ -485,19 +494,15 @@ def build_cases(p: Inputs) -> list[Case]:
 
     # --- stylemotion-data --------------------------------------------------------------------------------------
     data = "stylemotion-data"
-    for name in ("good", "fifo", "loop_link", "dangling_link", "folder", "empty", "binary", "number_nan",
-                 "millisecond", "unknown_skeleton"):
+    for name in ("good", "fifo", "loop_link", "dangling_link", "binary", "millisecond"):
         add(data, f"folder_with_{name}", ["data=bvh_folder", f"data.root={p.inputs / 'folders' / name}"],
             "answered" if name == "good" else "either", "BVH folder", (f"{name}.bvh",), out=("hydra",),
             warn=() if name == "good" else (f"{name}.bvh",))
     for override, names in [
-        ("data.fps=0", ["data.fps"]), ("data.fps=nan", ["data.fps"]), ("data.fps=-30", ["data.fps"]),
-        ("data.fps=1e308", ["data.fps"]), ("data.duration_s=-1", ["data.duration_s"]),
+        ("data.fps=0", ["data.fps"]), ("data.fps=nan", ["data.fps"]), ("data.fps=1e308", ["data.fps"]),
         ("data.duration_s=1e9", ["data.duration_s"]), ("data.takes_per_pair=-3", ["data.takes_per_pair"]),
-        ("data.takes_per_pair=1000000", ["data.takes_per_pair"]), ("data.contents=[fly]", ["fly"]),
-        ("data.styles=[]", ["data.styles"]), ("data.split.val_fraction=1.5", ["val_fraction", "1.5"]),
-        ("data.split.test_fraction=-0.1", ["test_fraction", "-0.1"]), ("data.split.seed=abc", ["seed", "abc"]),
-        ("data.nope=1", ["nope"]),
+        ("data.contents=[fly]", ["fly"]), ("data.styles=[]", ["data.styles"]),
+        ("data.split.val_fraction=1.5", ["val_fraction", "1.5"]), ("data.nope=1", ["nope"]),
     ]:
         add(data, f"value_{override}", [override], "refused", "bad Hydra value", names, out=("hydra",))
     for args, names, kind in [
@@ -529,10 +534,9 @@ def build_cases(p: Inputs) -> list[Case]:
     # --- stylemotion-train --------------------------------------------------------------------------------------
     tr = "stylemotion-train"
     smoke = SMOKE
-    for override, names in [("seed=abc", ["seed"]), ("seed=-1", ["seed"]), ("trainer.max_epochs=-5", ["max_epochs"]),
+    for override, names in [("seed=abc", ["seed"]), ("trainer.max_epochs=-5", ["max_epochs"]),
                             ("model.hidden_units=0", ["hidden_units"]), ("datamodule.batch_size=0", ["batch_size"]),
-                            ("data.fps=0", ["data.fps"]), ("model.lr=nan", ["lr", "nan"]),
-                            ("threads=0", ["threads"]), ("experiment=nope", ["nope"]), ("ckpt_path=last", ["last"])]:
+                            ("model.lr=nan", ["lr", "nan"]), ("experiment=nope", ["nope"])]:
         add(tr, f"value_{override}", [*smoke, override], "refused", "bad Hydra value", names, out=("hydra",))
     for name in ("empty", "junk", "cut", "foreign", "autoencoder", "malicious", "nan_weights"):
         add(tr, f"ckpt_{name}", [*smoke, f"ckpt_path={i(name + '.ckpt')}"], "refused", "checkpoint",
@@ -569,10 +573,8 @@ def build_cases(p: Inputs) -> list[Case]:
     rp = "stylemotion-reproduce"
     tiny = ["data.takes_per_pair=2", "data.duration_s=3.0", "data.styles=[normal,elderly]", "data.contents=[walk]"]
     for override, names in [("styles=[nope]", ["nope"]), ("primitives=[nope]", ["nope"]),
-                            ("primitives=[run_leftStance]", ["run_leftStance"]),
                             ("evaluation.neutral_style=nope", ["nope"]), ("workers=0", ["workers"]),
-                            ("workers=-2", ["workers"]), ("seed=abc", ["seed"]), ("threads=-1", ["threads"]),
-                            ("executor=nope", ["nope"]), ("evaluation.samples.table_5_1=0", ["table_5_1"])]:
+                            ("seed=abc", ["seed"]), ("evaluation.samples.table_5_1=0", ["table_5_1"])]:
         add(rp, f"value_{override}", [*tiny, override, "out=out"], "refused", "bad Hydra value", names,
             out=("out", "hydra"))
     add(rp, "out_is_file", [*tiny, "out=afile"], "refused", "out is a file", ("afile",), setup=_file("afile"),
@@ -674,13 +676,12 @@ def build_cases(p: Inputs) -> list[Case]:
     # --- stylemotion-search -------------------------------------------------------------------------------------
     se = "stylemotion-search"
     q = f"query={TAKE}:0-30"
-    for override, names in [("k=0", ["k"]), ("k=-1", ["k"]), ("top=0", ["top"]), ("features=bogus", ["bogus"]),
-                            ("engine=bogus", ["bogus"]), ("radius=nan", ["radius"]), ("eps=-1", ["eps"]),
-                            ("normalize=bogus", ["bogus"]), ("k=1e12", ["k"])]:
+    for override, names in [("k=0", ["k"]), ("top=0", ["top"]), ("features=bogus", ["bogus"]),
+                            ("radius=nan", ["radius"]), ("k=1e12", ["k"])]:
         add(se, f"value_{override}", [*DATA, q, override, "out=out"], "refused", "bad Hydra value", names)
-    for query, names in [(f"{TAKE}:0-99999", ["99999"]), (f"{TAKE}:50-10", ["50-10"]), (f"{TAKE}:a-b", ["a-b"]),
+    for query, names in [(f"{TAKE}:0-99999", ["99999"]), (f"{TAKE}:50-10", ["50-10"]),
                          ("nope", ["nope"]), (f"{i('good.bvh')}:0-99999", ["99999"]),
-                         (f"{i('good.bvh')}:-5-10", ["-5"]), (f"{i('notes.txt')}", ["notes.txt"]),
+                         (f"{i('notes.txt')}", ["notes.txt"]),
                          (f"{i('member.zip')}::../walk.bvh", ["../walk.bvh"]),
                          (f"{i('member.zip')}::missing.bvh", ["missing.bvh"])]:
         add(se, f"query_{query.replace(str(p.inputs) + '/', '')}", [*DATA, f"query={query}", "out=out"], "refused",
@@ -727,15 +728,13 @@ def build_cases(p: Inputs) -> list[Case]:
     rc = "stylemotion-reconstruct"
     for name in ("markers.csv", "markers.npz"):
         add(rc, f"file_{name}", [*DATA, f"markers={i(name)}", "out=out", "gif=false"], "answered", "valid input")
-    for name in ("markers_nan.csv", "markers_huge.csv", "markers_short_rows.csv", "markers_header_only.csv",
-                 "markers_unknown_joint.csv", "markers_no_header.csv", "markers_wrong_shape.npz",
-                 "markers_nan.npz", "markers_fps_zero.npz", "pickled.npz", "pickle.npz", "notes.txt"):
+    for name in ("markers_nan.csv", "markers_huge.csv", "markers_short_rows.csv", "markers_unknown_joint.csv",
+                 "markers_wrong_shape.npz", "markers_nan.npz", "markers_fps_zero.npz", "pickle.npz"):
         expect = "either" if name == "markers_nan.csv" else "refused"  # one gap may be filled, named
         add(rc, f"file_{name}", [*DATA, f"markers={i(name)}", "out=out", "gif=false"], expect, "marker file",
             (name,), warn=(name,) if expect == "either" else ())
-    for override, names in [(f"markers={TAKE}:a-b", ["a-b"]), (f"markers={TAKE}:0-99999", ["99999"]),
-                            ("k=0", ["k"]), ("joints=[Nope]", ["Nope"]), ("noise_mm=nan", ["noise_mm"]),
-                            ("model.variance=2", ["variance"]), ("features=bogus", ["bogus"])]:
+    for override, names in [(f"markers={TAKE}:a-b", ["a-b"]), ("k=0", ["k"]), ("joints=[Nope]", ["Nope"]),
+                            ("noise_mm=nan", ["noise_mm"])]:
         args = [*DATA, override] if override.startswith("markers=") else [*DATA, f"markers={TAKE}:0-60", override]
         add(rc, f"value_{override}", [*args, "out=out", "gif=false"], "refused", "bad Hydra value", names)
     add(rc, "good_take", [*DATA, f"markers={TAKE}:0-60", "out=out", "gif=false"], "answered", "valid input")
@@ -743,16 +742,14 @@ def build_cases(p: Inputs) -> list[Case]:
     # --- stylemotion-keyframes ----------------------------------------------------------------------------------
     kf = "stylemotion-keyframes"
     for name in ("keys_time_huge", "keys_time_1e9", "keys_time_negative", "keys_time_equal",
-                 "keys_frame_out_of_range", "keys_unknown_take", "keys_positions_wrong_shape",
-                 "keys_positions_nan", "keys_one_key", "keys_empty", "keys_not_object", "keys_every_zero",
-                 "keys_every_nan", "keys_cut", "keys_turn_huge"):
+                 "keys_frame_out_of_range", "keys_positions_wrong_shape", "keys_positions_nan", "keys_one_key",
+                 "keys_not_object", "keys_every_zero", "keys_every_nan", "keys_cut", "keys_turn_huge"):
         add(kf, f"file_{name}", [*DATA, f"keys={i(name + '.json')}", "out=out", "gif=false"], "refused", "keys file",
             (f"{name}.json",))
     add(kf, "keys_missing", [*DATA, "keys=/nonexistent/keys.json", "out=out"], "refused", "keys file",
         ("keys.json",))
     add(kf, "keys_fifo", [*DATA, f"keys={i('fifo.bvh')}", "out=out"], "refused", "FIFO", ("fifo.bvh",))
-    for override, names in [("model.k=0", ["model.k", "k"]), ("model.max_iterations=-1", ["max_iterations"]),
-                            ("model.voxel_m=0", ["voxel_m"])]:
+    for override, names in [("model.k=0", ["model.k", "k"]), ("model.voxel_m=0", ["voxel_m"])]:
         add(kf, f"value_{override}", [*DATA, f"keys={i('keys_good.json')}", override, "out=out"], "refused",
             "bad Hydra value", names)
     add(kf, "good", [*DATA, f"keys={i('keys_good.json')}", "out=out", "gif=false"], "either", "valid input",
@@ -760,11 +757,10 @@ def build_cases(p: Inputs) -> list[Case]:
 
     # --- stylemotion-texture ------------------------------------------------------------------------------------
     tx = "stylemotion-texture"
-    for override, names in [("mode=bogus", ["bogus"]), ("k=0", ["k"]), ("joints=[Nope]", ["Nope"]),
-                            ("model.top=0", ["top"]), ("model.weights={pose: nan}", ["pose", "nan"])]:
+    for override, names in [("mode=bogus", ["bogus"]), ("k=0", ["k"]), ("model.weights={pose: nan}", ["pose", "nan"])]:
         add(tx, f"value_{override}", [*DATA, f"motion={TAKE}:0-60", override, "out=out"], "refused",
             "bad Hydra value", names)
-    for name in ("markers_nan.npz", "markers_wrong_shape.npz", "pickled.npz", "notes.txt"):
+    for name in ("markers_nan.npz", "pickled.npz"):
         add(tx, f"file_{name}", [*DATA, f"motion={i(name)}", "out=out"], "refused", "motion file", (name,))
     add(tx, "good_take", [*DATA, f"motion={TAKE}:0-60", "out=out", "gif=false"], "answered", "valid input")
 
@@ -816,12 +812,10 @@ def build_cases(p: Inputs) -> list[Case]:
 
     # --- stylemotion-view (beyond the BVH kinds) ----------------------------------------------------------------
     vw = "stylemotion-view"
-    for extra, names in [(["--spacing", "nan"], ["--spacing"]), (["--spacing", "-1"], ["--spacing"]),
-                         (["--spacing", "1e308"], ["--spacing"]), (["--fps", "0"], ["--fps"]),
-                         (["--max-samples", "0"], ["--max-samples"]), (["--port", "99999"], ["--port"]),
-                         (["--layout", "bogus"], ["bogus"])]:
+    for extra, names in [(["--spacing", "nan"], ["--spacing"]), (["--spacing", "1e308"], ["--spacing"]),
+                         (["--fps", "0"], ["--fps"]), (["--max-samples", "0"], ["--max-samples"])]:
         add(vw, f"value_{'_'.join(extra)}", [good_bvh, "--out", "out", *extra], "refused", "bad argument", names)
-    for name in ("pickled.npz", "pickle.npz", "markers_wrong_shape.npz", "markers_nan.npz", "notes.txt"):
+    for name in ("pickled.npz", "pickle.npz", "markers_wrong_shape.npz", "markers_nan.npz"):
         add(vw, f"file_{name}", [i(name), "--out", "out"], "refused", "motion file", (name,))
     add(vw, "run_folder", [str(repro), "--out", "out"], "either", "run folder", (str(repro),))
     add(vw, "missing", ["/nonexistent/walk.bvh", "--out", "out"], "refused", "missing file", ("walk.bvh",))
