@@ -7,7 +7,10 @@ uncovered, so every frame of a take of at least one window's length is seen. Tak
 one window are left out (counted in :attr:`MotionWindowDataModule.summary`).
 
 The split is by take (:meth:`stylemotion.datasets.TakeSet.split`, seeded, with the data config's
-``split`` settings); the per-channel z-score statistics come from the train split only. Batches are
+``split`` settings); the per-channel z-score statistics come from the train split only. ``exclude_styles``
+drops every take of those styles from every split *after* splitting, so the other takes keep the parts they
+have in the full data (an autoencoder that never saw a style, for the leave-one-style-out evaluation of
+:mod:`stylemotion.evaluation.zero_shot`, shares the full run's split). Batches are
 raw (un-normalized) frames ``(batch, window_frames, 66)``: the model owns its normalization.
 """
 
@@ -34,6 +37,10 @@ SPLITS = ("train", "val", "test")
 
 class EmptySplitError(UserInputError, ValueError):
     """A split needed for training or testing holds no window."""
+
+
+class UnknownStyleError(UserInputError, ValueError):
+    """``datamodule.exclude_styles`` names a style the data does not have (or leaves none)."""
 
 
 def window_starts(num_frames: int, window: int, stride: int, cover_tail: bool = True) -> list[int]:
@@ -101,6 +108,7 @@ class MotionWindowDataModule(SplitDataModule):
         num_workers: DataLoader worker processes (0 = load in the training process).
         std_floor: smallest per-channel standard deviation (see :mod:`.normalization`).
         split: split settings (``seed``, ``val_fraction``, ``test_fraction``); None = ``data.split``.
+        exclude_styles: styles whose takes no split holds (see the module doc).
     """
 
     #: What a model checks the data against (see ``MotionAutoencoder.check_compatible``).
@@ -119,10 +127,14 @@ class MotionWindowDataModule(SplitDataModule):
         num_workers: int = 0,
         std_floor: float = DEFAULT_STD_FLOOR,
         split: Mapping[str, Any] | None = None,
+        exclude_styles: Sequence[str] = (),
     ):
         super().__init__(data, takeset, batch_size, eval_batch_size, num_workers, split)
         if window_frames < 2 or stride < 1:
             raise ValueError(f"need window_frames ≥ 2 and stride ≥ 1; got {window_frames}, {stride}")
+        if isinstance(exclude_styles, str) or not all(isinstance(s, str) for s in exclude_styles or []):
+            raise UnknownStyleError(f"datamodule.exclude_styles must be a list of style names, got {exclude_styles!r}")
+        self.exclude_styles = list(exclude_styles or [])
         self.save_hyperparameters(ignore=["takeset"])
         self.window_frames, self.stride, self.cover_tail = window_frames, stride, cover_tail
         self.std_floor = std_floor
@@ -142,7 +154,7 @@ class MotionWindowDataModule(SplitDataModule):
     def setup(self, stage: str | None = None) -> None:
         takeset = self.takeset
         if not self.split_takes:
-            self.split_takes = takeset.split(**self.split_cfg)
+            self.split_takes = self._without_excluded(takeset.split(**self.split_cfg))
             for name in SPLITS:
                 self.datasets[name] = WindowDataset(self.split_takes[name], self.window_frames, self.stride,
                                                     self.cover_tail)
@@ -158,6 +170,20 @@ class MotionWindowDataModule(SplitDataModule):
             self._require(name)
         if self.mean is None:
             self.mean, self.std = channel_stats([self.datasets["train"].frames.numpy()], self.std_floor)
+
+    def _without_excluded(self, parts: dict[str, list[Take]]) -> dict[str, list[Take]]:
+        """``parts`` without the takes of ``exclude_styles`` (each of which must be a style of the data)."""
+        if not self.exclude_styles:
+            return parts
+        styles = self.takeset.label_values("style")
+        unknown = [s for s in self.exclude_styles if s not in styles]
+        if unknown:
+            raise UnknownStyleError(f"datamodule.exclude_styles: style(s) {unknown} are not in dataset "
+                                    f"{self.takeset.name!r} (styles: {styles}); name styles of the data")
+        if not set(styles) - set(self.exclude_styles):
+            raise UnknownStyleError(f"datamodule.exclude_styles {self.exclude_styles} leaves no style of dataset "
+                                    f"{self.takeset.name!r} to train on")
+        return {name: [t for t in takes if t.style not in self.exclude_styles] for name, takes in parts.items()}
 
     def _require(self, name: str) -> None:
         if len(self.datasets[name]):

@@ -1,23 +1,29 @@
-"""Leave-one-style-out evaluation of the zero-shot style network against a reproduce run's style CVAEs.
+"""Leave-one-style-out evaluation of the zero-shot style network, without leakage, against a reproduce run's CVAEs.
 
-    python scripts/zero_shot_loso.py --run runs/reproduce/synthetic --out runs/zero_shot/synthetic
+    python scripts/benchmarks.py run zero_shot --run <finished reproduce run>      # the suite (3 seeds)
 
 For each primitive ``p`` of a finished ``stylemotion-reproduce`` run and each of its CVAE styles ``s``
-(or ``styles``):
+(or ``styles``), with one ``seed`` (of the autoencoder, the network and the samples):
 
-1. a :class:`~stylemotion.models.zero_shot.ZeroShotStyleVAE` trained **without any clip of s**
-   (``experiment=zero_shot``, ``datamodule.exclude_styles=[s]``; the run's data, seed and autoencoder) into
-   ``<out>/models/<p>_without_<s>/``, or the checkpoint of an earlier output (``checkpoints``);
+1. **a generator that never saw s**: an autoencoder trained without any take of ``s`` (the run's autoencoder
+   stage settings on the run's data and split, ``datamodule.exclude_styles=[s]``) into
+   ``<out>/autoencoders/without_<s>/``, and on its features a
+   :class:`~stylemotion.models.zero_shot.ZeroShotStyleVAE` trained without any clip of ``s``
+   (``experiment=zero_shot``, ``datamodule.exclude_styles=[s]``) into ``<out>/models/<p>_without_<s>/``;
 2. conditioned on s's example: the clip(s) the run's CVAE of ``(p, s)`` was trained with (its recorded
-   ``spec.style_examples``), encoded at the canonical length as the network's training examples were;
-3. ``samples`` samples of it and of that CVAE (same seed), and for each:
+   ``spec.style_examples``), encoded by the generator's autoencoder at the canonical length, as the network's
+   training examples were;
+3. ``samples`` samples of it, decoded to motion by **its own** autoencoder (its feature statistics and its frame
+   normalization), and ``samples`` samples of the run's CVAE of s (the supervised baseline: it was trained on
+   s's example), and for each, measured in **one judge space**, the run's autoencoder and style classifier
+   (trained on every style, s included, as an FID network is: a fixed measuring instrument that never
+   generates; the decoded frames are re-encoded there with the judge's own normalization):
 
    * **recognition**: the share the run's style classifier assigns to ``s``
-     (:func:`stylemotion.evaluation.pipeline.real_side`, fitted on the train split of every style, s
-     included: an outside judge, never a generator);
-   * **Table 5.1 row**: the mean Gram distance of the samples to every column of the run's Table 5.1
-     (the neutral mean motion and each CVAE style's example; :func:`stylemotion.evaluation.tables.distance_table`)
-     and whether s's own column is the row's minimum;
+     (:func:`stylemotion.evaluation.pipeline.real_side`, fitted on the train split of every style);
+   * **Table 5.1 row**: the mean Gram distance, in the judge autoencoder's features, of the samples to every
+     column of the run's Table 5.1 (the neutral mean motion and each CVAE style's example;
+     :func:`stylemotion.evaluation.tables.distance_table`) and whether s's own column is the row's minimum;
    * ``pose_across_sd`` (cm): the spread across samples at aligned frames (a model that copies the example
      scores near 0);
 
@@ -25,11 +31,16 @@ For each primitive ``p`` of a finished ``stylemotion-reproduce`` run and each of
 
 4. ``<out>/zero_shot.json`` and ``<out>/zero_shot.md``.
 
-``out`` must not exist (``force`` replaces it).
+``shared_autoencoder=True`` keeps the earlier protocol: the network is trained on the run's autoencoder, which
+saw s. Its output is labelled **leaky** (``meta.leaky``) and is no evidence that the network generalizes to an
+unseen style. ``out`` must not exist unless ``force`` (replace it) or ``resume`` (reuse the finished trainings in
+it, resume interrupted ones).
 """
 
 from __future__ import annotations
 
+import hashlib
+import json
 import logging
 import math
 import shutil
@@ -47,17 +58,19 @@ from stylemotion.config import config_dir, positive_int, set_torch_threads
 from stylemotion.datasets import TakeSet, build_dataset
 from stylemotion.evaluation.pipeline import example_column_gram, real_side, recognition
 from stylemotion.evaluation.settings import EvalSettings
-from stylemotion.evaluation.sources import check_one_autoencoder
+from stylemotion.evaluation.sources import MixedAutoencodersError, check_one_autoencoder
 from stylemotion.evaluation.tables import across_sample_sd, distance_table
 from stylemotion.io.atomic import atomic_write_bytes
 from stylemotion.io.errors import UserInputError
+from stylemotion.io.jsonfile import read_json_object as read_record
 from stylemotion.io.jsonfile import write_json
-from stylemotion.io.outputs import check_new_output, inside
-from stylemotion.models.checkpoints import fingerprint, load_autoencoder
+from stylemotion.io.outputs import check_new_output, inside, safe_name
+from stylemotion.models.checkpoints import fingerprint, load_autoencoder, read_checkpoint
 from stylemotion.models.loading import NEUTRAL, EvalModel, load_generative, load_model
 from stylemotion.models.zero_shot import ZeroShotStyleVAE
 from stylemotion.primitives.segmentation import parse_primitive
 from stylemotion.provenance import provenance
+from stylemotion.training.reproduction import stage_train_config
 from stylemotion.training.run_folder import FinishedRun, read_json_object
 
 log = logging.getLogger(__name__)
@@ -65,6 +78,9 @@ log = logging.getLogger(__name__)
 Say = Callable[[str], None]
 #: The rows of each left-out style: the two models, and the style's real clips.
 ROWS = ("zero_shot", "cvae", "real")
+#: What ``meta.leaky`` says of an output of the shared-autoencoder protocol.
+LEAKY = ("the networks were trained on the run's autoencoder, which was trained on every style, the left-out one "
+         "included: the left-out style leaked into the generator (not evidence of generalization to an unseen style)")
 
 
 class ZeroShotRunError(UserInputError, ValueError):
@@ -134,13 +150,24 @@ def hydra_configs() -> Iterator[None]:
         yield
 
 
+def _quiet(cfg: DictConfig) -> DictConfig:
+    """``cfg`` without a progress bar (several trainings in a row would fill the log)."""
+    with open_dict(cfg):
+        cfg.trainer.enable_progress_bar = False
+        if cfg.get("callbacks") and "progress_bar" in cfg.callbacks:
+            cfg.callbacks.progress_bar = None
+    return cfg
+
+
 def network_train_config(run: FinishedRun, primitive: str, folder: Path, epochs: int | None = None,
                          overrides: Sequence[str] = (), threads: Any = None, exclude: Sequence[str] = (),
-                         epochs_key: str = "epochs") -> DictConfig:
+                         epochs_key: str = "epochs", autoencoder_ckpt: str | Path | None = None,
+                         seed: int | None = None) -> DictConfig:
     """The ``train`` config of a zero-shot network of ``primitive`` on ``run``'s data, started afresh in
     ``folder``: ``experiment=zero_shot``, ``trainer.max_epochs=epochs`` (None: the experiment's; ``epochs_key``
-    names it in errors), the ``overrides``, then the run's data, seed, autoencoder and neutral style, and
-    ``exclude`` left out. Composes inside Hydra's config search (:func:`hydra_configs`)."""
+    names it in errors), the ``overrides``, then the run's data and neutral style, ``seed`` (None: the run's),
+    ``autoencoder_ckpt`` (None: the run's autoencoder), and ``exclude`` left out. Composes inside Hydra's config
+    search (:func:`hydra_configs`)."""
     from hydra import compose
 
     listed = ["experiment=zero_shot"] + ([f"trainer.max_epochs={positive_int(epochs, epochs_key)}"] if epochs else [])
@@ -149,48 +176,103 @@ def network_train_config(run: FinishedRun, primitive: str, folder: Path, epochs:
     with open_dict(cfg):
         cfg.data = OmegaConf.create(run.data_cfg)
         cfg.output_dir = str(Path(folder).resolve())
-        cfg.seed = run.seed
+        cfg.seed = run.seed if seed is None else int(seed)
         if threads is not None:
             cfg.threads = positive_int(threads, "threads")
         cfg.primitive = primitive
-        cfg.autoencoder_ckpt = str(run.autoencoder_ckpt)
+        cfg.autoencoder_ckpt = str(run.autoencoder_ckpt if autoencoder_ckpt is None else autoencoder_ckpt)
         cfg.datamodule.neutral_style = run.settings.neutral_style
         cfg.datamodule.exclude_styles = list(exclude)
     return cfg
 
 
 def train_config(run: ReproduceRun, primitive: str, style: str, folder: Path, epochs: int | None = None,
-                 overrides: Sequence[str] = (), threads: Any = None) -> DictConfig:
+                 overrides: Sequence[str] = (), threads: Any = None, autoencoder_ckpt: str | Path | None = None,
+                 seed: int | None = None) -> DictConfig:
     """The ``train`` config of the zero-shot network of ``primitive`` without ``style``
-    (:func:`network_train_config`), without a progress bar."""
-    cfg = network_train_config(run, primitive, folder, epochs, overrides, threads, exclude=[style])
+    (:func:`network_train_config`: on ``autoencoder_ckpt``, None the run's), without a progress bar."""
+    return _quiet(network_train_config(run, primitive, folder, epochs, overrides, threads, exclude=[style],
+                                       autoencoder_ckpt=autoencoder_ckpt, seed=seed))
+
+
+def autoencoder_train_config(run: FinishedRun, style: str, folder: Path, seed: int | None = None,
+                             threads: Any = None) -> DictConfig:
+    """The ``train`` config of an autoencoder that never sees ``style``: the run's autoencoder stage (its Hydra
+    overrides as ``reproduce.json`` records them, its data and split), ``seed`` (None: the run's) and
+    ``datamodule.exclude_styles=[style]`` (every take of the style left out of every split, after splitting: the
+    other takes keep their parts), into ``folder``, without a progress bar."""
+    stage = run.stages("autoencoder")[0]
+    with hydra_configs():
+        cfg = stage_train_config(list(stage.get("overrides") or []), dict(stage.get("values") or {}), run.data_cfg,
+                                 folder, run.seed if seed is None else int(seed), threads)
     with open_dict(cfg):
-        cfg.trainer.enable_progress_bar = False
-        if cfg.get("callbacks") and "progress_bar" in cfg.callbacks:
-            cfg.callbacks.progress_bar = None
-    return cfg
+        cfg.datamodule.exclude_styles = [style]
+    return _quiet(cfg)
 
 
-def train_left_out(run: ReproduceRun, primitive: str, style: str, folder: Path, epochs: int | None = None,
-                   overrides: Sequence[str] = (), threads: Any = None) -> tuple[Path, float]:
-    """Train the zero-shot network of ``primitive`` without ``style`` into ``folder``; its best checkpoint
-    and the training seconds."""
+def _settings_hash(cfg: DictConfig) -> str:
+    """A hash of what a training computes from (``threads``, ``ckpt_path`` and the fresh ``run_id`` left out: they
+    change no figure)."""
+    values = {k: v for k, v in OmegaConf.to_container(cfg, resolve=True).items()
+              if k not in ("threads", "ckpt_path", "run_id")}
+    return hashlib.sha256(json.dumps(values, sort_keys=True, default=str).encode()).hexdigest()[:16]
+
+
+def train_once(cfg: DictConfig, what: str, say: Say = print) -> tuple[Path, float | None]:
+    """Train ``cfg`` into its ``output_dir``, or reuse the training that finished there with the same settings
+    (its ``done.json``); an interrupted one resumes from ``last.ckpt``. Returns the best checkpoint and the
+    training seconds (None when reused).
+
+    Raises:
+        ZeroShotRunError: the folder holds a finished training of other settings (delete it or choose another
+            output folder).
+    """
     from stylemotion.training.fit import run as train_run
 
+    folder = Path(cfg.output_dir)
+    done, settings = folder / "done.json", _settings_hash(cfg)
+    if done.is_file():
+        record = read_record(done, f"the record of {what}", f"delete {folder} to train it again")
+        checkpoint = folder / str(record.get("checkpoint"))
+        if record.get("settings_hash") != settings:
+            raise ZeroShotRunError(f"{folder} holds {what} trained with other settings (hash "
+                                   f"{record.get('settings_hash')}, now {settings}); delete it or choose another out")
+        if checkpoint.is_file():
+            say(f"{what}: reused {checkpoint}")
+            return checkpoint, None
+    with open_dict(cfg):
+        cfg.ckpt_path = "auto"
+    say(f"{what}: training")
     t0 = time.perf_counter()
-    metrics = train_run(train_config(run, primitive, style, folder, epochs, overrides, threads))["metrics"]
+    metrics = train_run(cfg)["metrics"]
     seconds = time.perf_counter() - t0
-    return Path(metrics.get("best_checkpoint") or folder / "checkpoints" / "last.ckpt"), seconds
+    best = Path(metrics.get("best_checkpoint") or folder / "checkpoints" / "last.ckpt").resolve()
+    write_json(done, {"settings_hash": settings, "checkpoint": str(best.relative_to(folder.resolve())),
+                      "seconds": seconds, "what": what})
+    say(f"    trained in {seconds / 60:.1f} min")
+    return best, seconds
+
+
+def autoencoder_excluded_styles(path: str | Path) -> list[str]:
+    """The styles an autoencoder checkpoint's training data left out (``datamodule.exclude_styles`` as Lightning
+    saved it; ``[]`` for one trained on every style)."""
+    saved = read_checkpoint(path, "autoencoder checkpoint").get("datamodule_hyper_parameters") or {}
+    return [str(s) for s in saved.get("exclude_styles") or []]
 
 
 def model_folder(out: Path, primitive: str, style: str) -> Path:
     """Where the network of ``primitive`` without ``style`` is trained: ``<out>/models/<p>_without_<s>``."""
-    return inside(out, "models", f"{primitive}_without_{style}")
+    return inside(out, "models", f"{primitive}_without_{safe_name(style, 'style label')}")
+
+
+def autoencoder_folder(out: Path, style: str) -> Path:
+    """Where the autoencoder without ``style`` is trained: ``<out>/autoencoders/without_<s>``."""
+    return inside(out, "autoencoders", f"without_{safe_name(style, 'style label')}")
 
 
 def load_left_out(path: Path, primitive: str, style: str, fingerprint: str) -> ZeroShotStyleVAE:
-    """A zero-shot checkpoint, checked to be of ``primitive``, trained without ``style`` and on the run's
-    autoencoder (``fingerprint``).
+    """A zero-shot checkpoint, checked to be of ``primitive``, trained without ``style`` and on the autoencoder
+    of weights ``fingerprint``.
 
     Raises:
         ZeroShotRunError: another kind of model, primitive, exclusion or autoencoder.
@@ -203,7 +285,7 @@ def load_left_out(path: Path, primitive: str, style: str, fingerprint: str) -> Z
         ("primitive", spec["primitive"], primitive), ("excluded_styles", model.excluded_styles, [style]),
         ("autoencoder", spec["autoencoder"]["fingerprint"], fingerprint)) if got != want]
     if bad:
-        raise ZeroShotRunError(f"{path} is not the leave-{style}-out network of {primitive} on this run: "
+        raise ZeroShotRunError(f"{path} is not the leave-{style}-out network of {primitive} on this autoencoder: "
                                + "; ".join(bad))
     return model
 
@@ -241,22 +323,43 @@ def _real_row(real, autoencoder, style: str, columns: list[str], grams: torch.Te
             "clips": len(truth)}
 
 
+def generator_autoencoder(network: ZeroShotStyleVAE) -> dict[str, Any]:
+    """``path``/``fingerprint`` of the autoencoder ``network`` decodes with, checked to be the one it was trained
+    on: its feature statistics (``feature_mean``/``feature_std``) and its decoder's frame normalization belong to
+    that autoencoder, so its samples are de-normalized there and only their decoded frames reach the judge.
+
+    Raises:
+        MixedAutoencodersError: the network decodes with another autoencoder than its features came from.
+    """
+    info = dict(network.spec["autoencoder"])
+    got = fingerprint(network.autoencoder)
+    if got != info["fingerprint"]:
+        raise MixedAutoencodersError(f"{network.checkpoint_file or 'the network'} decodes with an autoencoder of "
+                                     f"weights {got}, not the one it was trained on ({info['fingerprint']}, "
+                                     f"{info.get('path')}): load it again without attaching another autoencoder")
+    return {"path": info.get("path"), "fingerprint": got}
+
+
 def evaluate_primitive(primitive: str, left_out: Mapping[str, ZeroShotStyleVAE], cvaes: Sequence[EvalModel],
                        takeset: TakeSet, autoencoder, settings: EvalSettings, split: Mapping[str, Any] | None,
-                       samples: int, seed: int, say: Say = print) -> dict[str, Any]:
-    """Each left-out network of ``primitive`` against the CVAE of its style (see the module doc).
+                       samples: int, seed: int, say: Say = print, shared_autoencoder: bool = False) -> dict[str, Any]:
+    """Each left-out network of ``primitive`` against the CVAE of its style, in one judge space (module doc).
 
     Args:
-        left_out: style → the network trained without it.
+        left_out: style → the network trained without it, decoding with the autoencoder it was trained on
+            (:func:`generator_autoencoder`; for ``shared_autoencoder``, the judge ``autoencoder``).
         cvaes: the run's CVAEs of ``primitive`` (every style: each gives a Table 5.1 column), one per style
             of ``left_out`` at least.
         takeset, split, settings: the run's data, split and evaluation settings.
-        autoencoder: the run's autoencoder.
+        autoencoder: the judge: the run's autoencoder (its CVAEs' features, the Table 5.1 space). Samples
+            reach it as decoded frames and are re-encoded with its own frame normalization.
         samples, seed: samples per model and their seed.
+        shared_autoencoder: the networks must decode with the judge autoencoder itself (the leaky protocol).
 
     Raises:
         ZeroShotRunError: a left-out style without a CVAE, or a network on another timeline.
-        MixedAutoencodersError: models of different autoencoders.
+        MixedAutoencodersError: a network decoding with another autoencoder than its own (or, with
+            ``shared_autoencoder``, than the judge).
     """
     by_style = {m.style: m for m in cvaes}
     missing = [s for s in left_out if s not in by_style]
@@ -280,15 +383,19 @@ def evaluate_primitive(primitive: str, left_out: Mapping[str, ZeroShotStyleVAE],
             raise ZeroShotRunError(f"the {primitive} network without {style} uses a timeline of "
                                    f"{network.timeline_frames} frames, the run's models {real.length}: it was "
                                    "trained on other data (or datamodule.timeline)")
-        # the CVAE's example clip(s), encoded as the network's training examples were (canonical length)
+        generator = generator_autoencoder(network)
+        # the CVAE's example clip(s) (frames), encoded by the network's own autoencoder as its training examples
+        # were (canonical length); its samples come back as frames decoded by that autoencoder
         bound = network.bind_example(real.examples[cvae.name], style, cvae.examples)
         model = EvalModel(f"zero_shot:{style}", primitive, style, bound, list(cvae.examples),
                           dict(network.spec["autoencoder"]), network.checkpoint_file, network.timeline_frames,
                           bound.target_gram, network.spec.get("dataset"), "canonical")
-        check_one_autoencoder([cvae, model])
+        if shared_autoencoder:
+            check_one_autoencoder([cvae, model], fingerprint(autoencoder))
         say(f"{primitive}/{style}: {samples} samples of the network without {style} and of the {style} CVAE")
         out["styles"][style] = {
             "example": [dict(e) for e in cvae.examples], "trained_styles": network.styles,
+            "generator_autoencoder": generator,
             "zero_shot": _model_row(real, autoencoder, model, columns, grams, samples, seed, settings),
             "cvae": _model_row(real, autoencoder, cvae, columns, grams, samples, seed, settings),
             "real": _real_row(real, autoencoder, style, columns, grams, settings)}
@@ -308,32 +415,54 @@ def _summary(per_primitive: Mapping[str, Any]) -> dict[str, Any]:
     return out
 
 
+def splits_record(source: ReproduceRun, shared_autoencoder: bool) -> dict[str, Any]:
+    """What each model and the judge saw (the ``splits`` entry of ``zero_shot.json``)."""
+    return {
+        "data": {"kind": "by take", **dict(source.data_cfg.get("split") or {}), "group_by": ["content", "style"]},
+        "judge": "the run's autoencoder (Table 5.1 features) and style classifier (fitted on the train-split clips "
+                 "of every style, the left-out one included): a fixed measuring instrument that never generates",
+        "generator_autoencoder": (LEAKY if shared_autoencoder else
+                                  "the run's autoencoder stage settings on the run's split minus every take of the "
+                                  "left-out style (train, val and test): it never saw the style"),
+        "network": "the train-split clips of every style but the left-out one (val: its val-split clips), features "
+                   "of the generator's autoencoder",
+        "condition": "the example clip(s) of the run's CVAE of the left-out style",
+        "cvae": "the run's CVAE of the style: its neutral train clips plus the style's example clip (supervised "
+                "baseline; the run's autoencoder)",
+        "real": "the left-out style's clips of every split but its example",
+    }
+
+
 def leave_one_style_out(run: str | Path, out: str | Path, styles: Sequence[str] | None = None,
                         primitives: Sequence[str] | None = None, epochs: int | None = None, samples: int = 1000,
-                        seed: int | None = None, checkpoints: str | Path | None = None,
-                        overrides: Sequence[str] = (), threads: Any = None, force: bool = False,
+                        seed: int | None = None, overrides: Sequence[str] = (), threads: Any = None,
+                        force: bool = False, resume: bool = False, shared_autoencoder: bool = False,
                         say: Say = print) -> dict[str, Any]:
     """The leave-one-style-out evaluation (see the module doc); returns what ``zero_shot.json`` holds.
 
     Args:
-        run: a finished ``stylemotion-reproduce`` run folder.
-        out: the output folder (must not exist unless ``force``, which replaces it).
+        run: a finished ``stylemotion-reproduce`` run folder (the judge and the CVAE baseline).
+        out: the output folder (must not exist unless ``force``, which replaces it, or ``resume``).
         styles: left-out styles (default: every CVAE style of the run).
         primitives: default every primitive with CVAEs.
-        epochs: training epochs of each network (None: the experiment's).
-        samples, seed: samples per model and their seed (default the run's seed).
-        checkpoints: an earlier output folder whose ``models/<p>_without_<s>/checkpoints/best.ckpt`` are taken
-            instead of training (each checked: primitive, exclusion, autoencoder).
+        epochs: training epochs of each network (None: the experiment's); the autoencoders train as the run's.
+        samples: samples per model.
+        seed: the seed of the autoencoders, the networks and the samples (default the run's seed).
         overrides: further Hydra overrides of the networks' ``train`` config (e.g. ``model.style_weight=5``).
         threads: torch threads.
+        resume: keep ``out`` and reuse the trainings that finished there (same settings), resume interrupted ones.
+        shared_autoencoder: the earlier, **leaky** protocol: networks on the run's autoencoder (``meta.leaky``).
 
     Raises:
-        OutputExistsError: ``out`` exists and ``force`` is off (before any work).
-        ZeroShotRunError: see :func:`read_run`, :func:`load_left_out`, :func:`evaluate_primitive`; a style or
-            primitive without a CVAE in the run.
+        OutputExistsError: ``out`` exists and neither ``force`` nor ``resume`` is on (before any work).
+        ZeroShotRunError: see :func:`read_run`, :func:`load_left_out`, :func:`evaluate_primitive`,
+            :func:`train_once`; a style or primitive without a CVAE in the run; an autoencoder that saw its
+            left-out style.
     """
     started = time.perf_counter()
-    out = check_new_output(Path(out).expanduser(), force)
+    out = Path(out).expanduser()
+    if not (resume and out.is_dir()):
+        out = check_new_output(out, force)
     source = read_run(run)
     samples = positive_int(samples, "samples")
     seed = source.seed if seed is None else int(seed)
@@ -346,42 +475,67 @@ def leave_one_style_out(run: str | Path, out: str | Path, styles: Sequence[str] 
         if absent:
             raise ZeroShotRunError(f"run={source.folder} has no CVAE of {p} for style(s) {absent} (its CVAEs: "
                                    f"{sorted(f'{a}/{b}' for a, b in source.cvaes)})")
-    if out.exists():
+    if out.exists() and not resume:
         shutil.rmtree(out)
-    out.mkdir(parents=True)
-    autoencoder = load_autoencoder(source.autoencoder_ckpt)
-    weights = fingerprint(autoencoder)
+    out.mkdir(parents=True, exist_ok=True)
+    judge = load_autoencoder(source.autoencoder_ckpt)
+    judge_info = {"path": str(source.autoencoder_ckpt.resolve()), "fingerprint": fingerprint(judge)}
     takeset = build_dataset(source.data_cfg)
-    trained: dict[str, dict[str, Any]] = {}
+    generators: dict[str, dict[str, Any]] = {}  # left-out style → its autoencoder
     results: dict[str, Any] = {}
     for p, wanted in plan.items():
-        networks = {}
+        networks, trained = {}, {}
         for s in wanted:
-            if checkpoints is not None:
-                path, seconds = model_folder(Path(checkpoints).expanduser(), p, s) / "checkpoints" / "best.ckpt", None
-                say(f"{p} without {s}: taken from {path}")
-            else:
-                say(f"{p} without {s}: training")
-                path, seconds = train_left_out(source, p, s, model_folder(out, p, s), epochs, overrides, threads)
-                say(f"    trained in {seconds / 60:.1f} min")
-            networks[s] = load_left_out(path, p, s, weights)
-            networks[s].attach_autoencoder(autoencoder)
-            trained.setdefault(p, {})[s] = {"checkpoint": str(path), "train_seconds": seconds}
-        cvaes = [load_model(source.cvaes[(q, s)], source.settings.neutral_style, autoencoder)
+            if s not in generators:
+                generators[s] = _generator_autoencoder(source, s, out, seed, threads, shared_autoencoder, say)
+            gen = generators[s]
+            cfg = train_config(source, p, s, model_folder(out, p, s), epochs, overrides, threads, gen["path"], seed)
+            path, seconds = train_once(cfg, f"{p} network without {s}", say)
+            networks[s] = load_left_out(path, p, s, gen["fingerprint"])
+            if shared_autoencoder:
+                networks[s].attach_autoencoder(judge)  # one module for all (the same weights)
+            trained[s] = {"checkpoint": str(path), "train_seconds": seconds}
+        cvaes = [load_model(source.cvaes[(q, s)], source.settings.neutral_style, judge)
                  for q, s in source.cvaes if q == p]
-        results[p] = evaluate_primitive(p, networks, cvaes, takeset, autoencoder, source.settings,
-                                        source.data_cfg.get("split"), samples, seed, say)
-        for s, record in trained[p].items():
-            results[p]["styles"][s]["zero_shot"]["train_seconds"] = record["train_seconds"]
-    payload = {"primitives": results, "summary": _summary(results),
+        results[p] = evaluate_primitive(p, networks, cvaes, takeset, judge, source.settings,
+                                        source.data_cfg.get("split"), samples, seed, say, shared_autoencoder)
+        for s, record in trained.items():
+            row = results[p]["styles"][s]
+            row["zero_shot"]["train_seconds"] = record["train_seconds"]
+            row["generator_autoencoder"].update({k: v for k, v in generators[s].items() if k != "path"},
+                                                path=str(generators[s]["path"]))
+    payload = {"primitives": results, "summary": _summary(results), "splits": splits_record(source, shared_autoencoder),
                "meta": {"run": str(source.folder.resolve()), "data": source.data_cfg, "seed": seed,
                         "samples": samples, "epochs": epochs, "overrides": list(overrides),
-                        "checkpoints_from": None if checkpoints is None else str(checkpoints),
+                        "leaky": LEAKY if shared_autoencoder else False,
+                        "autoencoders": "shared (the run's)" if shared_autoencoder else "one per left-out style",
+                        "judge_autoencoder": judge_info,
                         "settings": asdict(source.settings), **provenance(),
                         "seconds": time.perf_counter() - started}}
     write_json(out / "zero_shot.json", payload)
     atomic_write_bytes(out / "zero_shot.md", markdown(payload).encode())
     return payload
+
+
+def _generator_autoencoder(source: ReproduceRun, style: str, out: Path, seed: int, threads: Any,
+                           shared: bool, say: Say) -> dict[str, Any]:
+    """The autoencoder the networks without ``style`` are trained on: trained here without the style (or, when
+    ``shared``, the run's); its ``path``, ``fingerprint``, ``excluded_styles`` and ``train_seconds``.
+
+    Raises:
+        ZeroShotRunError: the trained checkpoint records data that did not leave the style out.
+    """
+    if shared:
+        path, seconds = source.autoencoder_ckpt, None
+    else:
+        cfg = autoencoder_train_config(source, style, autoencoder_folder(out, style), seed, threads)
+        path, seconds = train_once(cfg, f"autoencoder without {style}", say)
+    excluded = autoencoder_excluded_styles(path)
+    if not shared and style not in excluded:
+        raise ZeroShotRunError(f"{path} was trained on data with style {style!r} (its excluded styles: {excluded}); "
+                               f"delete {autoencoder_folder(out, style)} and run again")
+    return {"path": Path(path), "fingerprint": fingerprint(load_autoencoder(path)), "excluded_styles": excluded,
+            "train_seconds": seconds}
 
 
 # -- the markdown table
@@ -399,11 +553,14 @@ def _pct(value: float) -> str:
 def markdown(results: Mapping[str, Any]) -> str:
     """``zero_shot.md``: recognition of each left-out style and the Table 5.1 rows, zero-shot next to CVAE."""
     meta = results["meta"]
-    lines = ["# One network for every style: leave one style out", "",
-             f"Run `{meta['run']}`, {meta['samples']:,} samples per model (seed {meta['seed']}); each zero-shot "
-             f"network was trained without any clip of the style it is conditioned on, the CVAE on the neutral "
-             f"clips and that style's example. Git commit `{meta.get('git_commit', '?')}`; "
-             f"{meta['seconds'] / 60:.1f} min.", "",
+    leaky = meta.get("leaky")
+    generator = (f"**LEAKY: {leaky}.**" if leaky else
+                 "Each network and the autoencoder under it were trained without any clip of the style it is "
+                 "conditioned on; every row is measured with the run's autoencoder and style classifier (the judge).")
+    lines = ["# One network for every style: leave one style out" + (" (LEAKY: shared autoencoder)" if leaky else ""),
+             "", f"Run `{meta['run']}`, {meta['samples']:,} samples per model (seed {meta['seed']}). {generator} "
+             f"The CVAE was trained on the neutral clips and that style's example. Git commit "
+             f"`{meta.get('git_commit', '?')}`; {meta['seconds'] / 60:.1f} min.", "",
              "## Recognition of the left-out style", "",
              "Share of samples the style classifier (fitted on real train clips of every style) assigns to the "
              "style; `real`: the style's real clips (all but its example; the classifier was fitted on its "
