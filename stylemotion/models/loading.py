@@ -129,7 +129,7 @@ def load_model(path: str | Path, neutral_style: str = "normal", autoencoder=None
     if isinstance(model, ZeroShotStyleVAE):
         raise IncompatibleModelError(f"{path} is a zero-shot style network: it samples only given a style example "
                                      "(bind one with model.bind_example(...), or evaluate it with "
-                                     "scripts/zero_shot_loso.py)")
+                                     "python scripts/benchmarks.py run zero_shot)")
     spec = model.spec
     styled = isinstance(model, StyleCVAE)
     if styled:

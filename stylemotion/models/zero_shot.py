@@ -34,7 +34,8 @@ decoder's output and taken from the encoder's input: ``y = a + decoder(z, e)``,
 ``q(z | y − a, e)``: the network models a clip as its example plus a variation of the example's style.
 
 Why the anchor: leaving each style of the synthetic data out in turn (6 styles × 2 stance primitives, 30
-epochs, 1,000 samples from the style's one example; ``scripts/zero_shot_loso.py``, docs/zero_shot.md), the
+epochs, 1,000 samples from the style's one example; an earlier session, with the leaky protocol whose
+autoencoder saw the left-out style: a design note, not a figure; suite ``zero_shot`` measures without leakage), the
 run's style classifier recognizes 17 % of the embedding-only network's samples as the left-out style (0 %
 but for ``exhausted``, which lies between trained styles: the decoder maps an unseen embedding onto the
 nearest style it knows; for elderly on walk_leftStance a Gram style term of weight 20 did not change that)
