@@ -10,8 +10,8 @@ the run's CVAE of ``s`` (trained on s's example: a supervised baseline, samples 
 
 The judge: ``--run`` (any finished ``stylemotion-reproduce`` run), else ``stylemotion-reproduce seed=<judge seed>
 out=runs/benchmarks/zero_shot/<data>/<setup>/judge<seed>`` run (or reused, resumed) through its library entry as
-suite ``style`` does. Trainings land under ``runs/benchmarks/zero_shot/<data>/<setup>/seed<k>/`` and are reused
-when the suite runs again (an interrupted one resumes).
+suite ``style`` does. Trainings land under ``runs/benchmarks/zero_shot/<data>/loso_<judge>[_e<epochs>]/seed<k>/``
+and are reused when the suite runs again, also with other ``--styles`` (an interrupted one resumes).
 
 ``--data synthetic`` (default) is the embedded synthetic set: a smoke test of the pipeline, never evidence.
 ``--data bandai`` (or suite ``zero_shot_bandai``) Bandai dataset-2's walks: about 10 min per autoencoder and 1–2 min
@@ -65,6 +65,16 @@ def judge_run(args: argparse.Namespace) -> Path:
     return out
 
 
+def loso_folder(args: argparse.Namespace, judge: Path) -> Path:
+    """Where the seeds' trainings go: ``<runs>/<data>/loso_<judge>[_e<epochs>]``. A training depends on the judge
+    run's data, split and autoencoder stage, its seed and the network epochs, not on which other styles or
+    primitives are left out, so narrowed and full runs on one judge share (reuse) their trainings."""
+    from stylemotion.io.outputs import safe_name
+
+    name = safe_name(f"{judge.parent.name}_{judge.name}", "judge run folder")
+    return args.runs / args.data / (f"loso_{name}" + (f"_e{args.epochs}" if args.epochs else ""))
+
+
 def relative(path: Path | str) -> str:
     path = Path(path)
     return str(path.relative_to(ROOT)) if path.is_relative_to(ROOT) else str(path)
@@ -89,10 +99,10 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
     judge = judge_run(args)
     source = read_run(judge)
     check_data(judge, args.data, source.data_cfg)
-    tag = setup_tag(args.primitives, args.styles) + (f"_e{args.epochs}" if args.epochs else "")
+    base = loso_folder(args, judge)
     per_seed: dict[str, Any] = {}
     for seed in seeds:
-        out = args.runs / args.data / tag / f"seed{seed}"
+        out = base / f"seed{seed}"
         result = leave_one_style_out(judge, out, args.styles, args.primitives, args.epochs, args.samples, seed,
                                      threads=1, resume=True, say=lambda line, k=seed: print(f"[seed {k}] {line}",
                                                                                              flush=True))
@@ -118,7 +128,7 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
                                                        for v in per_seed.values()),
                        "rows": first["summary"][kind]["rows"]} for kind in ROWS}
     classifier = {p: res["classifier"] for p, res in first["primitives"].items()}
-    splits = read_splits(per_seed, args.runs / args.data / tag, seeds)
+    splits = read_splits(per_seed, base, seeds)
     return {"data": args.data, "judge": {"run": relative(judge), "seed": source.seed,
                                          "autoencoder": relative(source.autoencoder_ckpt),
                                          "cvae_styles": {p: source.styles(p) for p in source.primitives}},
