@@ -154,12 +154,13 @@ class TakeSpec:
 
 
 class DatasetBuildError(MotionDataError):
-    """Some inputs of a dataset could not be converted; lists every one of them."""
+    """Some inputs of a dataset could not be converted; lists every one of them, in one line (a command's
+    error is one line), separated by ``;``."""
 
     def __init__(self, dataset: str, failures: list[tuple[str, str]]):
         self.failures = failures
-        lines = "\n".join(f"  {msg}" for _, msg in failures)
-        super().__init__(dataset, f"{len(failures)} broken input file(s):\n{lines}\n{SKIP_HINT}")
+        listed = "; ".join(" ".join(msg.split()) for _, msg in failures)
+        super().__init__(dataset, f"{len(failures)} broken input file(s): {listed}. {SKIP_HINT}")
 
 
 def describe_failure(source: str, exc: BaseException) -> str:

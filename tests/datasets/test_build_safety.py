@@ -106,6 +106,7 @@ def test_every_broken_file_is_listed_labels_and_conversion_alike(tmp_path):
     # The label failure (pattern) and the conversion failure are both reported, in one error.
     assert "walk_x.bvh" in message and "does not match pattern" in message
     assert "walk_2.bvh" in message and "2 broken input file(s)" in message
+    assert "\n" not in message  # one line: a command's error is one line (issue 26)
 
 
 def test_overflowing_positions_are_an_error_naming_the_file(tmp_path):
