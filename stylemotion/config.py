@@ -16,6 +16,7 @@ from __future__ import annotations
 import math
 import secrets
 from collections.abc import Mapping
+from dataclasses import dataclass
 from datetime import datetime
 from pathlib import Path
 from typing import Any
@@ -40,6 +41,21 @@ def config_dir() -> str:
 
 class ConfigError(UserInputError, ValueError):
     """A config value that cannot be used; the message names the key and the value."""
+
+
+@dataclass(frozen=True)
+class MotionFileKeys:
+    """The keys of every command that reads a user's motion file, as datasets convert theirs
+    (:data:`stylemotion.datasets.user_motion.CONVERSION_KEYS`); the settings of those commands derive from it.
+
+    ``joint_map``: the file's skeleton: None = auto-detect (bandai, cmu21, cmu31), a built-in name or a YAML
+    map ``{joints: {Hips: <its name>, ...}}``; ``unit_scale``: metres per file unit or a unit name (cm, mm,
+    m, inch), None = detect; ``up_axis``: the file's up axis, ``y`` or ``z``.
+    """
+
+    joint_map: Any = None
+    unit_scale: Any = None
+    up_axis: str = "y"
 
 
 def _is_int(value: Any) -> bool:
@@ -158,8 +174,11 @@ def structured_schema(cls: type) -> Any:
 def build_settings(cls: type, values: Mapping[str, Any] | None, key: str) -> Any:
     """An instance of the dataclass ``cls`` from (partial) config values, defaults from ``cls``.
 
+    ``key``: where the values sit in the command's config (``""``: at its top level).
+
     Raises:
-        ConfigError: an unknown key or a value of the wrong type, named as ``<key>.<field>``.
+        ConfigError: an unknown key or a value of the wrong type, named as ``<key>.<field>`` (``<field>`` at the
+            top level).
     """
     from omegaconf import OmegaConf
     from omegaconf.errors import OmegaConfBaseException
@@ -168,7 +187,27 @@ def build_settings(cls: type, values: Mapping[str, Any] | None, key: str) -> Any
         return OmegaConf.to_object(OmegaConf.merge(structured_schema(cls), values or {}))
     except OmegaConfBaseException as exc:
         where = getattr(exc, "full_key", None)
-        raise ConfigError(f"{key}.{where}: {str(exc).splitlines()[0]}" if where else f"{key}: {exc}") from None
+        if where:
+            raise ConfigError(f"{key}.{where}: {str(exc).splitlines()[0]}" if key else
+                              f"{where}: {str(exc).splitlines()[0]}") from None
+        raise ConfigError(f"{key}: {exc}" if key else str(exc).splitlines()[0]) from None
+
+
+def settings_from_config(cfg: Any, cls: type, command: str) -> tuple[dict[str, Any] | None, Any]:
+    """A command's composed config (or a plain mapping of its keys) split into its ``data`` config (a plain dict,
+    None when it has none) and its settings: the dataclass ``cls`` (whose defaults are the command's, the YAML
+    repeating none) built from every other key by :func:`build_settings`.
+
+    Raises:
+        ConfigError: not a mapping; an unknown key, a value of the wrong type or a missing mandatory value, named.
+    """
+    from omegaconf import DictConfig, OmegaConf
+
+    plain = OmegaConf.to_container(cfg, resolve=True) if isinstance(cfg, DictConfig) else dict(cfg)
+    if not isinstance(plain, dict):
+        raise ConfigError(f"the {command} config must be a mapping")
+    data = plain.pop("data", None)
+    return data, build_settings(cls, plain, "")
 
 
 def _register_resolvers() -> None:

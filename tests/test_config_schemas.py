@@ -11,8 +11,16 @@ from hydra import compose, initialize_config_dir
 from hydra.errors import ConfigCompositionException
 from omegaconf import OmegaConf
 
-from stylemotion.cli.schemas import register_schemas, register_schemas_for
-from stylemotion.config import CONFIG_DIR, ConfigError, build_settings
+from stylemotion.cli.schemas import (
+    CONFIG_SCHEMAS,
+    PACKAGES,
+    SCHEMAS,
+    check_overrides,
+    register_schemas,
+    register_schemas_for,
+)
+from stylemotion.config import CONFIG_DIR, ConfigError, build_settings, structured_schema
+from stylemotion.config import settings_from_config as config_settings
 from stylemotion.evaluation.run import settings_from_config
 from stylemotion.evaluation.settings import EvalSettings, SampleCounts
 from stylemotion.primitives.segmentation import SegmentSettings
@@ -86,3 +94,98 @@ def test_each_command_registers_the_schemas_its_config_needs(name):
         repo.pop("schema", None)
         if saved is not None:
             repo["schema"] = saved
+
+
+# -- the commands whose own keys are one settings dataclass at the top level of their config (schema@_here_)
+
+TOP_LEVEL = sorted(name for name, schemas in CONFIG_SCHEMAS.items() if any(PACKAGES[s] == "" for s in schemas))
+#: What each top-level config needs on the command line to be complete.
+REQUIRED = {"search": {"query": "q"}, "reconstruct": {"markers": "m"}, "keyframes": {"keys": "k.json"},
+            "texture": {"motion": "m"}, "style": {"example": "e.bvh", "name": "mine"}, "annotate": {}}
+
+
+def _settings_class(name: str) -> type:
+    (schema,) = CONFIG_SCHEMAS[name]
+    return SCHEMAS[schema]()
+
+
+def test_the_top_level_schemas_are_the_six_commands():
+    assert TOP_LEVEL == ["annotate", "keyframes", "reconstruct", "search", "style", "texture"]
+
+
+@pytest.mark.parametrize("name", TOP_LEVEL)
+def test_top_level_yaml_holds_no_value_the_dataclass_defines(name):
+    """A default cannot drift between the YAML and its dataclass: the YAML has none of the dataclass's keys."""
+    raw = yaml.safe_load((CONFIG_DIR / f"{name}.yaml").read_text())
+    fields = set(structured_schema(_settings_class(name)).keys())
+    assert not fields & set(raw), f"{name}.yaml restates {sorted(fields & set(raw))}; they live in the dataclass"
+    where = raw["defaults"].index({"schema@_here_": name})
+    assert where < raw["defaults"].index("_self_"), "the YAML's own keys (out's interpolation…) come after the schema"
+
+
+@pytest.mark.parametrize("name", TOP_LEVEL)
+def test_top_level_config_composes_to_the_dataclass_defaults(name):
+    cls = _settings_class(name)
+    cfg = _compose(name, [f"{k}={v}" for k, v in REQUIRED[name].items()] + ["out=o"])
+    plain = OmegaConf.to_container(cfg, resolve=True)
+    plain.pop("data", None)
+    assert build_settings(cls, plain, "") == cls(**REQUIRED[name], out="o")
+
+
+def _footer_defaults(name: str) -> dict[str, str]:
+    """``key=value`` in the ``== Main keys ==`` part of ``--help`` that state a default: a number, or the first of
+    ``a|b|…`` alternatives (a single ``true``/``false``, ``N`` or a ``<placeholder>`` is an example, not a
+    default)."""
+    help_text = yaml.safe_load((CONFIG_DIR / "hydra" / "help" / f"{name}.yaml").read_text())["footer"]
+    keys = help_text.split("== Main keys ==", 1)[1].split("==", 1)[0]
+    found = {}
+    for token in keys.split():
+        key, _, value = token.partition("=")
+        plain_key = key.replace(".", "").replace("_", "").isalnum()
+        if not value or value == "N" or value.startswith(("<", "[", "'")) or not plain_key:
+            continue
+        if "|" in value:
+            found[key] = value.split("|")[0]
+        elif value not in ("true", "false"):
+            found[key] = value
+    return found
+
+
+@pytest.mark.parametrize("name", TOP_LEVEL)
+def test_help_footers_state_the_dataclass_defaults(name):
+    """Every default ``--help`` states is the dataclass's (``model.weights.control=4`` of texture is an example of
+    a key without a single default)."""
+    defaults = OmegaConf.to_container(structured_schema(_settings_class(name)))
+    stated = {k: v for k, v in _footer_defaults(name).items() if k != "model.weights.control"}
+    assert stated, f"{name}: no default found in its help footer"
+    for key, value in stated.items():
+        node = defaults
+        for part in key.split("."):
+            node = node[part]
+        want = yaml.safe_load(value) if value not in ("y", "z") else value
+        assert node == want, f"stylemotion-{name} --help states {key}={value}, the dataclass {node!r}"
+
+
+@pytest.mark.parametrize(("name", "override", "message"), [
+    ("search", "k=abc", "k=abc: Value 'abc' of type 'str' could not be converted to Integer"),
+    ("search", "export.bogus=1", "export.bogus=1: Key 'bogus' not in 'ExportSettings'"),
+    ("annotate", "keyframes.count=many", "keyframes.count=many: "),
+    ("reconstruct", "model.variance=x", "model.variance=x: "),
+    ("texture", "gif=maybe", "gif=maybe: "),
+    ("segment", "segment.max_step_s=abc", "segment.max_step_s=abc: "),
+])
+def test_a_bad_override_of_a_schema_key_is_one_line_naming_it(name, override, message):
+    with pytest.raises(ConfigError) as caught:
+        check_overrides(name, ["data.fps=30", "hydra.run.dir=x", "out=o", override])
+    assert str(caught.value).startswith(message) and "\n" not in str(caught.value)
+
+
+@pytest.mark.parametrize("overrides", [["k=5", "export.top=2", "radius=null", "data.contents=[walk]"],
+                                       ["k=1,2", "--cfg", "job", "+extra=1", "~radius"], ["bad=[syntax"]])
+def test_good_overrides_and_what_hydra_handles_pass_the_check(overrides):
+    check_overrides("search", overrides)
+
+
+def test_a_missing_mandatory_key_is_named():
+    with pytest.raises(ConfigError, match="^query: "):
+        config_settings({"data": {}, "out": "o"}, _settings_class("search"), "search")

@@ -21,14 +21,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from stylemotion.annotate.settings import AnnotateSettings, KeyframeSettings
 from stylemotion.annotate.subsequence import subsequence_dtw
 from stylemotion.annotate.templates import MotionTemplate, local_cost
 from stylemotion.io.errors import UserInputError
 
-#: Matching threshold τ (the thesis used 0.13 with its features; our masked costs are smaller). Chosen with
-#: ``min_run`` and the key frames on documents of Bandai val takes by ``python scripts/benchmarks.py run annotate``
-#: (benchmarks/annotate.md).
-DEFAULT_TAU = 0.025
+#: Matching threshold τ: ``stylemotion-annotate``'s ``tau`` (:class:`AnnotateSettings`, where it is set and why).
+DEFAULT_TAU: float = AnnotateSettings.tau
 
 
 class AnnotationInputError(UserInputError, ValueError):
@@ -140,13 +139,13 @@ class AnnotationSettings:
 
     ``tau``, ``keyframes``, ``keyframe_tolerance`` and ``min_run`` were chosen on documents of Bandai val takes
     (suite ``annotate``: key frames off ties with the best tolerance, 0.2, and the simpler setting wins);
-    ``keyframe_count`` is not tuned."""
+    ``keyframe_count`` is not tuned. The defaults are ``stylemotion-annotate``'s (:class:`AnnotateSettings`)."""
 
     tau: float = DEFAULT_TAU
-    keyframes: bool = False
-    keyframe_count: int = 3
-    keyframe_tolerance: float = 0.2
-    min_run: int = 30
+    keyframes: bool = KeyframeSettings.use
+    keyframe_count: int = KeyframeSettings.count
+    keyframe_tolerance: float = KeyframeSettings.tolerance
+    min_run: int = AnnotateSettings.min_run
 
 
 @dataclass(frozen=True)

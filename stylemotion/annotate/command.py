@@ -24,13 +24,14 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from omegaconf import DictConfig, OmegaConf
+from omegaconf import DictConfig
 
 from stylemotion.annotate.annotation import AnnotationInputError, AnnotationSettings, annotate_features, segments
 from stylemotion.annotate.features import relational_features
 from stylemotion.annotate.model import AnnotationModel, ModelFolderError, learn_model, load_model, save_model
+from stylemotion.annotate.settings import AnnotateSettings
 from stylemotion.annotate.templates import TemplateInputError
-from stylemotion.config import ConfigError, positive_int
+from stylemotion.config import positive_int, settings_from_config
 from stylemotion.datasets import build_dataset
 from stylemotion.datasets.loading import ConversionSettings
 from stylemotion.datasets.user_motion import UserMotionError, conversion_keys, convert_example, parse_example
@@ -41,16 +42,18 @@ from stylemotion.io.outputs import check_new_output, inside
 from stylemotion.provenance import provenance
 
 Say = Callable[[str], None]
+_D = AnnotateSettings
 
 
 class AnnotateInputError(UserInputError, ValueError):
     """A ``stylemotion-annotate`` input that cannot be used; the message names the key and the value."""
 
 
-def learn(data: Mapping[str, Any], out: str | os.PathLike, *, per_class: int = 9, seed: int = 0,
-          repetitions: int | None = None, tensors: bool = True, force: bool = False, say: Say = print,
-          command: str = "") -> AnnotationModel:
-    """Learn templates (and tensors) from ``data``'s train split and write the folder ``out``."""
+def learn(data: Mapping[str, Any], out: str | os.PathLike, *, per_class: int = _D.per_class, seed: int = _D.seed,
+          repetitions: int | None = _D.repetitions, tensors: bool = _D.tensors, force: bool = _D.force,
+          say: Say = print, command: str = "") -> AnnotationModel:
+    """Learn templates (and tensors) from ``data``'s train split and write the folder ``out`` (the keyword
+    defaults are :class:`~stylemotion.annotate.settings.AnnotateSettings`'s)."""
     out = check_new_output(out, force)
     per_class = positive_int(per_class, "per_class")
     if repetitions is not None:
@@ -117,7 +120,7 @@ def annotate_positions(positions: np.ndarray, model: AnnotationModel,
 
 def annotate(document: str, templates: str | os.PathLike, out: str | os.PathLike, *,
              settings: AnnotationSettings | None = None, conversion: Mapping[str, Any] | None = None,
-             force: bool = False, say: Say = print, command: str = "") -> dict[str, Any]:
+             force: bool = _D.force, say: Say = print, command: str = "") -> dict[str, Any]:
     """Annotate ``document`` with the model in ``templates`` and write the folder ``out`` (module docstring)."""
     started = time.perf_counter()
     settings = settings or AnnotationSettings()
@@ -159,26 +162,17 @@ def annotate(document: str, templates: str | os.PathLike, out: str | os.PathLike
 
 
 def annotate_from_config(cfg: DictConfig, say: Say = print, command: str = "") -> Any:
-    """:func:`learn` (no ``document``) or :func:`annotate` with the keys of ``stylemotion/configs/annotate.yaml``."""
-    plain = OmegaConf.to_container(cfg, resolve=True)
-    if not isinstance(plain, dict):
-        raise ConfigError("the annotate config must be a mapping")
-    force = bool(plain.get("force", False))
-    if not plain.get("document"):
-        return learn(plain["data"], plain["out"], per_class=plain.get("per_class", 9), seed=plain.get("seed", 0),
-                     repetitions=plain.get("repetitions"), tensors=bool(plain.get("tensors", True)), force=force,
-                     say=say, command=command)
-    if not plain.get("templates"):
+    """:func:`learn` (no ``document``) or :func:`annotate` with the keys of ``stylemotion/configs/annotate.yaml``
+    (:class:`AnnotateSettings`)."""
+    data, s = settings_from_config(cfg, AnnotateSettings, "annotate")
+    if not s.document:
+        return learn(data, s.out, per_class=s.per_class, seed=s.seed, repetitions=s.repetitions, tensors=s.tensors,
+                     force=s.force, say=say, command=command)
+    if not s.templates:
         raise AnnotateInputError("document= needs templates=<folder> (learn one with stylemotion-annotate "
                                  "data=<dataset> out=<folder>)")
-    keyframes = plain.get("keyframes") or {}
-    default = AnnotationSettings()
-    settings = AnnotationSettings(tau=plain.get("tau", default.tau),
-                                  keyframes=bool(keyframes.get("use", default.keyframes)),
-                                  keyframe_count=positive_int(keyframes.get("count", default.keyframe_count),
-                                                              "keyframes.count"),
-                                  keyframe_tolerance=float(keyframes.get("tolerance", default.keyframe_tolerance)),
-                                  min_run=int(plain.get("min_run", default.min_run)))
-    return annotate(str(plain["document"]), plain["templates"], plain["out"], settings=settings,
-                    conversion=conversion_keys(plain),
-                    force=force, say=say, command=command)
+    settings = AnnotationSettings(tau=s.tau, keyframes=s.keyframes.use,
+                                  keyframe_count=positive_int(s.keyframes.count, "keyframes.count"),
+                                  keyframe_tolerance=s.keyframes.tolerance, min_run=s.min_run)
+    return annotate(str(s.document), s.templates, s.out, settings=settings, conversion=conversion_keys(vars(s)),
+                    force=s.force, say=say, command=command)

@@ -139,12 +139,13 @@ def hydra_command(command: str, config_name: str, work: Callable[[Any, str], Any
     def main() -> None:
         import hydra
 
-        from stylemotion.cli.schemas import register_schemas_for
+        from stylemotion.cli.schemas import check_overrides, register_schemas_for
         from stylemotion.config import CONFIG_PACKAGE
 
         stop_on_sigterm()
         with one_line_errors(command):
             register_schemas_for(config_name)
+            check_overrides(config_name, sys.argv[1:])
             hydra.main(config_path=CONFIG_PACKAGE, config_name=config_name, version_base="1.3")(task)()
 
     main.__doc__ = f"Console script ``{command}``."

@@ -26,18 +26,19 @@ import os
 import time
 import warnings
 from collections.abc import Callable, Mapping, Sequence
+from dataclasses import asdict
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 from omegaconf import DictConfig
 
-from stylemotion.config import ConfigError, positive_int
+from stylemotion.config import ConfigError, positive_int, settings_from_config
 from stylemotion.datasets import TakeSet
 from stylemotion.datasets.user_motion import conversion_keys, parse_example
 from stylemotion.io.outputs import check_new_output
 from stylemotion.provenance import provenance
-from stylemotion.reconstruct.inputs import command_takeset, database_without, joints_option, plain_config
+from stylemotion.reconstruct.inputs import command_takeset, database_without
 from stylemotion.reconstruct.markers import (
     DEFAULT_MARKERS,
     MarkerGapWarning,
@@ -47,9 +48,11 @@ from stylemotion.reconstruct.markers import (
     tracks_from_positions,
 )
 from stylemotion.reconstruct.output import write_motion_folder
+from stylemotion.reconstruct.settings import ReconstructSettings
 from stylemotion.reconstruct.sparse import RECONSTRUCT_FEATURE_SETS, SparseReconstructor, joint_errors_cm
 
 Say = Callable[[str], None]
+_D = ReconstructSettings
 
 
 def _number(value: Any, key: str, low: float = 0.0) -> float:
@@ -85,15 +88,17 @@ def load_tracks(text: str, takeset: TakeSet, joints: Sequence[str] | None,
     return read_markers(text, joints, takeset.fps, dict(conversion or {})), None
 
 
-def reconstruct_command(data: Mapping[str, Any], markers: str, out: str | os.PathLike, *, features: str = "E15",
-                        k: int = 128, joints: Sequence[str] | None = None, noise_mm: float = 0.0, seed: int = 0,
-                        exclude_markers_take: bool = True, model: Mapping[str, Any] | None = None,
-                        conversion: Mapping[str, Any] | None = None, force: bool = False, gif: bool = True,
+def reconstruct_command(data: Mapping[str, Any], markers: str, out: str | os.PathLike, *,
+                        features: str = _D.features, k: int = _D.k, joints: Sequence[str] | None = _D.joints,
+                        noise_mm: float = _D.noise_mm, seed: int = _D.seed,
+                        exclude_markers_take: bool = _D.exclude_markers_take, model: Mapping[str, Any] | None = None,
+                        conversion: Mapping[str, Any] | None = None, force: bool = _D.force, gif: bool = _D.gif,
                         say: Say = print, command: str = "") -> dict[str, Any]:
     """Reconstruct ``markers`` on the database ``data`` (a ``data`` config) and write ``out`` (module docstring).
 
     ``model``: further :class:`SparseReconstructor` settings (variance, marker_sd, smooth_sd, prior_weight,
-    iterations, weighted). Returns what ``summary.json`` holds.
+    iterations, weighted). The defaults are :class:`~stylemotion.reconstruct.settings.ReconstructSettings`'s.
+    Returns what ``summary.json`` holds.
 
     Raises:
         OutputExistsError: ``out`` exists and ``force`` is off (before any work).
@@ -152,12 +157,10 @@ def reconstruct_command(data: Mapping[str, Any], markers: str, out: str | os.Pat
 
 
 def reconstruct_from_config(cfg: DictConfig, say: Say = print, command: str = "") -> dict[str, Any]:
-    """:func:`reconstruct_command` with the keys of ``stylemotion/configs/reconstruct.yaml``."""
-    plain = plain_config(cfg, "reconstruct")
-    joints = joints_option(plain, "'[Hand_L,Hand_R,Hips]'")
+    """:func:`reconstruct_command` with the keys of ``stylemotion/configs/reconstruct.yaml``
+    (:class:`ReconstructSettings`)."""
+    data, s = settings_from_config(cfg, ReconstructSettings, "reconstruct")
     return reconstruct_command(
-        plain["data"], plain["markers"], plain["out"], features=str(plain.get("features", "E15")),
-        k=plain.get("k", 64), joints=joints, noise_mm=plain.get("noise_mm", 0.0), seed=int(plain.get("seed", 0)),
-        exclude_markers_take=bool(plain.get("exclude_markers_take", True)), model=plain.get("model") or {},
-        conversion=conversion_keys(plain),
-        force=bool(plain.get("force", False)), gif=bool(plain.get("gif", True)), say=say, command=command)
+        data, s.markers, s.out, features=s.features, k=s.k, joints=s.joints, noise_mm=s.noise_mm, seed=s.seed,
+        exclude_markers_take=s.exclude_markers_take, model=asdict(s.model), conversion=conversion_keys(vars(s)),
+        force=s.force, gif=s.gif, say=say, command=command)

@@ -46,6 +46,7 @@ import numpy as np
 from stylemotion.geometry import rotate_yaw, wrap_angle
 from stylemotion.io.errors import UserInputError
 from stylemotion.primitives.contacts import foot_contacts
+from stylemotion.reconstruct.settings import DynamicGraphSettings as _G
 from stylemotion.reconstruct.texture import MotionTexturer
 from stylemotion.representation import facing_yaw
 from stylemotion.search.database import MotionDatabase
@@ -226,12 +227,13 @@ class DynamicMotionGraph:
         :class:`MotionTexturer` (built in texture mode when None and ``clean``).
     """
 
-    def __init__(self, database: MotionDatabase, k: int = 16, b: int = 4, max_iterations: int = 12,
-                 voxel_m: float = 0.1, min_segment_frames: int = 4, max_segment_s: float = 1.0,
-                 max_turn_deg: float = 30.0, max_pose_m: float = 0.15, max_velocity_m_s: float = 0.6,
-                 blend_frames: int = 10, duration_weight: float = 30.0, facing_weight_m: float = 1.0,
-                 key_weight: float = 10.0, extra_iterations: int = 1,
-                 retime: bool = True, clean: bool = True,
+    def __init__(self, database: MotionDatabase, k: int = _G.k, b: int = _G.b, max_iterations: int = _G.max_iterations,
+                 voxel_m: float = _G.voxel_m, min_segment_frames: int = _G.min_segment_frames,
+                 max_segment_s: float = _G.max_segment_s, max_turn_deg: float = _G.max_turn_deg,
+                 max_pose_m: float = _G.max_pose_m, max_velocity_m_s: float = _G.max_velocity_m_s,
+                 blend_frames: int = _G.blend_frames, duration_weight: float = _G.duration_weight,
+                 facing_weight_m: float = _G.facing_weight_m, key_weight: float = 10.0, extra_iterations: int = 1,
+                 retime: bool = _G.retime, clean: bool = _G.clean,
                  index: FrameIndex | None = None, texturer: MotionTexturer | None = None):
         for key, value, low in (("k", k, 1), ("b", b, 1), ("max_iterations", max_iterations, 1),
                                 ("min_segment_frames", min_segment_frames, 1), ("blend_frames", blend_frames, 0)):

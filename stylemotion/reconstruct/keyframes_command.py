@@ -30,18 +30,19 @@ import os
 import time
 import warnings
 from collections.abc import Callable, Mapping
+from dataclasses import asdict
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 from omegaconf import DictConfig
 
-from stylemotion.config import ConfigError
+from stylemotion.config import ConfigError, settings_from_config
 from stylemotion.datasets import TakeSet
 from stylemotion.datasets.user_motion import conversion_keys
 from stylemotion.io.outputs import check_new_output
 from stylemotion.provenance import provenance
-from stylemotion.reconstruct.inputs import command_takeset, database_without, plain_config
+from stylemotion.reconstruct.inputs import command_takeset, database_without
 from stylemotion.reconstruct.keyframes import (
     DynamicMotionGraph,
     FarKeyframeWarning,
@@ -53,9 +54,11 @@ from stylemotion.reconstruct.keyframes import (
 )
 from stylemotion.reconstruct.markers import read_markers
 from stylemotion.reconstruct.output import write_motion_folder
+from stylemotion.reconstruct.settings import KeyframesSettings
 from stylemotion.skeleton import CANONICAL_JOINTS, JOINT_INDEX, NUM_JOINTS
 
 Say = Callable[[str], None]
+_D = KeyframesSettings
 _KEY_FIELDS = {"time", "take", "motion", "frame", "positions", "turn_deg", "shift_m"}
 
 
@@ -168,12 +171,12 @@ def read_keys(path: str | os.PathLike, takeset: TakeSet,
 
 
 def keyframes_command(data: Mapping[str, Any], keys: str | os.PathLike, out: str | os.PathLike, *,
-                      exclude_key_takes: bool = True, model: Mapping[str, Any] | None = None,
-                      conversion: Mapping[str, Any] | None = None, force: bool = False, gif: bool = True,
+                      exclude_key_takes: bool = _D.exclude_key_takes, model: Mapping[str, Any] | None = None,
+                      conversion: Mapping[str, Any] | None = None, force: bool = _D.force, gif: bool = _D.gif,
                       say: Say = print, command: str = "") -> dict[str, Any]:
     """A motion through the keys of the JSON file ``keys`` on the database ``data`` (a ``data`` config), written
-    to ``out`` (module docstring). ``model``: :class:`DynamicMotionGraph` settings. Returns what ``summary.json``
-    holds.
+    to ``out`` (module docstring). ``model``: :class:`DynamicMotionGraph` settings. The defaults are
+    :class:`~stylemotion.reconstruct.settings.KeyframesSettings`'s. Returns what ``summary.json`` holds.
 
     Raises:
         OutputExistsError: ``out`` exists and ``force`` is off (before any work).
@@ -220,11 +223,11 @@ def keyframes_command(data: Mapping[str, Any], keys: str | os.PathLike, out: str
 
 
 def keyframes_from_config(cfg: DictConfig, say: Say = print, command: str = "") -> dict[str, Any]:
-    """:func:`keyframes_command` with the keys of ``stylemotion/configs/keyframes.yaml``."""
-    plain = plain_config(cfg, "keyframes")
-    if not plain.get("keys"):
+    """:func:`keyframes_command` with the keys of ``stylemotion/configs/keyframes.yaml``
+    (:class:`KeyframesSettings`)."""
+    data, s = settings_from_config(cfg, KeyframesSettings, "keyframes")
+    if not s.keys:
         raise ConfigError("keys= is empty: give a keyframe JSON file (stylemotion-keyframes --help)")
     return keyframes_command(
-        plain["data"], plain["keys"], plain["out"], exclude_key_takes=bool(plain.get("exclude_key_takes", True)),
-        model=plain.get("model") or {}, conversion=conversion_keys(plain),
-        force=bool(plain.get("force", False)), gif=bool(plain.get("gif", True)), say=say, command=command)
+        data, s.keys, s.out, exclude_key_takes=s.exclude_key_takes, model=asdict(s.model),
+        conversion=conversion_keys(vars(s)), force=s.force, gif=s.gif, say=say, command=command)

@@ -39,6 +39,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from stylemotion.reconstruct.markers import MarkerInputError, MarkerTracks, check_marker_names
+from stylemotion.reconstruct.settings import ReconstructSettings as _C
+from stylemotion.reconstruct.settings import SparseModelSettings as _M
 from stylemotion.search.database import MotionDatabase
 from stylemotion.search.features import feature_spec, stack_window, window_offsets
 from stylemotion.search.index import FrameIndex
@@ -124,10 +126,10 @@ class SparseReconstructor:
         engine, workers: the k-NN engine (:class:`FrameIndex`).
     """
 
-    def __init__(self, database: MotionDatabase, joints: Sequence[str], features: str = "E15", k: int = 128,
-                 variance: float = 0.99, marker_sd: float = 0.002, smooth_sd: float = 0.1,
-                 prior_weight: float = 1.0, iterations: int = 1, weighted: bool = True, engine: str = "ckdtree",
-                 workers: int = 1):
+    def __init__(self, database: MotionDatabase, joints: Sequence[str], features: str = _C.features, k: int = _C.k,
+                 variance: float = _M.variance, marker_sd: float = _M.marker_sd, smooth_sd: float = _M.smooth_sd,
+                 prior_weight: float = _M.prior_weight, iterations: int = _M.iterations, weighted: bool = _M.weighted,
+                 engine: str = "ckdtree", workers: int = 1):
         self.joints = check_marker_names(joints)
         if features not in RECONSTRUCT_FEATURE_SETS:
             raise ValueError(f"features={features} cannot be used for reconstruction; valid: "

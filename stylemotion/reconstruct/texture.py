@@ -48,6 +48,8 @@ from scipy.sparse.linalg import splu
 
 from stylemotion.io.errors import UserInputError
 from stylemotion.reconstruct.markers import check_joint_names
+from stylemotion.reconstruct.settings import TextureModelSettings as _M
+from stylemotion.reconstruct.settings import TextureSettings as _C
 from stylemotion.reconstruct.sparse import marker_frames, to_local, to_world
 from stylemotion.search.database import MotionDatabase
 from stylemotion.search.features import stack_window, window_offsets
@@ -172,9 +174,10 @@ class MotionTexturer:
             :data:`DEFAULT_WEIGHTS`).  cleanup: the foot-skating clean-up at the end.
     """
 
-    def __init__(self, database: MotionDatabase, mode: str = "complete", joints: Sequence[str] | None = None,
-                 k: int = 32, top: int = 2, lng_window: int = 8, samples: int = 3, feature_seconds: float = 0.2,
-                 distance_sd: float = 0.002, weights: dict | None = None, cleanup: bool = True):
+    def __init__(self, database: MotionDatabase, mode: str = _C.mode, joints: Sequence[str] | None = None,
+                 k: int = _C.k, top: int = _M.top, lng_window: int = _M.lng_window, samples: int = _M.samples,
+                 feature_seconds: float = _M.feature_seconds, distance_sd: float = _M.distance_sd,
+                 weights: dict | None = None, cleanup: bool = _M.cleanup):
         if mode not in MODES:
             raise TextureInputError(f"mode={mode} is not one of {list(MODES)}")
         default = LEG_JOINTS if mode == "complete" else CANONICAL_JOINTS

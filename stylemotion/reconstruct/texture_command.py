@@ -17,24 +17,27 @@ from __future__ import annotations
 import os
 import time
 from collections.abc import Callable, Mapping, Sequence
+from dataclasses import asdict
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 from omegaconf import DictConfig
 
-from stylemotion.config import ConfigError
+from stylemotion.config import ConfigError, settings_from_config
 from stylemotion.datasets import TakeSet
 from stylemotion.datasets.user_motion import conversion_keys
 from stylemotion.io.outputs import check_new_output
 from stylemotion.provenance import provenance
-from stylemotion.reconstruct.inputs import command_takeset, database_without, joints_option, plain_config
+from stylemotion.reconstruct.inputs import command_takeset, database_without
 from stylemotion.reconstruct.markers import read_markers
 from stylemotion.reconstruct.output import write_motion_folder
+from stylemotion.reconstruct.settings import TextureSettings
 from stylemotion.reconstruct.texture import LEG_JOINTS, MODES, MotionTexturer, TextureInputError, check_joints
 from stylemotion.skeleton import CANONICAL_JOINTS, JOINT_INDEX, NUM_JOINTS
 
 Say = Callable[[str], None]
+_D = TextureSettings
 
 
 def load_motion(text: str, takeset: TakeSet, joints: Sequence[str],
@@ -62,12 +65,14 @@ def _errors_cm(positions: np.ndarray, truth: np.ndarray, joints: Sequence[str]) 
             "per_joint_mean_cm": {j: round(float(err[:, i].mean()), 3) for i, j in enumerate(joints)}}
 
 
-def texture_command(data: Mapping[str, Any], motion: str, out: str | os.PathLike, *, mode: str = "complete",
-                    joints: Sequence[str] | None = None, k: int = 32, exclude_motion_take: bool = True,
-                    model: Mapping[str, Any] | None = None, conversion: Mapping[str, Any] | None = None,
-                    force: bool = False, gif: bool = True, say: Say = print, command: str = "") -> dict[str, Any]:
+def texture_command(data: Mapping[str, Any], motion: str, out: str | os.PathLike, *, mode: str = _D.mode,
+                    joints: Sequence[str] | None = _D.joints, k: int = _D.k,
+                    exclude_motion_take: bool = _D.exclude_motion_take, model: Mapping[str, Any] | None = None,
+                    conversion: Mapping[str, Any] | None = None, force: bool = _D.force, gif: bool = _D.gif,
+                    say: Say = print, command: str = "") -> dict[str, Any]:
     """Complete or texture ``motion`` on the database ``data`` (a ``data`` config) and write ``out`` (module
-    docstring). ``model``: further :class:`MotionTexturer` settings. Returns what ``summary.json`` holds.
+    docstring). ``model``: further :class:`MotionTexturer` settings. The defaults are
+    :class:`~stylemotion.reconstruct.settings.TextureSettings`'s. Returns what ``summary.json`` holds.
 
     Raises:
         OutputExistsError: ``out`` exists and ``force`` is off (before any work).
@@ -115,14 +120,9 @@ def texture_command(data: Mapping[str, Any], motion: str, out: str | os.PathLike
 
 
 def texture_from_config(cfg: DictConfig, say: Say = print, command: str = "") -> dict[str, Any]:
-    """:func:`texture_command` with the keys of ``stylemotion/configs/texture.yaml``."""
-    plain = plain_config(cfg, "texture")
-    joints = joints_option(plain, "'[Hips,Foot_L,Foot_R]'")
-    k = plain.get("k", 32)
-    if isinstance(k, bool) or not isinstance(k, int):
-        raise ConfigError(f"k={k} must be a whole number")
+    """:func:`texture_command` with the keys of ``stylemotion/configs/texture.yaml`` (:class:`TextureSettings`)."""
+    data, s = settings_from_config(cfg, TextureSettings, "texture")
     return texture_command(
-        plain["data"], plain["motion"], plain["out"], mode=str(plain.get("mode", "complete")), joints=joints, k=k,
-        exclude_motion_take=bool(plain.get("exclude_motion_take", True)), model=plain.get("model") or {},
-        conversion=conversion_keys(plain),
-        force=bool(plain.get("force", False)), gif=bool(plain.get("gif", True)), say=say, command=command)
+        data, s.motion, s.out, mode=s.mode, joints=s.joints, k=s.k, exclude_motion_take=s.exclude_motion_take,
+        model=asdict(s.model), conversion=conversion_keys(vars(s)), force=s.force, gif=s.gif, say=say,
+        command=command)

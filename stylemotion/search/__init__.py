@@ -4,40 +4,51 @@ Feature sets of canonical positions (§2.3.2, §2.6.1), every frame of a dataset
 :class:`MotionDatabase`, and a k-NN :class:`FrameIndex` over one feature set, persisted in the dataset cache;
 global motion matching of a query (:func:`search_motion`, §2.4.1), numerical and logical similarity searches
 (§2.5.1) and fast fat-graph base poses (§2.5.3). The ``stylemotion-search`` command: :mod:`.command`.
+
+The names below load from their submodules on first use (PEP 562, :func:`stylemotion.lazy_exports`), so a light
+submodule of the package loads without the heavy ones.
 """
 
-from stylemotion.search.database import FrameLocation, MotionDatabase
-from stylemotion.search.fat_graph import FatGraphClusters, base_poses, greedy_bases, write_clusters
-from stylemotion.search.features import (
-    E15_JOINTS,
-    E30_JOINTS,
-    E39_JOINTS,
-    FEATURE_SETS,
-    NORMALIZATIONS,
-    SEGMENTS,
-    WINDOW_SECONDS,
-    FeatureSpec,
-    FittedPCA,
-    body_frame_positions,
-    centre_of_mass,
-    compute_features,
-    feature_names,
-    feature_spec,
-    fit_features,
-    physics_terms,
-    root_frames,
-)
-from stylemotion.search.index import ENGINES, EXACT_ENGINES, SEARCH_FORMAT, FrameIndex, database_features
-from stylemotion.search.matching import (
-    DEFAULT_K,
-    MATCH_KEYS,
-    SearchResult,
-    SegmentMatch,
-    nearest_outside,
-    search_features,
-    search_motion,
-)
-from stylemotion.search.similarity import LogicalResult, logical_search, numerical_search
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from stylemotion import lazy_exports
+
+if TYPE_CHECKING:
+    from stylemotion.search.database import FrameLocation, MotionDatabase
+    from stylemotion.search.fat_graph import FatGraphClusters, base_poses, greedy_bases, write_clusters
+    from stylemotion.search.features import (
+        E15_JOINTS,
+        E30_JOINTS,
+        E39_JOINTS,
+        FEATURE_SETS,
+        NORMALIZATIONS,
+        SEGMENTS,
+        WINDOW_SECONDS,
+        FeatureSpec,
+        FittedPCA,
+        body_frame_positions,
+        centre_of_mass,
+        compute_features,
+        feature_names,
+        feature_spec,
+        fit_features,
+        physics_terms,
+        root_frames,
+    )
+    from stylemotion.search.index import ENGINES, EXACT_ENGINES, SEARCH_FORMAT, FrameIndex, database_features
+    from stylemotion.search.matching import (
+        DEFAULT_K,
+        MATCH_KEYS,
+        SearchResult,
+        SegmentMatch,
+        nearest_outside,
+        search_features,
+        search_motion,
+    )
+    from stylemotion.search.similarity import LogicalResult, logical_search, numerical_search
+
 
 __all__ = [
     "E15_JOINTS", "E30_JOINTS", "E39_JOINTS", "ENGINES", "EXACT_ENGINES", "FEATURE_SETS", "NORMALIZATIONS",
@@ -48,3 +59,44 @@ __all__ = [
     "LogicalResult", "logical_search", "numerical_search",
     "FatGraphClusters", "base_poses", "greedy_bases", "write_clusters",
 ]
+
+__getattr__, __dir__ = lazy_exports(__name__, {
+    "FrameLocation": "database",
+    "MotionDatabase": "database",
+    "FatGraphClusters": "fat_graph",
+    "base_poses": "fat_graph",
+    "greedy_bases": "fat_graph",
+    "write_clusters": "fat_graph",
+    "E15_JOINTS": "features",
+    "E30_JOINTS": "features",
+    "E39_JOINTS": "features",
+    "FEATURE_SETS": "features",
+    "FeatureSpec": "features",
+    "FittedPCA": "features",
+    "NORMALIZATIONS": "features",
+    "SEGMENTS": "features",
+    "WINDOW_SECONDS": "features",
+    "body_frame_positions": "features",
+    "centre_of_mass": "features",
+    "compute_features": "features",
+    "feature_names": "features",
+    "feature_spec": "features",
+    "fit_features": "features",
+    "physics_terms": "features",
+    "root_frames": "features",
+    "ENGINES": "index",
+    "EXACT_ENGINES": "index",
+    "FrameIndex": "index",
+    "SEARCH_FORMAT": "index",
+    "database_features": "index",
+    "DEFAULT_K": "matching",
+    "MATCH_KEYS": "matching",
+    "SearchResult": "matching",
+    "SegmentMatch": "matching",
+    "nearest_outside": "matching",
+    "search_features": "matching",
+    "search_motion": "matching",
+    "LogicalResult": "similarity",
+    "logical_search": "similarity",
+    "numerical_search": "similarity",
+})

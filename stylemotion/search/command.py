@@ -29,9 +29,9 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from omegaconf import DictConfig, OmegaConf
+from omegaconf import DictConfig
 
-from stylemotion.config import ConfigError, positive_int
+from stylemotion.config import positive_int, settings_from_config
 from stylemotion.datasets import TakeSet, build_dataset
 from stylemotion.datasets.loading import ConversionSettings
 from stylemotion.datasets.user_motion import (
@@ -50,9 +50,11 @@ from stylemotion.search.database import MotionDatabase
 from stylemotion.search.features import feature_names, feature_spec
 from stylemotion.search.index import ENGINES, FrameIndex
 from stylemotion.search.lng import NORMALIZATIONS
-from stylemotion.search.matching import DEFAULT_K, SearchResult, SegmentMatch, search_motion
+from stylemotion.search.matching import SearchResult, SegmentMatch, search_motion
+from stylemotion.search.settings import ExportSettings, FigureSettings, SearchSettings
 
 Say = Callable[[str], None]
+_D = SearchSettings
 
 
 class SearchInputError(UserInputError, ValueError):
@@ -147,13 +149,17 @@ def _checked_search(eps: Any, radius: Any) -> tuple[float, float | None]:
     return number(eps), None if radius is None else number(radius)
 
 
-def search(data: Mapping[str, Any], query: str, out: str | os.PathLike, *, features: str = "E15",
-           k: int = DEFAULT_K, top: int = 10, eps: float = 0.0, radius: float | None = None,
-           engine: str = "ckdtree", normalize: str = "none", exclude_query_take: bool = True,
-           retarget_query: bool = True, conversion: Mapping[str, Any] | None = None, export_bvh: bool = False,
-           export_gif: bool = False, export_top: int = 3, figure_matches: int = 3, figure_margin_s: float = 1.0,
-           force: bool = False, say: Say = print, command: str = "") -> dict[str, Any]:
+def search(data: Mapping[str, Any], query: str, out: str | os.PathLike, *, features: str = _D.features,
+           k: int = _D.k, top: int = _D.top, eps: float = _D.eps, radius: float | None = _D.radius,
+           engine: str = _D.engine, normalize: str = _D.normalize, exclude_query_take: bool = _D.exclude_query_take,
+           retarget_query: bool = _D.retarget_query, conversion: Mapping[str, Any] | None = None,
+           export_bvh: bool = ExportSettings.bvh, export_gif: bool = ExportSettings.gif,
+           export_top: int = ExportSettings.top, figure_matches: int = FigureSettings.matches,
+           figure_margin_s: float = FigureSettings.margin_s, force: bool = _D.force, say: Say = print,
+           command: str = "") -> dict[str, Any]:
     """Search ``data`` (a ``data`` config) for ``query`` and write the folder ``out`` (module docstring).
+
+    The keyword defaults are :class:`~stylemotion.search.settings.SearchSettings`'s (what each key means).
 
     Returns:
         What ``search.json`` holds (its ``matches`` are ``matches.json``'s records).
@@ -265,19 +271,12 @@ def _exports(folder: Path, q: Query, result: SearchResult, index: FrameIndex, bv
 
 
 def search_from_config(cfg: DictConfig, say: Say = print, command: str = "") -> dict[str, Any]:
-    """:func:`search` with the keys of ``stylemotion/configs/search.yaml``."""
-    plain = OmegaConf.to_container(cfg, resolve=True)
-    if not isinstance(plain, dict):
-        raise ConfigError("the search config must be a mapping")
-    export, figure = plain.get("export") or {}, plain.get("figure") or {}
+    """:func:`search` with the keys of ``stylemotion/configs/search.yaml`` (:class:`SearchSettings`)."""
+    data, settings = settings_from_config(cfg, SearchSettings, "search")
     return search(
-        plain["data"], plain["query"], plain["out"], features=plain.get("features", "E15"),
-        k=plain.get("k", DEFAULT_K), top=plain.get("top", 10), eps=plain.get("eps", 0.0), radius=plain.get("radius"),
-        engine=plain.get("engine", "ckdtree"), normalize=plain.get("normalize", "none"),
-        exclude_query_take=bool(plain.get("exclude_query_take", True)),
-        retarget_query=bool(plain.get("retarget_query", True)),
-        conversion=conversion_keys(plain),
-        export_bvh=bool(export.get("bvh", False)), export_gif=bool(export.get("gif", False)),
-        export_top=export.get("top", 3), figure_matches=figure.get("matches", 3),
-        figure_margin_s=float(figure.get("margin_s", 1.0)), force=bool(plain.get("force", False)), say=say,
-        command=command)
+        data, settings.query, settings.out, features=settings.features, k=settings.k, top=settings.top,
+        eps=settings.eps, radius=settings.radius, engine=settings.engine, normalize=settings.normalize,
+        exclude_query_take=settings.exclude_query_take, retarget_query=settings.retarget_query,
+        conversion=conversion_keys(vars(settings)), export_bvh=settings.export.bvh, export_gif=settings.export.gif,
+        export_top=settings.export.top, figure_matches=settings.figure.matches,
+        figure_margin_s=settings.figure.margin_s, force=settings.force, say=say, command=command)

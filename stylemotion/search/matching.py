@@ -34,13 +34,11 @@ import numpy as np
 
 from stylemotion.search.index import FrameIndex
 from stylemotion.search.lng import THESIS_STEPS, Match, Normalization, Step, lng_match
+from stylemotion.search.settings import SearchSettings
 
-#: Neighbours per query frame by default. With the thesis' steps a match needs every query frame's neighbours to
-#: hold the next frame of the same take, so a small k often finds no path. Chosen among 64, 256 and 1024 on 1 s
-#: queries cut from Bandai's validation takes against its train takes (the smallest k for which the LNG returns
-#: exact DTW's best segment for 95 % of the queries; else the highest share) by
-#: ``python scripts/benchmarks.py run search``; the test figures are in benchmarks/search.md.
-DEFAULT_K = 1024
+#: Neighbours per query frame by default: ``stylemotion-search``'s ``k`` (:class:`SearchSettings`, where it is
+#: set and why).
+DEFAULT_K: int = SearchSettings.k
 #: Keys of a match's record in ``matches.json``, in order.
 MATCH_KEYS = ("take", "content", "style", "start", "end", "cost")
 

@@ -38,7 +38,7 @@ from typing import Any
 import numpy as np
 from omegaconf import DictConfig, OmegaConf
 
-from stylemotion.config import ConfigError, config_dir, positive_int
+from stylemotion.config import ConfigError, config_dir, positive_int, settings_from_config
 from stylemotion.datasets import TakeSet, build_dataset
 from stylemotion.datasets.loading import ConversionSettings
 from stylemotion.datasets.user_motion import CONVERSION_KEYS, conversion_keys
@@ -62,9 +62,11 @@ from stylemotion.style_example.example import (
     parse_example,
 )
 from stylemotion.style_example.methods import Method, recorded_path
+from stylemotion.style_example.settings import StyleSettings
 from stylemotion.style_example.zero_shot import ZeroShotMethod
 
 Say = Callable[[str], None]
+_D = StyleSettings
 
 
 class Progress:
@@ -155,10 +157,11 @@ def method_options(method: str, options: Mapping[str, Any] | None) -> dict[str, 
 # -- the command
 
 
-def add_style(example: str, run: str | os.PathLike, name: str, out: str | os.PathLike, method: str = "cvae",
-              action: str | None = None, samples: int = 1000, seed: int | None = None, threads: Any = 1,
-              conversion: Mapping[str, Any] | None = None, say: Say = print, command: str = "",
-              network: Any = None, network_epochs: int | None = None) -> dict[str, Any]:
+def add_style(example: str, run: str | os.PathLike, name: str, out: str | os.PathLike, method: str = _D.method,
+              action: str | None = _D.action, samples: int = _D.samples, seed: int | None = _D.seed,
+              threads: Any = _D.threads, conversion: Mapping[str, Any] | None = None, say: Say = print,
+              command: str = "", network: Any = _D.network,
+              network_epochs: int | None = _D.network_epochs) -> dict[str, Any]:
     """Make the models of a new style ``name`` from ``example`` and evaluate them (see the module doc).
 
     Args:
@@ -338,17 +341,14 @@ def _percent(value: Any) -> str:
 
 
 def add_style_from_config(cfg: DictConfig | Mapping[str, Any], say: Say = print, command: str = "") -> dict[str, Any]:
-    """:func:`add_style` with the keys of ``configs/style.yaml``; missing mandatory keys are named."""
+    """:func:`add_style` with the keys of ``configs/style.yaml`` (:class:`StyleSettings`); missing mandatory keys
+    are named."""
     if isinstance(cfg, DictConfig):
         for key, form in (("example", "example=<BVH>[:start-end]"), ("name", "name=<the new style's name>")):
             if OmegaConf.is_missing(cfg, key):
                 raise ConfigError(f"{key} is missing: give {form}")
-        values = OmegaConf.to_container(cfg, resolve=True)
-    else:
-        values = dict(cfg)
-    return add_style(str(values["example"]), values["run"], values["name"], values["out"],
-                     method=values.get("method", "cvae"), action=values.get("action"),
-                     samples=values.get("samples", 1000), seed=values.get("seed"), threads=values.get("threads", 1),
-                     conversion=conversion_keys(values), say=say, command=command,
-                     network=values.get("network"), network_epochs=values.get("network_epochs"))
+    _, s = settings_from_config(cfg, StyleSettings, "style")
+    return add_style(str(s.example), s.run, s.name, s.out, method=s.method, action=s.action, samples=s.samples,
+                     seed=s.seed, threads=s.threads, conversion=conversion_keys(vars(s)), say=say, command=command,
+                     network=s.network, network_epochs=s.network_epochs)
 

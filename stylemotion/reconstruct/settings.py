@@ -1,0 +1,159 @@
+"""The settings of ``stylemotion-reconstruct``, ``stylemotion-texture`` and ``stylemotion-keyframes``: every key
+of ``configs/{reconstruct,texture,keyframes}.yaml`` and its one default.
+
+Each YAML takes its dataclass as its structured config (``- schema@_here_: reconstruct``,
+:mod:`stylemotion.cli.schemas`) and repeats no value; the library's defaults read them (the keyword defaults of
+:class:`~stylemotion.reconstruct.sparse.SparseReconstructor`, :class:`~stylemotion.reconstruct.texture.MotionTexturer`,
+:class:`~stylemotion.reconstruct.keyframes.DynamicMotionGraph` and of the three command functions). This module
+imports no numpy or torch, so the commands' ``--help`` stays fast.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from omegaconf import MISSING
+
+from stylemotion.config import MotionFileKeys
+
+
+@dataclass(frozen=True)
+class SparseModelSettings:
+    """The pose model of ``stylemotion-reconstruct`` (:class:`~stylemotion.reconstruct.sparse.SparseReconstructor`).
+
+    ``variance``: fraction of the neighbours' spread the local PCA keeps; ``marker_sd``: metres a marker may miss
+    by; ``smooth_sd``: metres a joint may move between frames (body frame); ``prior_weight``: weight of the
+    Mahalanobis prior of the local PCA; ``iterations``: k-NN searches per frame for E30/E39/pca* (searched
+    around the synthesized pose); ``weighted``: neighbours weighted by ``1/(feature distance + marker_sd)^2``.
+    """
+
+    variance: float = 0.99
+    marker_sd: float = 0.002
+    smooth_sd: float = 0.1
+    prior_weight: float = 1.0
+    iterations: int = 1
+    weighted: bool = True
+
+
+@dataclass(frozen=True)
+class ReconstructSettings(MotionFileKeys):
+    """Every key of ``stylemotion-reconstruct`` (besides ``data``), with its default.
+
+    ``markers``: ``BVH[:start-end]`` | NPZ (as ``stylemotion-convert`` writes) | CSV of marker tracks
+    (``frame,<joint>_x,<joint>_y,<joint>_z,…`` metres, Y up) | a take of the dataset. ``joints``: the markers;
+    None = ``[Hand_L,Hand_R,Foot_L,Foot_R,Head,Hips]`` (a CSV: its columns). ``features``: k-NN feature set
+    (E15 E30 E39 E15x3 E15x5 pca8 pca16 pca25). ``k``: neighbours of the local linear model per frame; chosen
+    on Bandai val takes (suite reconstruct, docs/reconstruct.md). ``noise_mm``: uniform noise of ± ``noise_mm``
+    millimetres added to the markers (thesis: 1); ``seed``: of that noise. ``exclude_markers_take``: markers= a
+    take of the dataset: leave it out of the database. ``model``: :class:`SparseModelSettings`.
+    ``joint_map``, ``unit_scale``, ``up_axis``: a BVH's (:class:`~stylemotion.config.MotionFileKeys`). ``out``:
+    a new folder (an existing one is refused unless ``force``). ``gif``: also ``out/motion.gif`` (the stick
+    figure along its ground track).
+    """
+
+    markers: str = MISSING
+    joints: list[str] | None = None
+    features: str = "E15"
+    k: int = 128
+    noise_mm: float = 0.0
+    seed: int = 0
+    exclude_markers_take: bool = True
+    model: SparseModelSettings = field(default_factory=SparseModelSettings)
+    out: str = "runs/reconstruct/${now:%Y-%m-%d_%H-%M-%S}"
+    force: bool = False
+    gif: bool = True
+
+
+@dataclass(frozen=True)
+class TextureModelSettings:
+    """The texturer of ``stylemotion-texture`` (:class:`~stylemotion.reconstruct.texture.MotionTexturer`).
+
+    ``top``: LNG segments per frame in the prior; ``lng_window``: frames of the online LNG's window;
+    ``samples``: feature window samples; ``feature_seconds``: feature window length; ``distance_sd``: metres
+    added to a segment's mean feature distance in its weight; ``cleanup``: foot-skating clean-up at the end;
+    ``weights``: pose/motion/smooth/control (the defaults per mode are ``texture.DEFAULT_WEIGHTS``).
+    """
+
+    top: int = 2
+    lng_window: int = 8
+    samples: int = 3
+    feature_seconds: float = 0.2
+    distance_sd: float = 0.002
+    cleanup: bool = True
+    weights: dict[str, float] = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class TextureSettings(MotionFileKeys):
+    """Every key of ``stylemotion-texture`` (besides ``data``), with its default.
+
+    ``motion``: ``BVH[:start-end]`` | NPZ (as ``stylemotion-convert`` writes; NaN allowed in untrusted joints for
+    complete) | a take of the dataset. ``mode``: complete (synthesize the untrusted joints) | texture (weak
+    control on all joints). ``joints``: trusted joints; None = hips and legs (complete) / every joint (texture).
+    ``k``: nearest database frames per frame fed to the online LNG. ``exclude_motion_take``: motion= a take of
+    the dataset: leave it out of the database. ``model``: :class:`TextureModelSettings`. ``joint_map``,
+    ``unit_scale``, ``up_axis``: a BVH's. ``out``: a new folder (an existing one is refused unless ``force``).
+    ``gif``: also ``out/motion.gif`` (the stick figure along its ground track).
+    """
+
+    motion: str = MISSING
+    mode: str = "complete"
+    joints: list[str] | None = None
+    k: int = 32
+    exclude_motion_take: bool = True
+    model: TextureModelSettings = field(default_factory=TextureModelSettings)
+    out: str = "runs/texture/${now:%Y-%m-%d_%H-%M-%S}"
+    force: bool = False
+    gif: bool = True
+
+
+@dataclass(frozen=True)
+class DynamicGraphSettings:
+    """The dynamic motion graph of ``stylemotion-keyframes``
+    (:class:`~stylemotion.reconstruct.keyframes.DynamicMotionGraph`).
+
+    ``k``: nearest database frames per expanded node (E15); ``b``: nodes expanded per tree and iteration;
+    ``max_iterations``: iterations before two keys are given up; ``voxel_m``: spatial hash voxel of the Hips
+    (thesis: 10 cm); ``min_segment_frames``: shortest segment (a segment runs to the next change of foot
+    contact); ``max_segment_s``: longest segment; ``max_turn_deg``: connection: facings within this;
+    ``max_pose_m``: connection: body-frame hands, feet and head within this (mean); ``max_velocity_m_s``:
+    connection: body-frame root velocities within this; ``blend_frames``: frames blended at a connection;
+    ``duration_weight``: price of a frame of timing error, in median frames of motion (0: thesis), chosen on
+    Bandai val key pairs (suite reconstruct, docs/reconstruct.md); ``facing_weight_m``: D_node's facing term,
+    metres per radian (0: thesis); ``retime``: resample each key pair to the keys' times; ``clean``: motion
+    texturing of the result with the keys pinned (§4.3.4).
+    """
+
+    k: int = 16
+    b: int = 4
+    max_iterations: int = 12
+    voxel_m: float = 0.1
+    min_segment_frames: int = 4
+    max_segment_s: float = 1.0
+    max_turn_deg: float = 30.0
+    max_pose_m: float = 0.15
+    max_velocity_m_s: float = 0.6
+    blend_frames: int = 10
+    duration_weight: float = 30.0
+    facing_weight_m: float = 1.0
+    retime: bool = True
+    clean: bool = True
+
+
+@dataclass(frozen=True)
+class KeyframesSettings(MotionFileKeys):
+    """Every key of ``stylemotion-keyframes`` (besides ``data``), with its default.
+
+    ``keys``: a JSON file ``{"keys": [{"time": s, "take"|"motion": ..., "frame": i} | {"time": s, "positions":
+    [[x,y,z] x 21]}, ...]}`` or ``{"motion": ..., "every_s": 2.0}``. ``exclude_key_takes``: leave the dataset
+    takes the keys come from out of the database. ``model``: :class:`DynamicGraphSettings`. ``joint_map``,
+    ``unit_scale``, ``up_axis``: a BVH's. ``out``: a new folder (an existing one is refused unless ``force``).
+    ``gif``: also ``out/motion.gif`` (the stick figure, keys marked).
+    """
+
+    keys: str = MISSING
+    exclude_key_takes: bool = True
+    model: DynamicGraphSettings = field(default_factory=DynamicGraphSettings)
+    out: str = "runs/keyframes/${now:%Y-%m-%d_%H-%M-%S}"
+    force: bool = False
+    gif: bool = True

@@ -1,0 +1,75 @@
+"""The settings of ``stylemotion-search``: every key of ``configs/search.yaml`` and its one default.
+
+``configs/search.yaml`` takes :class:`SearchSettings` as its structured config (``- schema@_here_: search``,
+:mod:`stylemotion.cli.schemas`) and repeats no value; :func:`stylemotion.search.command.search_from_config`
+builds it with :func:`stylemotion.config.build_settings`. This module imports no numpy or torch, so
+``stylemotion-search --help`` stays fast.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from omegaconf import MISSING
+
+from stylemotion.config import MotionFileKeys
+
+
+@dataclass(frozen=True)
+class ExportSettings:
+    """``bvh``: write ``bvh/query.bvh`` and ``bvh/<rank>_<take>_<start>-<end>.bvh`` of the top matches; ``gif``:
+    ``gif/…``, stick-figure animations of the same; ``top``: matches exported."""
+
+    bvh: bool = False
+    gif: bool = False
+    top: int = 3
+
+
+@dataclass(frozen=True)
+class FigureSettings:
+    """``matches``: panels of ``distance_matrix.png`` (the best matches); ``margin_s``: seconds of the take shown
+    before and after each match."""
+
+    matches: int = 3
+    margin_s: float = 1.0
+
+
+@dataclass(frozen=True)
+class SearchSettings(MotionFileKeys):
+    """Every key of ``stylemotion-search`` (besides ``data``), with its default.
+
+    ``query``: ``<BVH>[:start-end]`` (frames of the FILE's rate, 0-based, end exclusive; also
+    ``archive.zip::member.bvh``) or ``<take of the dataset>[:start-end]`` (frames at ``data.fps``).
+    ``features``: feature set (E15 E30 E39 E15x3 E15x5 E30x3 E39x3 pca8 pca16 pca25 EP17 EP19).
+    ``k``: neighbours per query frame (:data:`stylemotion.search.matching.DEFAULT_K` reads it). With the thesis'
+    steps a match needs every query frame's neighbours to hold the next frame of the same take, so a small k
+    often finds no path. Chosen among 64, 256 and 1024 on 1 s queries cut from Bandai's validation takes against
+    its train takes (the smallest k for which the LNG returns exact DTW's best segment for 95 % of the queries;
+    else the highest share) by ``python scripts/benchmarks.py run search``; test figures in benchmarks/search.md.
+    ``top``: most matches reported (non-overlapping, best first).
+    ``eps``: approximate k-NN: each distance within ``(1 + eps)`` of the true one; 0 = exact.
+    ``radius``: fixed-radius k-NN (feature units): only neighbours within it; None = the k nearest.
+    ``engine``: k-NN engine: ckdtree (exact) | pykdtree (exact) | faiss (exact) | faiss-hnsw (approx.).
+    ``normalize``: reported cost: none (the thesis' accumulated distance) | length | query.
+    ``exclude_query_take``: a take query: leave its own take out of the results.
+    ``retarget_query``: a BVH query: put it on the dataset's skeleton (``data.retarget``'s, else the median bones
+    of its normal takes), as ``stylemotion-style`` does with its example.
+    ``joint_map``, ``unit_scale``, ``up_axis``: the query file's (:class:`~stylemotion.config.MotionFileKeys`).
+    ``export``, ``figure``: :class:`ExportSettings`, :class:`FigureSettings`.
+    ``out``: a new folder (an existing one is refused unless ``force``).
+    """
+
+    query: str = MISSING
+    features: str = "E15"
+    k: int = 1024
+    top: int = 10
+    eps: float = 0.0
+    radius: float | None = None
+    engine: str = "ckdtree"
+    normalize: str = "none"
+    exclude_query_take: bool = True
+    retarget_query: bool = True
+    export: ExportSettings = field(default_factory=ExportSettings)
+    figure: FigureSettings = field(default_factory=FigureSettings)
+    out: str = "runs/search/${now:%Y-%m-%d_%H-%M-%S}"
+    force: bool = False
