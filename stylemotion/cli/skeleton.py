@@ -73,6 +73,65 @@ def one_line_errors(command: str) -> Iterator[None]:
         raise SystemExit(EXIT_INTERRUPTED) from None
 
 
+#: Hydra's message lines that only describe Hydra itself (its config search path, its grammar page).
+_HYDRA_NOISE = ("Config search path", "provider=", "See https://hydra.cc")
+
+
+def hydra_message(exc: BaseException) -> str:
+    """One line of Hydra's (or OmegaConf's) several-line message: blank and Hydra-internal lines dropped, a
+    line ending in ``:`` followed by its items joined with commas, the OmegaConf cause appended."""
+    parts: list[str] = []
+    for error in (exc, exc.__cause__):
+        if error is None:
+            continue
+        lines = [ln.strip() for ln in str(error).splitlines() if ln.strip()]
+        text, listing = "", False
+        for line in lines:
+            if line.startswith(_HYDRA_NOISE):
+                break
+            text += (", " if listing and not text.endswith(":") else " ") + line
+            listing = listing or line.endswith(":")
+        if text.strip() and text.strip() not in " ".join(parts):
+            parts.append(text.strip())
+    return " — ".join(parts) or type(exc).__name__
+
+
+@contextmanager
+def hydra_errors_in_one_line() -> Iterator[None]:
+    """Within the block, a config Hydra cannot compose (an unknown key or config group option, an override its
+    grammar refuses) and a missing or mistyped value (``???``) raise :class:`~stylemotion.config.ConfigError`
+    with :func:`hydra_message`, instead of Hydra's several lines and exit status 1; other exceptions keep
+    Hydra's reporting. (Hydra offers no hook for this: its ``run_and_report`` is wrapped for the block.)"""
+    from hydra._internal import utils
+    from hydra.errors import HydraException
+    from omegaconf.errors import MissingMandatoryValue, ValidationError
+
+    from stylemotion.config import ConfigError
+
+    original = utils.run_and_report
+
+    def run_and_report(func: Callable[[], Any]) -> Any:
+        try:
+            return func()
+        except (HydraException, MissingMandatoryValue, ValidationError) as exc:
+            if debugging():
+                raise
+            raise ConfigError(hydra_message(exc)) from None
+        except Exception as exc:  # noqa: BLE001 - handed back to Hydra's own reporting
+            caught = exc
+
+            def again() -> Any:
+                raise caught
+
+            return original(again)
+
+    utils.run_and_report = run_and_report
+    try:
+        yield
+    finally:
+        utils.run_and_report = original
+
+
 def _interrupt(signum: int, frame: Any) -> None:
     raise KeyboardInterrupt
 
@@ -146,7 +205,8 @@ def hydra_command(command: str, config_name: str, work: Callable[[Any, str], Any
         with one_line_errors(command):
             register_schemas_for(config_name)
             check_overrides(config_name, sys.argv[1:])
-            hydra.main(config_path=CONFIG_PACKAGE, config_name=config_name, version_base="1.3")(task)()
+            with hydra_errors_in_one_line():
+                hydra.main(config_path=CONFIG_PACKAGE, config_name=config_name, version_base="1.3")(task)()
 
     main.__doc__ = f"Console script ``{command}``."
     return main

@@ -1,0 +1,52 @@
+"""Config errors Hydra reports itself (issue 26): an unknown key, an unknown config group option, an override its
+grammar refuses and a missing mandatory value end in one line naming it, exit status 2, no traceback — not in
+Hydra's several lines and exit status 1. ``HYDRA_FULL_ERROR=1`` still shows Hydra's own error."""
+
+from __future__ import annotations
+
+import pytest
+from cli_runner import run_command
+
+from stylemotion.cli.skeleton import hydra_message
+
+
+@pytest.mark.parametrize("module, override, message", [
+    ("prepare", "data.nope=1", "Could not override 'data.nope'. To append to your config use +data.nope=1 — "
+                               "Key 'nope' is not in struct"),
+    ("train", "experiment=nope", "In 'train': Could not find 'experiment/nope' Available options in 'experiment': "
+                                 "autoencoder, "),
+    ("search", "query=[1,2", "no viable alternative at input '[1,2'"),
+    ("search", "out=x", "missing mandatory value: query"),
+])
+def test_hydra_config_errors_end_in_one_line(module, override, message, tmp_path, capsys, monkeypatch):
+    done = run_command(module, override, "hydra.run.dir=hydra", capsys=capsys, monkeypatch=monkeypatch, cwd=tmp_path)
+    assert done.returncode == 2 and "Traceback" not in done.stderr, done.stderr
+    (line,) = done.stderr.strip().splitlines()
+    assert line.startswith("stylemotion-") and message in line, line
+    assert "HYDRA_FULL_ERROR" not in line and "provider=" not in line
+
+
+def test_hydra_full_error_still_shows_hydras_error(tmp_path, capsys, monkeypatch):
+    from hydra.errors import MissingConfigException
+
+    monkeypatch.setenv("HYDRA_FULL_ERROR", "1")
+    from stylemotion.cli.train import main
+
+    monkeypatch.setattr("sys.argv", ["stylemotion-train", "experiment=nope", "hydra.run.dir=hydra"])
+    monkeypatch.chdir(tmp_path)
+    try:
+        with pytest.raises(MissingConfigException):
+            main()
+    finally:
+        from hydra.core.global_hydra import GlobalHydra
+
+        GlobalHydra.instance().clear()
+
+
+def test_a_several_line_message_becomes_one():
+    class Composed(Exception):
+        pass
+
+    error = Composed("Could not find 'x'\n\nAvailable options in 'g':\n\ta\n\tb\nConfig search path:\n\tprovider=p")
+    error.__cause__ = ValueError("Key 'x'\n    full_key: g.x")
+    assert hydra_message(error) == "Could not find 'x' Available options in 'g': a, b — Key 'x' full_key: g.x"
