@@ -132,7 +132,10 @@ class MotionWindowDataModule(SplitDataModule):
         super().__init__(data, takeset, batch_size, eval_batch_size, num_workers, split)
         if window_frames < 2 or stride < 1:
             raise ValueError(f"need window_frames ≥ 2 and stride ≥ 1; got {window_frames}, {stride}")
-        if isinstance(exclude_styles, str) or not all(isinstance(s, str) for s in exclude_styles or []):
+        if isinstance(exclude_styles, str):
+            raise UnknownStyleError(f"datamodule.exclude_styles must be a list of style names, got the string "
+                                    f"{exclude_styles!r} (write [{exclude_styles}])")
+        if not all(isinstance(s, str) for s in exclude_styles or []):
             raise UnknownStyleError(f"datamodule.exclude_styles must be a list of style names, got {exclude_styles!r}")
         self.exclude_styles = list(exclude_styles or [])
         self.save_hyperparameters(ignore=["takeset"])
