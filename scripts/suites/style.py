@@ -15,6 +15,8 @@ method works. ``--data bandai`` runs Bandai dataset-2's walks (30–60 min per s
 from __future__ import annotations
 
 import argparse
+from concurrent.futures import ProcessPoolExecutor
+from multiprocessing import get_context
 from pathlib import Path
 from typing import Any
 
@@ -123,18 +125,20 @@ def reproduce_seed(data: str, seed: int, out: Path, workers: int, primitives: li
     return read_json_object(out / "report" / "report.json", "the reproduction's report", "rerun the suite")
 
 
-def candidate_metrics(cfg, folder: Path) -> dict[str, float]:
-    """Train one α candidate (the ``train`` config ``cfg``) into ``folder``, or reuse its recorded result; returns
-    its validation metrics at the best ``val/loss`` epoch (``metrics.json``'s ``val``)."""
+def train_candidate(container: dict[str, Any], folder: str) -> dict[str, float]:
+    """Train one α candidate (a resolved ``train`` config) into ``folder``, or reuse its recorded result; returns
+    its validation metrics at the best ``val/loss`` epoch (``metrics.json``'s ``val``). Runs in a worker process."""
+    from omegaconf import OmegaConf
+
     from stylemotion.io.jsonfile import read_json_object, write_json
     from stylemotion.training.fit import run as train_run
 
-    record = folder / "candidate.json"
+    path = Path(folder)
+    record = path / "candidate.json"
     if record.is_file():
-        return dict(read_json_object(record, "an α candidate's record", f"delete {folder}")["val"])
-    train_run(cfg)
-    val = dict(read_json_object(folder / "metrics.json", "an α candidate's metrics", f"delete {folder}").get("val")
-               or {})
+        return dict(read_json_object(record, "an α candidate's record", f"delete {path}")["val"])
+    train_run(OmegaConf.create(container))
+    val = dict(read_json_object(path / "metrics.json", "an α candidate's metrics", f"delete {path}").get("val") or {})
     write_json(record, {"val": val})
     return val
 
@@ -162,11 +166,10 @@ def choose_alpha(args: argparse.Namespace, seed: int, primitives: list[str] | No
         pool = styles or [s for s in repro.data_summary["styles"] if s != str(cfg.evaluation.neutral_style)]
         chosen_styles = sorted(np.random.default_rng(1).choice(pool, min(args.alpha_styles, len(pool)),
                                                                replace=False).tolist())
+        # the reproduction's CVAE stage as it is, but α; no sample GIFs (nothing reads them here)
         overrides = [o for o in OmegaConf.to_container(cfg.stages.cvae, resolve=True)
-                     if not str(o).startswith("model.style_weight=")]
-        if not cfg.budget.stage_samples:
-            overrides.append("callbacks.samples=null")
-        values: dict[float, dict[str, dict[str, float]]] = {}
+                     if not str(o).startswith("model.style_weight=")] + ["callbacks.samples=null"]
+        jobs = {}
         for alpha in sorted(args.alphas):
             for primitive in repro.primitives:
                 for style in chosen_styles:
@@ -174,11 +177,17 @@ def choose_alpha(args: argparse.Namespace, seed: int, primitives: list[str] | No
                     train_cfg = stage_train_config([*overrides, f"model.style_weight={alpha}"],
                                                    {"primitive": primitive, "style": style}, repro.data_cfg, folder,
                                                    args.alpha_seed, 1, str(autoencoder.checkpoint))
-                    print(f"[α {alpha:g}] {primitive}/{style}", flush=True)
-                    val = candidate_metrics(train_cfg, folder)
-                    values.setdefault(alpha, {})[f"{primitive}/{style}"] = {m: val.get(m) for m in METRICS}
+                    jobs[(alpha, f"{primitive}/{style}")] = (OmegaConf.to_container(train_cfg, resolve=True),
+                                                             str(folder))
     finally:
         GlobalHydra.instance().clear()
+    values: dict[float, dict[str, dict[str, float]]] = {}
+    with ProcessPoolExecutor(max_workers=max(1, args.workers), mp_context=get_context("spawn")) as pool:
+        futures = {key: pool.submit(train_candidate, *job) for key, job in jobs.items()}
+        for (alpha, name), future in futures.items():
+            val = future.result()
+            print(f"[α {alpha:g}] {name}: " + ", ".join(f"{m} {val.get(m)}" for m in METRICS), flush=True)
+            values.setdefault(alpha, {})[name] = {m: val.get(m) for m in METRICS}
     scores = style_weight_scores(values)
     chosen = choose_style_weight(values)
     return {"candidates": sorted(args.alphas), "styles": chosen_styles, "seed": args.alpha_seed,

@@ -1,7 +1,7 @@
 """Suite ``style_bandai``: suite ``style`` on Bandai dataset-2's walks, its results kept apart from the synthetic
 smoke run (``benchmarks/results/style_bandai.json``). The same options; ``--data`` defaults to ``bandai``.
 
-    python scripts/benchmarks.py run style_bandai --primitives walk_leftStance --alphas 1 3 5 15 50 200
+    python scripts/benchmarks.py run style_bandai --primitives walk_leftStance --alphas 1 5 15 50 200
 """
 
 from __future__ import annotations
