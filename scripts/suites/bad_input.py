@@ -515,9 +515,7 @@ def build_cases(p: Inputs) -> list[Case]:
         (["data=bvh_folder", f"data.root={p.inputs / 'folders' / 'nothing'}"], ["nothing"], "empty folder"),
         (["data=bvh_folder", f"data.root={i('afile')}"], ["afile"], "root is a file"),
         (["data=bvh_folder", "data.root=/nonexistent/mocap"], ["/nonexistent/mocap"], "missing folder"),
-        (["data=bvh_folder", f"data.root={i('escape.zip')}"], ["escaped.bvh", "escape.zip"], "zip with ../ member"),
-        (["data=bvh_folder", f"data.root={i('absolute.zip')}"], ["absolute.bvh", "absolute.zip"],
-         "zip with absolute member"),
+
         (["data=bvh_folder", f"data.root={i('bomb.zip')}"], ["bomb.zip", "max_file_mb"], "zip bomb"),
         (["data=bvh_folder", f"data.root={i('junk.zip')}"], ["junk.zip"], "truncated zip"),
         (["data=bandai", "data.root=/nonexistent/data.zip"], ["data.zip"], "missing Bandai zip"),
@@ -534,6 +532,10 @@ def build_cases(p: Inputs) -> list[Case]:
     ]:
         add(data, f"input_{kind.replace(' ', '_')}_{len(cases)}", args, "refused", kind, names, out=("hydra",),
             timeout=240)
+    for zip_name, kind in [("escape.zip", "zip with ../ member"), ("absolute.zip", "zip with absolute member")]:
+        # a member is read, never extracted: answering is fine as long as nothing is written outside
+        add(data, f"input_{zip_name}", ["data=bvh_folder", f"data.root={i(zip_name)}"], "either", kind,
+            (zip_name,), out=("hydra",))
     add(data, "interrupt", ["data.takes_per_pair=40"], "interrupt", "Ctrl-C mid-run", out=("hydra", "cache"),
         trigger="hydra", interrupt_after=1.5, own_cache=True)
 
@@ -1049,6 +1051,8 @@ def run_case(case: Case, root: Path, cache: Path, logs: Path) -> dict[str, Any]:
     stdout_path, stderr_path = logs / f"{case.id.replace('/', '_')}.out", logs / f"{case.id.replace('/', '_')}.err"
 
     def limits() -> None:
+        # a suite started in the background (nohup, &) ignores Ctrl-C, and its children would inherit that
+        signal.signal(signal.SIGINT, signal.SIG_DFL)
         resource.setrlimit(resource.RLIMIT_AS, (ADDRESS_LIMIT, ADDRESS_LIMIT))
         os.nice(5)
         if uid:
