@@ -116,7 +116,11 @@ def load_bandai(
         raise MotionDataError(str(root), "no such file or folder: data.root is the Bandai data set's folder or its "
                               "data.zip (docs/data.md)")
     sources = list_sources(root, "*.bvh")  # a damaged zip is named before its label tables are looked for
-    content_table, style_table = find_label_tables(root if root.is_dir() else root.parent, label_dir)
+    try:
+        content_table, style_table = find_label_tables(root if root.is_dir() else root.parent, label_dir)
+    except MotionDataError as exc:  # named after data.root, the value the user gave
+        raise MotionDataError(str(root), "not the Bandai data set as downloaded (its data.zip beside the "
+                              f"label tables): {exc.detail}") from None
     for key, wanted, table in (("content", contents, content_table), ("style", styles, style_table)):
         unknown = sorted(set(wanted or []) - set(table))
         if unknown:

@@ -28,3 +28,16 @@ def test_bad_data_values_and_files_end_in_one_line(overrides, message, tmp_path,
     (line,) = done.stderr.strip().splitlines()
     assert line.startswith("stylemotion-data: ") and message in line, line
     assert not (out / "summary.json").exists()
+
+
+def test_a_zip_without_bandai_label_tables_is_named_as_data_root(tmp_path, capsys, monkeypatch):
+    import zipfile
+
+    with zipfile.ZipFile(tmp_path / "mine.zip", "w") as zf:
+        zf.writestr("walk.bvh", "HIERARCHY\n")
+    done = run_command("prepare", "data=bandai", f"data.root={tmp_path / 'mine.zip'}", "hydra.run.dir=run",
+                       capsys=capsys, monkeypatch=monkeypatch, cwd=tmp_path)
+    assert done.returncode == 2 and "Traceback" not in done.stderr, done.stderr
+    (line,) = done.stderr.strip().splitlines()
+    assert line.startswith(f"stylemotion-data: {tmp_path / 'mine.zip'}: not the Bandai data set as downloaded"), line
+    assert "label tables content_label.txt and style_label.txt not found" in line and "data.label_dir" in line
