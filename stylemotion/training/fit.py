@@ -20,6 +20,7 @@ from __future__ import annotations
 import json
 import logging
 import math
+import signal
 from collections.abc import Iterable, Mapping, Sequence
 from datetime import datetime
 from pathlib import Path
@@ -320,7 +321,7 @@ def run(cfg: DictConfig, extra_callbacks: list[pl.Callback] | None = None,
 
     if cfg.get("train", True):
         # checkpoints hold tensors and plain values only, so they load without unpickling code
-        trainer.fit(model, datamodule=datamodule, ckpt_path=ckpt_path, weights_only=True)
+        _stop_on_ctrl_c(trainer, trainer.fit, model, datamodule=datamodule, ckpt_path=ckpt_path, weights_only=True)
         if resumed_at is not None and trainer.global_step == resumed_at and finished.is_file():
             log.info("%s: the run had finished at step %d and its trainer limits are reached: nothing trained, "
                      "%s kept as it is", ckpt_path, resumed_at, finished)
@@ -341,7 +342,8 @@ def run(cfg: DictConfig, extra_callbacks: list[pl.Callback] | None = None,
                 cb.save_on_exception = False
         # the best checkpoint of this fit; with train=false, the checkpoint given as ckpt_path
         test_ckpt = best or (None if cfg.get("train", True) else ckpt_path)
-        results = trainer.test(model, datamodule=datamodule, ckpt_path=test_ckpt, weights_only=True)
+        results = _stop_on_ctrl_c(trainer, trainer.test, model, datamodule=datamodule, ckpt_path=test_ckpt,
+                                  weights_only=True)
         metrics["test"] = {k: _plain(v) for k, v in (results[0] if results else {}).items()}
     metrics["stylemotion_version"] = record["stylemotion_version"]
     metrics["git_commit"] = record["git_commit"]
@@ -390,6 +392,19 @@ def check_resume_checkpoint(ckpt_path: str, model: pl.LightningModule) -> int:
         raise ResumeCheckpointError(f"{where}: its weights do not fit the configured {type(model).__name__} — "
                                     + "; ".join(bad[:3]) + (" …" if len(bad) > 3 else ""))
     return step
+
+
+def _stop_on_ctrl_c(trainer: pl.Trainer, call: Any, *args: Any, **kwargs: Any) -> Any:
+    """``call(*args, **kwargs)`` (the trainer's ``fit`` or ``test``), with Ctrl-C raised again as
+    :class:`KeyboardInterrupt` after Lightning's graceful shutdown (which saves ``last.ckpt`` to resume from and
+    then exits with status 1), so the command ends in its one line and status 130."""
+    try:
+        return call(*args, **kwargs)
+    except SystemExit:
+        if not trainer.interrupted:
+            raise
+        signal.signal(signal.SIGINT, signal.default_int_handler)  # Lightning ignores further Ctrl-C
+        raise KeyboardInterrupt from None
 
 
 def nothing_left_to_train(ckpt_path: str, trainer_cfg: Mapping[str, Any]) -> bool:

@@ -118,3 +118,22 @@ def test_a_bad_seed_is_refused_before_the_run_folder_is_made(seed, tmp_path):
     with pytest.raises(ConfigError, match="seed must be a whole number ≥ 0"):
         run(_cfg(f"output_dir={tmp_path / 'run'}", f"seed={seed}"))
     assert not (tmp_path / "run").exists()
+
+
+def test_ctrl_c_while_training_is_a_keyboard_interrupt_not_exit_status_1(tmp_path):
+    import signal
+
+    import lightning.pytorch as pl
+
+    class CtrlC(pl.Callback):
+        def on_train_batch_start(self, trainer, pl_module, batch, batch_idx):
+            raise KeyboardInterrupt
+
+    handler = signal.getsignal(signal.SIGINT)
+    try:
+        with pytest.raises(KeyboardInterrupt):  # the skeleton turns it into one line and status 130
+            run(_cfg(f"output_dir={tmp_path / 'run'}"), extra_callbacks=[CtrlC()])
+        assert signal.getsignal(signal.SIGINT) is signal.default_int_handler  # Ctrl-C works again
+    finally:
+        signal.signal(signal.SIGINT, handler)
+    assert not (tmp_path / "run" / "metrics.json").exists()
