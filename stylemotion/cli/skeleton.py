@@ -97,11 +97,13 @@ def hydra_message(exc: BaseException) -> str:
 
 
 @contextmanager
-def hydra_errors_in_one_line() -> Iterator[None]:
+def hydra_errors_in_one_line(started: Callable[[], bool] = lambda: True) -> Iterator[None]:
     """Within the block, a config Hydra cannot compose (an unknown key or config group option, an override its
     grammar refuses) and a missing or mistyped value (``???``) raise :class:`~stylemotion.config.ConfigError`
-    with :func:`hydra_message`, instead of Hydra's several lines and exit status 1; other exceptions keep
-    Hydra's reporting. (Hydra offers no hook for this: its ``run_and_report`` is wrapped for the block.)"""
+    with :func:`hydra_message`, and a file Hydra cannot write before the work has ``started()`` (its run folder
+    below a file or in a read-only folder) :class:`~stylemotion.io.errors.OutputWriteError`, instead of Hydra's
+    several lines and exit status 1; other exceptions keep Hydra's reporting. (Hydra offers no hook for this:
+    its ``run_and_report`` is wrapped for the block.)"""
     from hydra._internal import utils
     from hydra.errors import HydraException
     from omegaconf.errors import MissingMandatoryValue, ValidationError
@@ -117,6 +119,13 @@ def hydra_errors_in_one_line() -> Iterator[None]:
             if debugging():
                 raise
             raise ConfigError(hydra_message(exc)) from None
+        except OSError as exc:
+            if started() or debugging():
+                raise
+            from stylemotion.io.errors import OutputWriteError
+
+            raise OutputWriteError(f"hydra.run.dir: cannot write {exc.filename or 'the run folder'} "
+                                   f"({exc.strerror or exc}); choose another hydra.run.dir") from None
         except Exception as exc:  # noqa: BLE001 - handed back to Hydra's own reporting
             caught = exc
 
@@ -130,6 +139,24 @@ def hydra_errors_in_one_line() -> Iterator[None]:
         yield
     finally:
         utils.run_and_report = original
+
+
+def check_run_dir(overrides: Sequence[str]) -> None:
+    """Refuse a ``hydra.run.dir=`` that is a link: Hydra would write its ``.hydra/`` and log through it, out of
+    the run folder (train, data and reproduce keep their run there).
+
+    Raises:
+        UnsafePathError: naming the link and where it points.
+    """
+    from stylemotion.io.outputs import UnsafePathError
+
+    for override in overrides:
+        key, _, value = override.partition("=")
+        if key.lstrip("+~") == "hydra.run.dir" and value:
+            path = Path(value.strip("'\"")).expanduser()
+            if path.is_symlink():
+                raise UnsafePathError(f"hydra.run.dir={value}: {path} is a link to {path.resolve()}; nothing is "
+                                      "written through a link: give the folder itself")
 
 
 def _interrupt(signum: int, frame: Any) -> None:
@@ -187,8 +214,11 @@ def hydra_command(command: str, config_name: str, work: Callable[[Any, str], Any
             already (the Hydra run folder is the run's folder: train, data, reproduce).
     """
 
+    started: list[bool] = []
+
     @functools.wraps(work)
     def task(cfg: Any) -> Any:
+        started.append(True)
         with one_line_errors(command):
             value = work(cfg, command_line(command))
             if record_in is not None:
@@ -205,7 +235,8 @@ def hydra_command(command: str, config_name: str, work: Callable[[Any, str], Any
         with one_line_errors(command):
             register_schemas_for(config_name)
             check_overrides(config_name, sys.argv[1:])
-            with hydra_errors_in_one_line():
+            check_run_dir(sys.argv[1:])
+            with hydra_errors_in_one_line(lambda: bool(started)):
                 hydra.main(config_path=CONFIG_PACKAGE, config_name=config_name, version_base="1.3")(task)()
 
     main.__doc__ = f"Console script ``{command}``."

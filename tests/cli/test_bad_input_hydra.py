@@ -50,3 +50,20 @@ def test_a_several_line_message_becomes_one():
     error = Composed("Could not find 'x'\n\nAvailable options in 'g':\n\ta\n\tb\nConfig search path:\n\tprovider=p")
     error.__cause__ = ValueError("Key 'x'\n    full_key: g.x")
     assert hydra_message(error) == "Could not find 'x' Available options in 'g': a, b — Key 'x' full_key: g.x"
+
+
+@pytest.mark.parametrize("run_dir, message", [
+    ("afile", "hydra.run.dir: cannot write afile (File exists); choose another hydra.run.dir"),
+    ("afile/run", "hydra.run.dir: cannot write afile/run (Not a directory)"),
+    ("linked", "hydra.run.dir=linked: linked is a link to "),
+])
+def test_a_run_folder_hydra_cannot_make_or_that_links_out_is_one_line(run_dir, message, tmp_path, capsys,
+                                                                       monkeypatch):
+    (tmp_path / "afile").write_text("mine")
+    (tmp_path / "elsewhere").mkdir()
+    (tmp_path / "linked").symlink_to(tmp_path / "elsewhere", target_is_directory=True)
+    done = run_command("prepare", f"hydra.run.dir={run_dir}", capsys=capsys, monkeypatch=monkeypatch, cwd=tmp_path)
+    assert done.returncode == 2 and "Traceback" not in done.stderr, done.stderr
+    (line,) = done.stderr.strip().splitlines()
+    assert line.startswith("stylemotion-data: ") and message in line, line
+    assert (tmp_path / "afile").read_text() == "mine" and not any((tmp_path / "elsewhere").iterdir())
