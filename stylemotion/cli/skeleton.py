@@ -141,6 +141,21 @@ def hydra_errors_in_one_line(started: Callable[[], bool] = lambda: True) -> Iter
         utils.run_and_report = original
 
 
+def check_not_a_link(value: Any, key: str) -> None:
+    """Refuse an output folder ``key=value`` that is a link (every command writes its outputs into ``out``):
+    nothing is written through a link, wherever it points.
+
+    Raises:
+        UnsafePathError: naming the key, the link and where it points.
+    """
+    from stylemotion.io.outputs import UnsafePathError
+
+    path = Path(str(value)).expanduser() if value not in (None, "") else None
+    if path is not None and path.is_symlink():
+        raise UnsafePathError(f"{key}={value}: {path} is a link to {path.resolve()}; nothing is written through a "
+                              f"link: choose another {key}=…")
+
+
 def check_run_dir(overrides: Sequence[str]) -> None:
     """Refuse a ``hydra.run.dir=`` that is a link: Hydra would write its ``.hydra/`` and log through it, out of
     the run folder (train, data and reproduce keep their run there).
@@ -220,6 +235,7 @@ def hydra_command(command: str, config_name: str, work: Callable[[Any, str], Any
     def task(cfg: Any) -> Any:
         started.append(True)
         with one_line_errors(command):
+            check_not_a_link(cfg.get("out") if hasattr(cfg, "get") else None, "out")
             value = work(cfg, command_line(command))
             if record_in is not None:
                 keep_run_record(cfg, record_in)

@@ -67,3 +67,16 @@ def test_a_run_folder_hydra_cannot_make_or_that_links_out_is_one_line(run_dir, m
     (line,) = done.stderr.strip().splitlines()
     assert line.startswith("stylemotion-data: ") and message in line, line
     assert (tmp_path / "afile").read_text() == "mine" and not any((tmp_path / "elsewhere").iterdir())
+
+
+@pytest.mark.parametrize("module, args", [("reproduce", ["data.takes_per_pair=2"]),
+                                          ("segment", ["data.takes_per_pair=1", "force=true"])])
+def test_an_out_that_is_a_link_is_refused_before_anything_is_written(module, args, tmp_path, capsys, monkeypatch):
+    (tmp_path / "elsewhere").mkdir()
+    (tmp_path / "linked").symlink_to(tmp_path / "elsewhere", target_is_directory=True)
+    done = run_command(module, *args, "out=linked", "hydra.run.dir=hydra", capsys=capsys, monkeypatch=monkeypatch,
+                       cwd=tmp_path)
+    assert done.returncode == 2 and "Traceback" not in done.stderr, done.stderr
+    line = done.stderr.strip().splitlines()[-1]
+    assert line.startswith(f"stylemotion-{module}: out=linked: linked is a link to "), line
+    assert not any((tmp_path / "elsewhere").iterdir())
