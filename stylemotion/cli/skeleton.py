@@ -174,6 +174,20 @@ def check_run_dir(overrides: Sequence[str]) -> None:
                                       "written through a link: give the folder itself")
 
 
+def finished_run_overrides(overrides: Sequence[str], finished: str | None) -> list[str]:
+    """Hydra overrides that keep a finished run's folder as it is: when ``hydra.run.dir=`` names a folder holding
+    ``finished``, Hydra's ``.hydra/`` record and its job log stay those of the run's first start (the console
+    still shows the log; a start the work accepts is recorded by the work, e.g. train's ``run.json``)."""
+    if not finished:
+        return []
+    for override in overrides:
+        key, _, value = override.partition("=")
+        if key.lstrip("+~") == "hydra.run.dir" and value:
+            if (Path(value.strip("'\"")).expanduser() / finished).is_file():
+                return ["hydra.output_subdir=null", "hydra/job_logging=stdout"]
+    return []
+
+
 def _interrupt(signum: int, frame: Any) -> None:
     raise KeyboardInterrupt
 
@@ -215,7 +229,7 @@ def keep_run_record(cfg: Any, key: str) -> None:
 
 
 def hydra_command(command: str, config_name: str, work: Callable[[Any, str], Any],
-                  record_in: str | None = None) -> Callable[[], None]:
+                  record_in: str | None = None, finished: str | None = None) -> Callable[[], None]:
     """The console-script entry point of a Hydra command.
 
     Args:
@@ -227,16 +241,20 @@ def hydra_command(command: str, config_name: str, work: Callable[[Any, str], Any
         record_in: the config key of the new output folder the work makes (``out``): when it finished, the
             resolved config and the log go into it (:func:`keep_run_record`); None when the folder holds them
             already (the Hydra run folder is the run's folder: train, data, reproduce).
+        finished: a file whose presence in the ``hydra.run.dir=`` given on the command line marks a finished
+            run (train: ``metrics.json``): Hydra then writes neither its ``.hydra/`` nor its job log there, so
+            the run's files are touched only once the work accepts the run (:func:`finished_run_overrides`).
     """
 
     started: list[bool] = []
+    typed: list[str] = []  # the command line as typed, without the overrides added here
 
     @functools.wraps(work)
     def task(cfg: Any) -> Any:
         started.append(True)
         with one_line_errors(command):
             check_not_a_link(cfg.get("out") if hasattr(cfg, "get") else None, "out")
-            value = work(cfg, command_line(command))
+            value = work(cfg, command_line(command, typed or None))
             if record_in is not None:
                 keep_run_record(cfg, record_in)
             return value
@@ -252,6 +270,8 @@ def hydra_command(command: str, config_name: str, work: Callable[[Any, str], Any
             register_schemas_for(config_name)
             check_overrides(config_name, sys.argv[1:])
             check_run_dir(sys.argv[1:])
+            typed[:] = sys.argv[1:]
+            sys.argv[1:] = [*typed, *finished_run_overrides(typed, finished)]
             with hydra_errors_in_one_line(lambda: bool(started)):
                 hydra.main(config_path=CONFIG_PACKAGE, config_name=config_name, version_base="1.3")(task)()
 

@@ -30,7 +30,7 @@ def train(cfg: DictConfig, command: str) -> float | None:
     return objective(result["metrics"], cfg)
 
 
-main = hydra_command("stylemotion-train", "train", train)
+main = hydra_command("stylemotion-train", "train", train, finished="metrics.json")
 
 
 if __name__ == "__main__":

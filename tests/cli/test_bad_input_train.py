@@ -137,3 +137,14 @@ def test_ctrl_c_while_training_is_a_keyboard_interrupt_not_exit_status_1(tmp_pat
     finally:
         signal.signal(signal.SIGINT, handler)
     assert not (tmp_path / "run" / "metrics.json").exists()
+
+
+@pytest.mark.parametrize("overrides, status", [(["ckpt_path=auto"], 0), (["ckpt_path=last"], 0),
+                                               (["ckpt_path=last", "model.hidden_units=64"], 2)])
+def test_the_command_touches_no_file_of_a_finished_run_it_does_not_train(run_copy, overrides, status, capsys,
+                                                                       monkeypatch):
+    before = _snapshot(run_copy)
+    done = run_command("train", *SMOKE, f"hydra.run.dir={run_copy}", *overrides, capsys=capsys,
+                       monkeypatch=monkeypatch, cwd=run_copy.parent)
+    assert done.returncode == status, done.stderr
+    assert _snapshot(run_copy) == before  # no .hydra/ record, no job log, no run.json start, no config
