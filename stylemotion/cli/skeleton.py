@@ -156,6 +156,18 @@ def check_not_a_link(value: Any, key: str) -> None:
                               f"link: choose another {key}=…")
 
 
+def check_seed(seed: Any, key: str = "seed") -> None:
+    """Refuse a ``seed`` that is not a whole number ≥ 0 (None: the command's default) before any work.
+
+    Raises:
+        ConfigError: naming the key and the value.
+    """
+    from stylemotion.config import ConfigError
+
+    if seed is not None and (not isinstance(seed, int) or isinstance(seed, bool) or seed < 0):
+        raise ConfigError(f"{key} must be a whole number ≥ 0, got {seed!r}")
+
+
 def check_run_dir(overrides: Sequence[str]) -> None:
     """Refuse a ``hydra.run.dir=`` that is a link: Hydra would write its ``.hydra/`` and log through it, out of
     the run folder (train, data and reproduce keep their run there).
@@ -253,7 +265,9 @@ def hydra_command(command: str, config_name: str, work: Callable[[Any, str], Any
     def task(cfg: Any) -> Any:
         started.append(True)
         with one_line_errors(command):
-            check_not_a_link(cfg.get("out") if hasattr(cfg, "get") else None, "out")
+            if hasattr(cfg, "get"):
+                check_not_a_link(cfg.get("out"), "out")
+                check_seed(cfg.get("seed"))
             value = work(cfg, command_line(command, typed or None))
             if record_in is not None:
                 keep_run_record(cfg, record_in)

@@ -80,3 +80,16 @@ def test_an_out_that_is_a_link_is_refused_before_anything_is_written(module, arg
     line = done.stderr.strip().splitlines()[-1]
     assert line.startswith(f"stylemotion-{module}: out=linked: linked is a link to "), line
     assert not any((tmp_path / "elsewhere").iterdir())
+
+
+@pytest.mark.parametrize("module, args", [("evaluate", ["checkpoints=[x.ckpt]"]), ("generate", []),
+                                          ("reproduce", ["data.takes_per_pair=2"])])
+@pytest.mark.parametrize("seed", ["abc", "-1", "1.5", "true"])
+def test_a_seed_that_is_not_a_whole_number_is_refused_before_any_work(module, args, seed, tmp_path, capsys,
+                                                                      monkeypatch):
+    done = run_command(module, *args, f"seed={seed}", "out=out", "hydra.run.dir=hydra", capsys=capsys,
+                       monkeypatch=monkeypatch, cwd=tmp_path)
+    assert done.returncode == 2 and "Traceback" not in done.stderr, done.stderr
+    line = done.stderr.strip().splitlines()[-1]
+    assert line.startswith("stylemotion-") and "seed must be a whole number ≥ 0, got " in line, line
+    assert not (tmp_path / "out").exists()
