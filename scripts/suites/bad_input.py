@@ -449,12 +449,12 @@ def build_cases(p: Inputs) -> list[Case]:
            "offset_huge", "deep_nesting", "utf16", "unknown_skeleton", "folder", "fifo", "loop_link",
            "dangling_link", "dev_zero", "huge_file"]
     #: the readers' kinds for the commands that load a database first (seconds per case)
-    fewer = ["good", "zup", "millisecond", "empty", "binary", "cut_in_motion", "frames_huge", "number_nan",
-             "unknown_skeleton", "fifo", "loop_link", "huge_file"]
-    fewest = ["good", "millisecond", "binary", "number_nan", "unknown_skeleton", "fifo"]
+    fewer = ["good", "zup", "millisecond", "empty", "binary", "frames_huge", "number_nan", "unknown_skeleton",
+             "fifo", "huge_file"]
+    fewest = ["good", "millisecond", "binary", "fifo"]
     #: the viewer reads BVH files as convert does: the kinds of another path through the reader
-    viewed = ["good", "zup", "empty", "binary", "cut_in_motion", "frames_huge", "number_nan", "frame_time_zero",
-              "deep_nesting", "utf16", "folder", "fifo", "loop_link", "dev_zero", "huge_file"]
+    viewed = ["good", "zup", "empty", "binary", "frames_huge", "number_nan", "deep_nesting", "fifo", "loop_link",
+              "huge_file"]
 
     def expect_of(name: str) -> tuple[str, tuple[str, ...]]:
         if name in VALID_BVH:
@@ -489,7 +489,7 @@ def build_cases(p: Inputs) -> list[Case]:
         add("stylemotion-annotate", f"bvh_{name}",
             [*DATA, f"document={i(document + '.bvh')}", f"templates={p.earlier / 'templates'}", "out=out"],
             expect, "BVH file", names, warn=warn)
-        if name not in VALID_BVH | WARN_BVH:  # a valid example would train CVAEs (minutes): refusals only
+        if name in ("binary", "fifo"):  # a valid example would train CVAEs (minutes): refusals only
             add("stylemotion-style", f"bvh_{name}",
                 [f"example={i(name + '.bvh')}", f"run={repro}", "name=mine", "out=out"], expect, "BVH file", names)
     for name in ("good", "binary", "fifo", "millisecond"):
@@ -500,7 +500,7 @@ def build_cases(p: Inputs) -> list[Case]:
 
     # --- stylemotion-data --------------------------------------------------------------------------------------
     data = "stylemotion-data"
-    for name in ("good", "fifo", "loop_link", "dangling_link", "binary", "millisecond"):
+    for name in ("good", "fifo", "loop_link", "binary"):
         add(data, f"folder_with_{name}", ["data=bvh_folder", f"data.root={p.inputs / 'folders' / name}"],
             "answered" if name == "good" else "either", "BVH folder", (f"{name}.bvh",), out=("hydra",),
             warn=() if name == "good" else (f"{name}.bvh",))
@@ -542,22 +542,19 @@ def build_cases(p: Inputs) -> list[Case]:
     # --- stylemotion-train --------------------------------------------------------------------------------------
     tr = "stylemotion-train"
     smoke = SMOKE
-    for override, names in [("seed=abc", ["seed"]), ("trainer.max_epochs=-5", ["max_epochs"]),
-                            ("model.hidden_units=0", ["hidden_units"]), ("datamodule.batch_size=0", ["batch_size"]),
-                            ("model.lr=nan", ["lr", "nan"]), ("experiment=nope", ["nope"])]:
+    for override, names in [("seed=abc", ["seed"]), ("model.hidden_units=0", ["hidden_units"])]:
         add(tr, f"value_{override}", [*smoke, override], "refused", "bad Hydra value", names, out=("hydra",))
-    for name in ("empty", "junk", "cut", "foreign", "autoencoder", "malicious", "nan_weights"):
-        add(tr, f"ckpt_{name}", [*smoke, f"ckpt_path={i(name + '.ckpt')}"], "refused", "checkpoint",
-            (f"{name}.ckpt",), out=("hydra",))
+    for name in ("junk", "foreign", "malicious"):
+        # the tiny run's autoencoder is a smoke autoencoder of the same shapes: resuming from it is allowed
+        add(tr, f"ckpt_{name}", [*smoke, f"ckpt_path={i(name + '.ckpt')}"],
+            "either" if name == "autoencoder" else "refused", "checkpoint", (f"{name}.ckpt",), out=("hydra",))
     add(tr, "ckpt_missing", [*smoke, "ckpt_path=/nonexistent/best.ckpt"], "refused", "checkpoint",
         ("/nonexistent/best.ckpt",), out=("hydra",))
     finished = _copy(train_run, "run")
     add(tr, "rerun_finished", [*smoke], "refused", "rerun into finished output", ("run",),
         earlier=("run",), setup=finished, hydra_dir=False, out=())
     cases[-1].args.append("hydra.run.dir=run")
-    for extra, expect in [("ckpt_path=auto", "either"), ("ckpt_path=last", "either"),
-                          ("ckpt_path=last model.hidden_units=64", "refused"),
-                          ("ckpt_path=auto trainer.max_epochs=1", "either")]:
+    for extra, expect in [("ckpt_path=auto", "either"), ("ckpt_path=last model.hidden_units=64", "refused")]:
         add(tr, f"resume_finished_{extra.replace(' ', '_')}", [*smoke, *extra.split(), "hydra.run.dir=run"],
             expect, "rerun into finished output", ("run", "hidden_units", "last.ckpt"), earlier=("run",),
             setup=finished, hydra_dir=False, out=())
@@ -580,9 +577,8 @@ def build_cases(p: Inputs) -> list[Case]:
     # --- stylemotion-reproduce ----------------------------------------------------------------------------------
     rp = "stylemotion-reproduce"
     tiny = ["data.takes_per_pair=2", "data.duration_s=3.0", "data.styles=[normal,elderly]", "data.contents=[walk]"]
-    for override, names in [("styles=[nope]", ["nope"]), ("primitives=[nope]", ["nope"]),
-                            ("evaluation.neutral_style=nope", ["nope"]), ("workers=0", ["workers"]),
-                            ("seed=abc", ["seed"]), ("evaluation.samples.table_5_1=0", ["table_5_1"])]:
+    for override, names in [("styles=[nope]", ["nope"]), ("seed=abc", ["seed"]),
+                            ("evaluation.samples.table_5_1=0", ["table_5_1"])]:
         add(rp, f"value_{override}", [*tiny, override, "out=out"], "refused", "bad Hydra value", names,
             out=("out", "hydra"))
     add(rp, "out_is_file", [*tiny, "out=afile"], "refused", "out is a file", ("afile",), setup=_file("afile"),
@@ -613,7 +609,7 @@ def build_cases(p: Inputs) -> list[Case]:
     ev = "stylemotion-eval"
     small = ["evaluation.samples.table_5_1=50", "evaluation.samples.variance=50", "evaluation.samples.metrics=50",
              "evaluation.classifier.components=4"]
-    for name in ("empty", "junk", "cut", "foreign", "autoencoder", "malicious", "nan_weights"):
+    for name in ("cut", "autoencoder", "malicious"):
         add(ev, f"ckpt_{name}", [f"checkpoints=[{i(name + '.ckpt')}]", "out=out"], "refused", "checkpoint",
             (f"{name}.ckpt",))
     good_ckpt = repro / "vae" / "walk_leftStance" / "checkpoints" / "best.ckpt"
@@ -621,9 +617,7 @@ def build_cases(p: Inputs) -> list[Case]:
         ("/nonexistent/best.ckpt",))
     add(ev, "ckpt_folder_without", [f"checkpoints=[{p.decoy}]", "out=out"], "refused", "checkpoint",
         (str(p.decoy),))
-    for override, names in [("evaluation.samples.table_5_1=0", ["table_5_1"]),
-                            ("evaluation.samples.variance=-3", ["variance"]), ("seed=abc", ["seed"]),
-                            ("threads=0", ["threads"])]:
+    for override, names in [("evaluation.samples.table_5_1=0", ["table_5_1"]), ("seed=abc", ["seed"])]:
         add(ev, f"value_{override}", [f"checkpoints=[{good_ckpt}]", *small, override, "out=out"], "refused",
             "bad Hydra value", names)
     add(ev, "out_exists", [f"checkpoints=[{good_ckpt}]", *small, "out=out"], "refused", "out exists", ("out",),
@@ -634,22 +628,18 @@ def build_cases(p: Inputs) -> list[Case]:
     gn = "stylemotion-generate"
     run = f"run={repro}"
     quick = ["outputs.gif=false"]
-    for override, names in [("follow.max_steps=0", ["max_steps"]), ("follow.pose_scale_m=-1", ["pose_scale_m"]),
-                            ("seed=abc", ["seed"]), ("style=nope", ["nope"]), ("path.points=[[0,0]]", ["path"]),
-                            ("path.points=[[0,0],[nan,1]]", ["path", "nan"]),
-                            ("'path.points=[[0,0],[1e9,0]]'", ["path", "1e+09", "1e9", "1000000000"]),
-                            ("+models={leftStance: /nonexistent.ckpt}", ["nonexistent.ckpt"])]:
+    for override, names in [("follow.max_steps=0", ["max_steps"]), ("seed=abc", ["seed"]),
+                            ("path.points=[[0,0],[nan,1]]", ["path", "nan"])]:
         add(gn, f"value_{override}", [run, *quick, override.strip("'"), "out=out"], "refused", "bad Hydra value",
             names)
-    for name in ("autoencoder", "malicious", "junk", "nan_weights"):
+    for name in ("malicious",):
         add(gn, f"ckpt_{name}", [run, *quick, f"+models={{walk_leftStance: {i(name + '.ckpt')}, walk_rightStance: "
                                                   f"{i(name + '.ckpt')}}}", "out=out"],
             "refused", "checkpoint", (f"{name}.ckpt",))
     add(gn, "run_missing", ["run=/nonexistent/run", *quick, "out=out"], "refused", "missing run", ("/nonexistent",))
     add(gn, "run_report_cut", [f"run={p.inputs / 'report_cut'}", *quick, "out=out"], "refused", "cut-off record",
         ("report.json",))
-    for name in ("path_one_point.json", "path_wrong_shape.json", "path_huge.json", "path_nan.csv", "path_text.csv",
-                 "path_empty.csv", "path_cut.json"):
+    for name in ("path_wrong_shape.json", "path_huge.json"):
         add(gn, f"path_{name}", [run, *quick, f"path.file={i(name)}", "out=out"], "refused", "path file", (name,))
     add(gn, "path_missing", [run, *quick, "path.file=/nonexistent/path.csv", "out=out"], "refused", "path file",
         ("path.csv",))
@@ -684,11 +674,9 @@ def build_cases(p: Inputs) -> list[Case]:
     # --- stylemotion-search -------------------------------------------------------------------------------------
     se = "stylemotion-search"
     q = f"query={TAKE}:0-30"
-    for override, names in [("k=0", ["k"]), ("top=0", ["top"]), ("features=bogus", ["bogus"]),
-                            ("radius=nan", ["radius"]), ("k=1e12", ["k"])]:
+    for override, names in [("k=0", ["k"]), ("features=bogus", ["bogus"]), ("k=1e12", ["k"])]:
         add(se, f"value_{override}", [*DATA, q, override, "out=out"], "refused", "bad Hydra value", names)
-    for query, names in [(f"{TAKE}:0-99999", ["99999"]), (f"{TAKE}:50-10", ["50-10"]),
-                         ("nope", ["nope"]), (f"{i('good.bvh')}:0-99999", ["99999"]),
+    for query, names in [(f"{TAKE}:0-99999", ["99999"]), (f"{i('good.bvh')}:50-10", ["50-10"]),
                          (f"{i('notes.txt')}", ["notes.txt"]),
                          (f"{i('member.zip')}::../walk.bvh", ["../walk.bvh"]),
                          (f"{i('member.zip')}::missing.bvh", ["missing.bvh"])]:
@@ -722,8 +710,7 @@ def build_cases(p: Inputs) -> list[Case]:
                         ("model.json", b'{"format": 1, "feat'), ("tensors.npz", b"")]:
         add(an, f"damaged_{name}_{len(data_)}", [*DATA, doc, "templates=tpl", "out=out"], "refused",
             "damaged model", (name,), setup=damaged_templates(name, data_), earlier=("tpl",))
-    for override, names in [("tau=nan", ["tau"]), ("tau=-1", ["tau"]), ("per_class=0", ["per_class"]),
-                            ("keyframes.tolerance=5", ["tolerance"])]:
+    for override, names in [("tau=nan", ["tau"]), ("keyframes.tolerance=5", ["tolerance"])]:
         add(an, f"value_{override}", [*DATA, doc, tpl, override, "out=out"], "refused", "bad Hydra value", names)
     add(an, "templates_missing", [*DATA, doc, "templates=/nonexistent/tpl", "out=out"], "refused", "missing model",
         ("/nonexistent/tpl",))
@@ -736,8 +723,8 @@ def build_cases(p: Inputs) -> list[Case]:
     rc = "stylemotion-reconstruct"
     for name in ("markers.csv", "markers.npz"):
         add(rc, f"file_{name}", [*DATA, f"markers={i(name)}", "out=out", "gif=false"], "answered", "valid input")
-    for name in ("markers_nan.csv", "markers_huge.csv", "markers_short_rows.csv", "markers_unknown_joint.csv",
-                 "markers_wrong_shape.npz", "markers_nan.npz", "markers_fps_zero.npz", "pickle.npz"):
+    for name in ("markers_nan.csv", "markers_huge.csv", "markers_short_rows.csv", "markers_wrong_shape.npz",
+                 "markers_fps_zero.npz", "pickle.npz"):
         expect = "either" if name == "markers_nan.csv" else "refused"  # one gap may be filled, named
         add(rc, f"file_{name}", [*DATA, f"markers={i(name)}", "out=out", "gif=false"], expect, "marker file",
             (name,), warn=(name,) if expect == "either" else ())
@@ -749,9 +736,8 @@ def build_cases(p: Inputs) -> list[Case]:
 
     # --- stylemotion-keyframes ----------------------------------------------------------------------------------
     kf = "stylemotion-keyframes"
-    for name in ("keys_time_huge", "keys_time_1e9", "keys_time_negative", "keys_time_equal",
-                 "keys_frame_out_of_range", "keys_positions_wrong_shape", "keys_positions_nan", "keys_one_key",
-                 "keys_not_object", "keys_every_zero", "keys_every_nan", "keys_cut", "keys_turn_huge"):
+    for name in ("keys_time_huge", "keys_time_1e9", "keys_time_negative", "keys_frame_out_of_range",
+                 "keys_positions_wrong_shape", "keys_positions_nan", "keys_every_zero", "keys_cut", "keys_turn_huge"):
         add(kf, f"file_{name}", [*DATA, f"keys={i(name + '.json')}", "out=out", "gif=false"], "refused", "keys file",
             (f"{name}.json",))
     add(kf, "keys_missing", [*DATA, "keys=/nonexistent/keys.json", "out=out"], "refused", "keys file",
@@ -779,12 +765,9 @@ def build_cases(p: Inputs) -> list[Case]:
         ([ex, "run=/nonexistent/run", "name=mine"], ["/nonexistent/run"], "missing run"),
         ([ex, f"run={repro}", "name=normal"], ["normal"], "bad Hydra value"),
         ([ex, f"run={repro}", "name=../x"], ["../x"], "unsafe label"),
-        ([ex, f"run={repro}", "name=mine", "method=bogus"], ["bogus"], "bad Hydra value"),
+
         ([f"example={i('good.bvh')}:0-99999", f"run={repro}", "name=mine"], ["99999"], "out-of-range cut"),
-        ([f"example={i('good.bvh')}:50-10", f"run={repro}", "name=mine"], ["50-10"], "out-of-range cut"),
-        ([ex, f"run={repro}", "name=mine", "samples=0"], ["samples"], "bad Hydra value"),
-        ([ex, f"run={repro}", "name=mine", "method=zero_shot", "network=/nonexistent/net"], ["/nonexistent/net"],
-         "missing model"),
+
     ]:
         add(st, f"{kind.replace(' ', '_')}_{len(cases)}", [*args, "out=out"], "refused", kind, names)
     add(st, "out_exists", [ex, f"run={repro}", "name=mine", "out=out"], "refused", "out exists", ("out",),
