@@ -47,7 +47,7 @@ from stylemotion.geometry import wrap_angle_torch
 from stylemotion.representation import JOINT_DIMS, VELOCITY_DIMS, frames_to_positions, integrate_root
 from stylemotion.skeleton import NUM_JOINTS
 from stylemotion.synthesis.graph import MotionGraph
-from stylemotion.synthesis.path import GroundPath
+from stylemotion.synthesis.path import GroundPath, PathError
 from stylemotion.synthesis.stitching import append_clip
 
 log = logging.getLogger(__name__)
@@ -319,8 +319,8 @@ def follow_path(graph: MotionGraph, path: GroundPath, seed: int = 0, settings: F
     else:
         notes.append(f"stopped after max_steps={settings.max_steps} steps before the end of the path")
     if motion is None:
-        raise ValueError(f"the path ({path.length:.2f} m) is shorter than half a step "
-                         f"({graph.profiles[primitive].length_m:.2f} m): nothing to walk")
+        raise PathError(f"the path ({path.length:.2f} m) is shorter than half a step "
+                        f"({graph.profiles[primitive].length_m:.2f} m): nothing to walk; give a longer path")
     positions = frames_to_positions(motion, fps, start_xz, heading)
     return SynthesizedMotion(frames=motion.astype(np.float32), positions=positions.astype(np.float32), fps=fps,
                              junctions=junctions, steps=steps, path=path, style=graph.style,

@@ -204,7 +204,9 @@ def test_a_turn_sharper_than_any_step_warns_and_still_walks(tiny_graph: MotionGr
 
 
 def test_a_path_shorter_than_half_a_step_is_refused(tiny_graph: MotionGraph) -> None:
-    with pytest.raises(ValueError, match="shorter than half a step"):
+    from stylemotion.io.errors import UserInputError
+
+    with pytest.raises(UserInputError, match="shorter than half a step"):  # one line, not a traceback (issue 26)
         follow_path(tiny_graph, GroundPath.from_points([[0, 0], [0, 0.05]]))
 
 
