@@ -17,6 +17,7 @@ from pathlib import Path
 
 import torch
 from hydra import compose, initialize_config_dir
+from log_lines import logged_lines
 
 from stylemotion.cli.schemas import register_schemas
 from stylemotion.config import CONFIG_DIR
@@ -63,15 +64,20 @@ def tiny_overrides(out: Path, vae_epochs: int = EPOCHS) -> list[str]:
 
 
 def reproduce(overrides: list[str], lines: list[str] | None = None) -> dict:
-    """``stylemotion-reproduce`` in this process (its lines to ``lines``, or printed); the summary. Torch's thread
-    count is restored afterwards (the run sets it to ``threads``)."""
+    """``stylemotion-reproduce`` in this process (the lines it logs appended to ``lines``); the summary. Torch's
+    thread count is restored afterwards (the run sets it to ``threads``)."""
     from stylemotion.training.reproduction import reproduce as run_reproduction
 
     threads = torch.get_num_threads()
     try:
         with initialize_config_dir(config_dir=str(CONFIG_DIR), version_base="1.3"):
             cfg = compose(config_name="reproduce", overrides=overrides)
-            return run_reproduction(cfg, say=(lines.append if lines is not None else print))
+            with logged_lines("stylemotion.training.reproduction") as logged:
+                try:
+                    return run_reproduction(cfg)
+                finally:
+                    if lines is not None:
+                        lines.extend(logged)
     finally:
         torch.set_num_threads(threads)
 

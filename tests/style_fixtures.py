@@ -12,6 +12,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from log_lines import logged_lines
+
 from stylemotion.cli.schemas import register_schemas
 from stylemotion.datasets.synthetic import generate_take
 from stylemotion.io.export import write_motion_bvh
@@ -40,8 +42,8 @@ def tiny_style(run: Path) -> tuple[Path, dict]:
         from stylemotion.style_example import add_style
 
         folder = run.parent
-        lines: list[str] = []
-        results = add_style(str(example_bvh(folder)), run, "tired", folder / "tired", samples=SAMPLES, say=lines.append)
+        with logged_lines("stylemotion.style_example") as lines:
+            results = add_style(str(example_bvh(folder)), run, "tired", folder / "tired", samples=SAMPLES)
         _CACHE["style"], _CACHE["results"], _CACHE["lines"] = folder / "tired", results, lines
     return _CACHE["style"], {"results": _CACHE["results"], "lines": _CACHE["lines"]}
 
@@ -58,8 +60,8 @@ def tiny_zero_shot_style(run: Path) -> tuple[Path, dict]:
         from stylemotion.style_example import add_style
 
         folder = run.parent
-        lines: list[str] = []
-        results = add_style(str(example_bvh(folder)), run, "weary", folder / "weary", method="zero_shot",
-                            network_epochs=NETWORK_EPOCHS, samples=SAMPLES, say=lines.append)
+        with logged_lines("stylemotion.style_example") as lines:
+            results = add_style(str(example_bvh(folder)), run, "weary", folder / "weary", method="zero_shot",
+                                network_epochs=NETWORK_EPOCHS, samples=SAMPLES)
         _CACHE["zero_shot"], _CACHE["zero_shot_results"] = folder / "weary", {"results": results, "lines": lines}
     return _CACHE["zero_shot"], _CACHE["zero_shot_results"]

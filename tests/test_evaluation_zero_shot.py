@@ -14,6 +14,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import torch
+from log_lines import logged_lines
 from omegaconf import OmegaConf
 from recognition_reference import hand_share
 
@@ -60,7 +61,7 @@ def leaky(run, tmp_path_factory) -> tuple[Path, dict]:
     """The old protocol (one network without elderly on the run's autoencoder): its folder and results."""
     out = tmp_path_factory.mktemp("leaky") / "loso"
     return out, leave_one_style_out(run, out, [STYLE], [PRIMITIVE], epochs=2, samples=SAMPLES, seed=SEED,
-                                    overrides=NETWORK, threads=1, shared_autoencoder=True, say=lambda _: None)
+                                    overrides=NETWORK, threads=1, shared_autoencoder=True)
 
 
 def hand_row(source, judge, clips_of, frames: torch.Tensor, duration_s: torch.Tensor, style: str,
@@ -78,9 +79,10 @@ def hand_row(source, judge, clips_of, frames: torch.Tensor, duration_s: torch.Te
 
 @pytest.mark.slow  # an autoencoder and a network trained without elderly, two evaluations: ~20 s on one busy core
 def test_leave_one_style_out_without_leakage_against_a_hand_computed_reference(run, tmp_path) -> None:
-    out, lines = tmp_path / "loso", []
-    results = leave_one_style_out(run, out, [STYLE], [PRIMITIVE], epochs=2, samples=SAMPLES, seed=SEED,
-                                  overrides=NETWORK, threads=1, say=lines.append)
+    out = tmp_path / "loso"
+    with logged_lines("stylemotion.evaluation.zero_shot") as lines:
+        results = leave_one_style_out(run, out, [STYLE], [PRIMITIVE], epochs=2, samples=SAMPLES, seed=SEED,
+                                      overrides=NETWORK, threads=1)
     source = read_run(run)
     judge = load_autoencoder(source.autoencoder_ckpt)
     res = results["primitives"][PRIMITIVE]
@@ -119,8 +121,10 @@ def test_leave_one_style_out_without_leakage_against_a_hand_computed_reference(r
     assert json.loads((out / "zero_shot.json").read_text())["splits"] == results["splits"]
     assert "LEAKY" not in (out / "zero_shot.md").read_text()
     # resumed: both trainings reused, the same figures
-    again = leave_one_style_out(run, out, [STYLE], [PRIMITIVE], epochs=2, samples=SAMPLES, seed=SEED,
-                                overrides=NETWORK, threads=1, resume=True, say=lines.append)
+    with logged_lines("stylemotion.evaluation.zero_shot") as resumed:
+        again = leave_one_style_out(run, out, [STYLE], [PRIMITIVE], epochs=2, samples=SAMPLES, seed=SEED,
+                                    overrides=NETWORK, threads=1, resume=True)
+    lines += resumed
     assert again["primitives"][PRIMITIVE]["styles"][STYLE]["zero_shot"] == {**row["zero_shot"], "train_seconds": None}
     assert sum("reused" in line for line in lines) == 2 and sum(line.endswith(": training") for line in lines) == 2
     with pytest.raises(OutputExistsError):
@@ -136,7 +140,7 @@ def _evaluate(source, network, shared: bool = False) -> dict:
     cvaes = [load_model(source.cvaes[(q, s)], source.settings.neutral_style, judge)
              for q, s in source.cvaes if q == PRIMITIVE]
     return evaluate_primitive(PRIMITIVE, {STYLE: network}, cvaes, build_dataset(source.data_cfg), judge,
-                              source.settings, source.data_cfg.get("split"), SAMPLES, SEED, lambda _: None,
+                              source.settings, source.data_cfg.get("split"), SAMPLES, SEED,
                               shared)["styles"][STYLE]
 
 

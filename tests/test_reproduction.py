@@ -225,7 +225,7 @@ def test_style_labels_cannot_place_a_stage_outside_the_run(tmp_path: Path) -> No
     """CVAE folders come from style labels: sanitized, inside ``out``, and two labels never share one."""
     with initialize_config_dir(config_dir=str(CONFIG_DIR), version_base="1.3"):
         cfg = compose(config_name="reproduce", overrides=[f"out={tmp_path / 'run'}", "primitives=[walk_leftStance]"])
-    repro = Reproduction(cfg, say=lambda _: None)
+    repro = Reproduction(cfg)
     repro.plan(["/../../../../escaped", "a b/c"])
     cvae = [s.folder for s in repro.stages if s.kind == "cvae"]
     assert [f.resolve().parent for f in cvae] == [(tmp_path / "run" / "cvae").resolve()] * 2, cvae
@@ -243,7 +243,7 @@ def test_a_null_retarget_keeps_the_stage_hashes_of_earlier_runs(tmp_path: Path) 
     the finished stages of earlier runs stay valid; a style name is other data."""
     with initialize_config_dir(config_dir=str(CONFIG_DIR), version_base="1.3"):
         cfg = compose(config_name="reproduce", overrides=[f"out={tmp_path / 'run'}", "primitives=[walk_leftStance]"])
-    repro = Reproduction(cfg, say=lambda _: None)
+    repro = Reproduction(cfg)
     repro.plan([])
     stage = repro.stages[0]
     hashes = {}

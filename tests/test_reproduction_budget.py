@@ -17,7 +17,7 @@ def planned(*overrides: str) -> dict[str, list[str]]:
     with initialize_config_dir(config_dir=str(CONFIG_DIR), version_base="1.3"):
         cfg = compose(config_name="reproduce", overrides=list(overrides))
     choose_budget(cfg)
-    repro = Reproduction(cfg, say=lambda _: None)
+    repro = Reproduction(cfg)
     repro.plan(["elderly"])
     return {stage.kind: stage.overrides for stage in reversed(repro.stages)}
 

@@ -6,9 +6,12 @@ path). Protocol: docs/benchmarks.md.
 
 from __future__ import annotations
 
+import logging
 import math
 import os
-from collections.abc import Iterable, Mapping, Sequence
+import sys
+from collections.abc import Iterable, Iterator, Mapping, Sequence
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
@@ -21,6 +24,23 @@ __all__ = ["spread", "fmt", "fmt_spread", "fmt_range", "md_table", "provenance_l
 
 #: Where the benchmark data lies (``$STYLEMOTION_DATA`` or ``../shared/data`` beside the repository).
 DATA_ROOT = Path(os.environ.get("STYLEMOTION_DATA") or Path(__file__).resolve().parents[3] / "shared" / "data")
+
+
+@contextmanager
+def progress_printed(prefix: str, logger: str = "stylemotion") -> Iterator[None]:
+    """Print what ``logger`` (the library) logs at INFO while the block runs, one line each after ``prefix``
+    (e.g. ``[seed 0]``); the library reports progress only through :mod:`logging`."""
+    handler = logging.StreamHandler(sys.stdout)
+    handler.setFormatter(logging.Formatter(f"{prefix} %(message)s"))
+    target = logging.getLogger(logger)
+    before = target.level
+    target.addHandler(handler)
+    target.setLevel(logging.INFO)
+    try:
+        yield
+    finally:
+        target.removeHandler(handler)
+        target.setLevel(before)
 
 
 def md_table(header: Sequence[str], rows: Sequence[Sequence[str]]) -> str:

@@ -24,7 +24,7 @@ import argparse
 from pathlib import Path
 from typing import Any
 
-from suites.common import fmt, fmt_range, fmt_spread, md_table, provenance_line, spread
+from suites.common import fmt, fmt_range, fmt_spread, md_table, progress_printed, provenance_line, spread
 from suites.style import DATA, reproduce_seed, setup_tag
 
 DESCRIPTION = ("zero-shot style network, leave one style out without leakage (an autoencoder and a network per "
@@ -103,9 +103,9 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
     per_seed: dict[str, Any] = {}
     for seed in seeds:
         out = base / f"seed{seed}"
-        result = leave_one_style_out(judge, out, args.styles, args.primitives, args.epochs, args.samples, seed,
-                                     threads=1, resume=True, say=lambda line, k=seed: print(f"[seed {k}] {line}",
-                                                                                             flush=True))
+        with progress_printed(f"[seed {seed}]"):
+            result = leave_one_style_out(judge, out, args.styles, args.primitives, args.epochs, args.samples, seed,
+                                         threads=1, resume=True)
         per_seed[str(seed)] = {"out": relative(out), "primitives": result["primitives"], "summary": result["summary"],
                                "seconds": result["meta"]["seconds"]}
     first = next(iter(per_seed.values()))

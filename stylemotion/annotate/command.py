@@ -17,9 +17,10 @@ Outputs are written atomically into a new folder; an existing one is refused unl
 
 from __future__ import annotations
 
+import logging
 import os
 import time
-from collections.abc import Callable, Mapping
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
@@ -41,7 +42,7 @@ from stylemotion.io.jsonfile import write_json
 from stylemotion.io.outputs import check_new_output, inside
 from stylemotion.provenance import provenance
 
-Say = Callable[[str], None]
+log = logging.getLogger(__name__)
 _D = AnnotateSettings
 
 
@@ -50,8 +51,8 @@ class AnnotateInputError(UserInputError, ValueError):
 
 
 def learn(data: Mapping[str, Any], out: str | os.PathLike, *, per_class: int = _D.per_class, seed: int = _D.seed,
-          repetitions: int | None = _D.repetitions, tensors: bool = _D.tensors, force: bool = _D.force,
-          say: Say = print, command: str = "") -> AnnotationModel:
+          repetitions: int | None = _D.repetitions, tensors: bool = _D.tensors,
+          force: bool = _D.force, command: str = "") -> AnnotationModel:
     """Learn templates (and tensors) from ``data``'s train split and write the folder ``out`` (the keyword
     defaults are :class:`~stylemotion.annotate.settings.AnnotateSettings`'s)."""
     out = check_new_output(out, force)
@@ -75,10 +76,10 @@ def learn(data: Mapping[str, Any], out: str | os.PathLike, *, per_class: int = _
              "learn_s": round(time.perf_counter() - started, 3), "provenance": provenance(command or None)}
     with atomic_folder(out, on_exists=lambda: check_new_output(out, force)) as tmp:
         save_model(model, tmp, extra)
-    say(f"{len(model.templates)} templates ({', '.join(model.classes)}) and {len(model.tensors)} tensors from "
-        f"{takeset.name}'s train takes written to {out}")
+    log.info(f"{len(model.templates)} templates ({', '.join(model.classes)}) and {len(model.tensors)} tensors from "
+             f"{takeset.name}'s train takes written to {out}")
     for label, reason in model.record["tensors_skipped"].items():
-        say(f"no tensor for {label}: {reason}")
+        log.info(f"no tensor for {label}: {reason}")
     return model
 
 
@@ -120,7 +121,7 @@ def annotate_positions(positions: np.ndarray, model: AnnotationModel,
 
 def annotate(document: str, templates: str | os.PathLike, out: str | os.PathLike, *,
              settings: AnnotationSettings | None = None, conversion: Mapping[str, Any] | None = None,
-             force: bool = _D.force, say: Say = print, command: str = "") -> dict[str, Any]:
+             force: bool = _D.force, command: str = "") -> dict[str, Any]:
     """Annotate ``document`` with the model in ``templates`` and write the folder ``out`` (module docstring)."""
     started = time.perf_counter()
     settings = settings or AnnotationSettings()
@@ -156,18 +157,18 @@ def annotate(document: str, templates: str | os.PathLike, out: str | os.PathLike
                       f"{record['file']}: tau={settings.tau}, key frames {'on' if settings.keyframes else 'off'}")
         report["timing_s"] = round(time.perf_counter() - started, 3)
         write_json(inside(tmp, "segments.json"), report)
-    say(f"{len(records)} segment(s), {report['labelled_fraction']:.0%} of {len(labels)} frames labelled; "
-        f"written to {out}")
+    log.info(f"{len(records)} segment(s), {report['labelled_fraction']:.0%} of {len(labels)} frames labelled; "
+             f"written to {out}")
     return report
 
 
-def annotate_from_config(cfg: DictConfig, say: Say = print, command: str = "") -> Any:
+def annotate_from_config(cfg: DictConfig, command: str = "") -> Any:
     """:func:`learn` (no ``document``) or :func:`annotate` with the keys of ``stylemotion/configs/annotate.yaml``
     (:class:`AnnotateSettings`)."""
     data, s = settings_from_config(cfg, AnnotateSettings, "annotate")
     if not s.document:
         return learn(data, s.out, per_class=s.per_class, seed=s.seed, repetitions=s.repetitions, tensors=s.tensors,
-                     force=s.force, say=say, command=command)
+                     force=s.force, command=command)
     if not s.templates:
         raise AnnotateInputError("document= needs templates=<folder> (learn one with stylemotion-annotate "
                                  "data=<dataset> out=<folder>)")
@@ -175,4 +176,4 @@ def annotate_from_config(cfg: DictConfig, say: Say = print, command: str = "") -
                                   keyframe_count=positive_int(s.keyframes.count, "keyframes.count"),
                                   keyframe_tolerance=s.keyframes.tolerance, min_run=s.min_run)
     return annotate(str(s.document), s.templates, s.out, settings=settings, conversion=conversion_keys(vars(s)),
-                    force=s.force, say=say, command=command)
+                    force=s.force, command=command)

@@ -21,7 +21,7 @@ log = logging.getLogger(__name__)
 def annotate(cfg: DictConfig, command: str) -> None:
     from stylemotion.annotate.command import annotate_from_config
 
-    annotate_from_config(cfg, say=log.info, command=command)
+    annotate_from_config(cfg, command=command)
 
 
 main = hydra_command("stylemotion-annotate", "annotate", annotate, record_in="out")

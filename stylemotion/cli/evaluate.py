@@ -25,7 +25,7 @@ def evaluate(cfg: DictConfig, command: str) -> None:
 
     set_torch_threads(cfg.get("threads"))
     results = run_evaluation(cfg.data, list(cfg.checkpoints), cfg.evaluation, cfg.out, int(cfg.seed),
-                             cfg.get("autoencoder_ckpt"), bool(cfg.force), command, progress=log.info)
+                             cfg.get("autoencoder_ckpt"), bool(cfg.force), command)
     for line in summary_lines(results):
         log.info(line)
     log.info("report written to %s", cfg.out)

@@ -20,7 +20,7 @@ log = logging.getLogger(__name__)
 def keyframes(cfg: DictConfig, command: str) -> None:
     from stylemotion.reconstruct.keyframes_command import keyframes_from_config
 
-    keyframes_from_config(cfg, say=log.info, command=command)
+    keyframes_from_config(cfg, command=command)
 
 
 main = hydra_command("stylemotion-keyframes", "keyframes", keyframes, record_in="out")

@@ -21,7 +21,7 @@ log = logging.getLogger(__name__)
 def reconstruct(cfg: DictConfig, command: str) -> None:
     from stylemotion.reconstruct.command import reconstruct_from_config
 
-    reconstruct_from_config(cfg, say=log.info, command=command)
+    reconstruct_from_config(cfg, command=command)
 
 
 main = hydra_command("stylemotion-reconstruct", "reconstruct", reconstruct, record_in="out")

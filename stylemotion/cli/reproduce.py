@@ -34,7 +34,7 @@ class OutFolderCheck(Callback):
 def reproduce(cfg: DictConfig, command: str) -> None:
     from stylemotion.training.reproduction import reproduce
 
-    reproduce(cfg, say=log.info)  # the console and <out>/hydra/<time>/reproduce.log
+    reproduce(cfg)  # progress is logged: the console and <out>/hydra/<time>/reproduce.log
 
 
 main = hydra_command("stylemotion-reproduce", "reproduce", reproduce)

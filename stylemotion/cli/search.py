@@ -21,7 +21,7 @@ log = logging.getLogger(__name__)
 def search(cfg: DictConfig, command: str) -> None:
     from stylemotion.search.command import search_from_config
 
-    search_from_config(cfg, say=log.info, command=command)
+    search_from_config(cfg, command=command)
 
 
 main = hydra_command("stylemotion-search", "search", search, record_in="out")

@@ -24,7 +24,7 @@ def style(cfg: DictConfig, command: str) -> None:
     from stylemotion.style_example import add_style_from_config
 
     set_torch_threads(cfg.get("threads"))
-    add_style_from_config(cfg, say=log.info, command=command)
+    add_style_from_config(cfg, command=command)
 
 
 main = hydra_command("stylemotion-style", "style", style, record_in="out")

@@ -21,7 +21,7 @@ log = logging.getLogger(__name__)
 def texture(cfg: DictConfig, command: str) -> None:
     from stylemotion.reconstruct.texture_command import texture_from_config
 
-    texture_from_config(cfg, say=log.info, command=command)
+    texture_from_config(cfg, command=command)
 
 
 main = hydra_command("stylemotion-texture", "texture", texture, record_in="out")

@@ -29,7 +29,7 @@ from __future__ import annotations
 import logging
 import time
 from collections import defaultdict
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import asdict, dataclass, field
 from typing import Any
 
@@ -68,7 +68,6 @@ GRAM_TOLERANCE = 1e-3
 
 def evaluate_models(models: Sequence[EvalModel], takeset: TakeSet, autoencoder, settings: EvalSettings | None = None,
                     split: Mapping[str, Any] | None = None, autoencoder_info: Mapping[str, Any] | None = None,
-                    progress: Callable[[str], None] | None = None,
                     extra_rows: Mapping[str, Mapping[str, Any]] | None = None) -> dict[str, Any]:
     """Evaluate models against real data (see the module doc).
 
@@ -79,7 +78,6 @@ def evaluate_models(models: Sequence[EvalModel], takeset: TakeSet, autoencoder, 
         settings: sample counts and metric settings.
         split: the data's split settings (as for training).
         autoencoder_info: ``path``/``fingerprint`` of the autoencoder (checked against the models).
-        progress: called with a line of text as each step starts.
         extra_rows: ``{primitive: {row name: SampleSource}}`` rows of Tables 5.1–5.3 only (module doc).
 
     Returns:
@@ -92,7 +90,6 @@ def evaluate_models(models: Sequence[EvalModel], takeset: TakeSet, autoencoder, 
         MissingExampleError: a style model without (or with a mismatching) example clip.
     """
     settings = settings or EvalSettings()
-    say = progress or log.info
     if not models:
         raise ValueError("no model to evaluate")
     fp = None if autoencoder_info is None else autoencoder_info.get("fingerprint")
@@ -117,7 +114,7 @@ def evaluate_models(models: Sequence[EvalModel], takeset: TakeSet, autoencoder, 
     skating: dict[str, list] = defaultdict(list)
     skating_real: dict[str, list] = defaultdict(list)
     shares: dict[str, list[tuple[float, int]]] = defaultdict(list)
-    say("autoencoder: reconstruction error on the test split")
+    log.info("autoencoder: reconstruction error on the test split")
     results["autoencoder"] = autoencoder_test_error(autoencoder, takeset, split, settings)
     if autoencoder_info is not None:
         results["autoencoder"].update(path=autoencoder_info.get("path"),
@@ -127,7 +124,7 @@ def evaluate_models(models: Sequence[EvalModel], takeset: TakeSet, autoencoder, 
         action = parse_primitive(primitive)[0]
         if action not in segmentations:
             segmentations[action] = segment_action(takeset.takes, action, settings.segment)
-        out = _evaluate_primitive(primitive, by_primitive[primitive], takeset, autoencoder, settings, split, say,
+        out = _evaluate_primitive(primitive, by_primitive[primitive], takeset, autoencoder, settings, split,
                                   segmentations[action], extra_rows.get(primitive))
         for key in results:
             if key in out:
@@ -251,8 +248,7 @@ def _canonical_length(primitive: str, models: Sequence[EvalModel], takeset: Take
 
 
 def real_side(primitive: str, models: Sequence[EvalModel], takeset: TakeSet, settings: EvalSettings,
-              split: Mapping[str, Any] | None, say: Callable[[str], None],
-              segmentation: Segmentation | None = None) -> RealSide:
+              split: Mapping[str, Any] | None, segmentation: Segmentation | None = None) -> RealSide:
     """Split the (segmented) data for ``primitive``, fit the style classifier, gather the ground truths.
 
     ``segmentation``: the primitive's action already segmented with ``settings.segment``
@@ -264,7 +260,7 @@ def real_side(primitive: str, models: Sequence[EvalModel], takeset: TakeSet, set
         ValueError: a model has fewer than 2 ground-truth clips.
     """
     length = _canonical_length(primitive, models, takeset, settings, split, segmentation)
-    say(f"{primitive}: real clips")
+    log.info(f"{primitive}: real clips")
     data = primitive_data(takeset, primitive, length, settings.neutral_style, _segment_values(settings), split,
                           segmentation)
     for m in models:
@@ -281,7 +277,7 @@ def real_side(primitive: str, models: Sequence[EvalModel], takeset: TakeSet, set
             raise ValueError(f"{m.label}: fewer than 2 real clips of style {m.style!r} besides its example; the "
                              "metrics need ground truth")
         truth[m.name] = motions_from_clips(clips, length)
-    say(f"{primitive}: style classifier on {len(data.split('train'))} real train clips")
+    log.info(f"{primitive}: style classifier on {len(data.split('train'))} real train clips")
     classifier, result = fit_style_classifier(data, settings)
     return RealSide(data, ordered, examples, classifier, result, motions_from_clips(data.training_data(), length),
                     motions_from_clips(data.heldout(settings.neutral_style), length), truth)
@@ -473,9 +469,9 @@ def example_column_gram(autoencoder, real: RealSide, model: EvalModel) -> torch.
 
 def _evaluate_primitive(primitive: str, models: list[EvalModel], takeset: TakeSet, autoencoder,
                         settings: EvalSettings, split: Mapping[str, Any] | None,
-                        say: Callable[[str], None], segmentation: Segmentation | None = None,
+                        segmentation: Segmentation | None = None,
                         extra_rows: Mapping[str, Any] | None = None) -> dict[str, Any]:
-    real = real_side(primitive, models, takeset, settings, split, say, segmentation)
+    real = real_side(primitive, models, takeset, settings, split, segmentation)
     variance = real_variance(real)
     train_poses = pose_sequences(real.training.normalized_frames.numpy())
     out: dict[str, Any] = {"frechet": {}, "frechet_reference": {}, "diversity": {}, "foot_skating_detail": {},
@@ -486,7 +482,7 @@ def _evaluate_primitive(primitive: str, models: list[EvalModel], takeset: TakeSe
     n_draw = max(settings.samples.table_5_1, settings.samples.variance, settings.samples.metrics)
     for m in real.models:
         t0 = time.perf_counter()
-        say(f"{primitive}: {m.name}: {n_draw} samples")
+        log.info(f"{primitive}: {m.name}: {n_draw} samples")
         samples = m.source.sample(n_draw, seed=settings.seed)  # one draw serves every family
         table_frames.append(samples.normalized_frames[:settings.samples.table_5_1].numpy())
         variance.rows[m.name] = _variance(samples.subset(slice(0, settings.samples.variance)))
@@ -509,13 +505,13 @@ def _evaluate_primitive(primitive: str, models: list[EvalModel], takeset: TakeSe
     n_models, n_table = len(real.models), settings.samples.table_5_1
     extra_frames = {}
     for name, source in (extra_rows or {}).items():
-        say(f"{primitive}: {name} (Tables 5.1–5.3 row): {max(n_table, settings.samples.variance)} samples")
+        log.info(f"{primitive}: {name} (Tables 5.1–5.3 row): {max(n_table, settings.samples.variance)} samples")
         samples = source.sample(max(n_table, settings.samples.variance), seed=settings.seed)
         variance.rows[name] = _variance(samples.subset(slice(0, settings.samples.variance)))
         frames = samples.normalized_frames[:n_table].numpy()
         extra_frames[name] = (frames if frames.shape[1] == real.length
                               else np.stack([time_normalize(f, real.length) for f in frames]))
-    say(f"{primitive}: Table 5.1 ({n_models} × {n_models}, {n_table} samples per model)")
+    log.info(f"{primitive}: Table 5.1 ({n_models} × {n_models}, {n_table} samples per model)")
     out["table_5_1"] = style_table(real, autoencoder, table_frames, settings, extra_frames).as_dict()
     out["variance"] = variance.rows
     out["variance_real"] = variance.real

@@ -16,7 +16,7 @@ from __future__ import annotations
 import logging
 import os
 import time
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import asdict
 from pathlib import Path
 from typing import Any
@@ -79,8 +79,7 @@ def models_autoencoder(model: EvalModel) -> tuple[MotionAutoencoder, str | None]
 
 def run_evaluation(data_cfg: Mapping[str, Any], checkpoints: Sequence[str], evaluation: Mapping[str, Any],
                    out: str | os.PathLike, seed: int = 0, autoencoder_ckpt: str | None = None, force: bool = False,
-                   command: str = "", progress: Callable[[str], None] | None = None,
-                   root: str | os.PathLike | None = None,
+                   command: str = "", root: str | os.PathLike | None = None,
                    extra_rows: Mapping[str, Mapping[str, Any]] | None = None) -> dict[str, Any]:
     """Load the models and their autoencoder, evaluate them on ``data_cfg``'s data, write the report.
 
@@ -118,7 +117,7 @@ def run_evaluation(data_cfg: Mapping[str, Any], checkpoints: Sequence[str], eval
     info = {**info, "path": recorded_path(info["path"], base)}
     takeset = build_dataset(data_cfg)
     results = evaluate_models(models, takeset, autoencoder, settings, split=data_cfg.get("split"),
-                              autoencoder_info=info, progress=progress, extra_rows=extra_rows)
+                              autoencoder_info=info, extra_rows=extra_rows)
     for entry in results.get("models", []):
         entry["checkpoint"] = recorded_path(entry.get("checkpoint"), base)
     results["meta"] = {

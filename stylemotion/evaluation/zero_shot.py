@@ -45,7 +45,7 @@ import logging
 import math
 import shutil
 import time
-from collections.abc import Callable, Iterator, Mapping, Sequence
+from collections.abc import Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from dataclasses import asdict
 from pathlib import Path
@@ -75,7 +75,7 @@ from stylemotion.training.run_folder import FinishedRun, read_json_object
 
 log = logging.getLogger(__name__)
 
-Say = Callable[[str], None]
+log = logging.getLogger(__name__)
 #: The rows of each left-out style: the two models, and the style's real clips.
 ROWS = ("zero_shot", "cvae", "real")
 #: What ``meta.leaky`` says of an output of the shared-autoencoder protocol.
@@ -218,7 +218,7 @@ def _settings_hash(cfg: DictConfig) -> str:
     return hashlib.sha256(json.dumps(values, sort_keys=True, default=str).encode()).hexdigest()[:16]
 
 
-def train_once(cfg: DictConfig, what: str, say: Say = print) -> tuple[Path, float | None]:
+def train_once(cfg: DictConfig, what: str) -> tuple[Path, float | None]:
     """Train ``cfg`` into its ``output_dir``, or reuse the training that finished there with the same settings
     (its ``done.json``); an interrupted one resumes from ``last.ckpt``. Returns the best checkpoint and the
     training seconds (None when reused).
@@ -238,18 +238,18 @@ def train_once(cfg: DictConfig, what: str, say: Say = print) -> tuple[Path, floa
             raise ZeroShotRunError(f"{folder} holds {what} trained with other settings (hash "
                                    f"{record.get('settings_hash')}, now {settings}); delete it or choose another out")
         if checkpoint.is_file():
-            say(f"{what}: reused {checkpoint}")
+            log.info(f"{what}: reused {checkpoint}")
             return checkpoint, None
     with open_dict(cfg):
         cfg.ckpt_path = "auto"
-    say(f"{what}: training")
+    log.info(f"{what}: training")
     t0 = time.perf_counter()
     metrics = train_run(cfg)["metrics"]
     seconds = time.perf_counter() - t0
     best = Path(metrics.get("best_checkpoint") or folder / "checkpoints" / "last.ckpt").resolve()
     write_json(done, {"settings_hash": settings, "checkpoint": str(best.relative_to(folder.resolve())),
                       "seconds": seconds, "what": what})
-    say(f"    trained in {seconds / 60:.1f} min")
+    log.info(f"    trained in {seconds / 60:.1f} min")
     return best, seconds
 
 
@@ -342,7 +342,7 @@ def generator_autoencoder(network: ZeroShotStyleVAE) -> dict[str, Any]:
 
 def evaluate_primitive(primitive: str, left_out: Mapping[str, ZeroShotStyleVAE], cvaes: Sequence[EvalModel],
                        takeset: TakeSet, autoencoder, settings: EvalSettings, split: Mapping[str, Any] | None,
-                       samples: int, seed: int, say: Say = print, shared_autoencoder: bool = False) -> dict[str, Any]:
+                       samples: int, seed: int, shared_autoencoder: bool = False) -> dict[str, Any]:
     """Each left-out network of ``primitive`` against the CVAE of its style, in one judge space (module doc).
 
     Args:
@@ -366,7 +366,7 @@ def evaluate_primitive(primitive: str, left_out: Mapping[str, ZeroShotStyleVAE],
     if missing:
         raise ZeroShotRunError(f"{primitive}: no CVAE of style(s) {missing} in the run to compare with (CVAE styles "
                                f"{sorted(by_style)})")
-    real = real_side(primitive, list(cvaes), takeset, settings, split, say)
+    real = real_side(primitive, list(cvaes), takeset, settings, split)
     columns = [NEUTRAL] + [m.name for m in real.models]
     neutral = EvalModel(NEUTRAL, primitive, settings.neutral_style, source=None)  # its column: the mean motion
     grams = torch.stack([example_column_gram(autoencoder, real, m) for m in [neutral, *real.models]])
@@ -392,7 +392,7 @@ def evaluate_primitive(primitive: str, left_out: Mapping[str, ZeroShotStyleVAE],
                           bound.target_gram, network.spec.get("dataset"), "canonical")
         if shared_autoencoder:
             check_one_autoencoder([cvae, model], fingerprint(autoencoder))
-        say(f"{primitive}/{style}: {samples} samples of the network without {style} and of the {style} CVAE")
+        log.info(f"{primitive}/{style}: {samples} samples of the network without {style} and of the {style} CVAE")
         out["styles"][style] = {
             "example": [dict(e) for e in cvae.examples], "trained_styles": network.styles,
             "generator_autoencoder": generator,
@@ -436,8 +436,7 @@ def splits_record(source: ReproduceRun, shared_autoencoder: bool) -> dict[str, A
 def leave_one_style_out(run: str | Path, out: str | Path, styles: Sequence[str] | None = None,
                         primitives: Sequence[str] | None = None, epochs: int | None = None, samples: int = 1000,
                         seed: int | None = None, overrides: Sequence[str] = (), threads: Any = None,
-                        force: bool = False, resume: bool = False, shared_autoencoder: bool = False,
-                        say: Say = print) -> dict[str, Any]:
+                        force: bool = False, resume: bool = False, shared_autoencoder: bool = False) -> dict[str, Any]:
     """The leave-one-style-out evaluation (see the module doc); returns what ``zero_shot.json`` holds.
 
     Args:
@@ -487,10 +486,10 @@ def leave_one_style_out(run: str | Path, out: str | Path, styles: Sequence[str] 
         networks, trained = {}, {}
         for s in wanted:
             if s not in generators:
-                generators[s] = _generator_autoencoder(source, s, out, seed, threads, shared_autoencoder, say)
+                generators[s] = _generator_autoencoder(source, s, out, seed, threads, shared_autoencoder)
             gen = generators[s]
             cfg = train_config(source, p, s, model_folder(out, p, s), epochs, overrides, threads, gen["path"], seed)
-            path, seconds = train_once(cfg, f"{p} network without {s}", say)
+            path, seconds = train_once(cfg, f"{p} network without {s}")
             networks[s] = load_left_out(path, p, s, gen["fingerprint"])
             if shared_autoencoder:
                 networks[s].attach_autoencoder(judge)  # one module for all (the same weights)
@@ -498,7 +497,7 @@ def leave_one_style_out(run: str | Path, out: str | Path, styles: Sequence[str] 
         cvaes = [load_model(source.cvaes[(q, s)], source.settings.neutral_style, judge)
                  for q, s in source.cvaes if q == p]
         results[p] = evaluate_primitive(p, networks, cvaes, takeset, judge, source.settings,
-                                        source.data_cfg.get("split"), samples, seed, say, shared_autoencoder)
+                                        source.data_cfg.get("split"), samples, seed, shared_autoencoder)
         for s, record in trained.items():
             row = results[p]["styles"][s]
             row["zero_shot"]["train_seconds"] = record["train_seconds"]
@@ -518,7 +517,7 @@ def leave_one_style_out(run: str | Path, out: str | Path, styles: Sequence[str] 
 
 
 def _generator_autoencoder(source: ReproduceRun, style: str, out: Path, seed: int, threads: Any,
-                           shared: bool, say: Say) -> dict[str, Any]:
+                           shared: bool) -> dict[str, Any]:
     """The autoencoder the networks without ``style`` are trained on: trained here without the style (or, when
     ``shared``, the run's); its ``path``, ``fingerprint``, ``excluded_styles`` and ``train_seconds``.
 
@@ -529,7 +528,7 @@ def _generator_autoencoder(source: ReproduceRun, style: str, out: Path, seed: in
         path, seconds = source.autoencoder_ckpt, None
     else:
         cfg = autoencoder_train_config(source, style, autoencoder_folder(out, style), seed, threads)
-        path, seconds = train_once(cfg, f"autoencoder without {style}", say)
+        path, seconds = train_once(cfg, f"autoencoder without {style}")
     excluded = autoencoder_excluded_styles(path)
     if not shared and style not in excluded:
         raise ZeroShotRunError(f"{path} was trained on data with style {style!r} (its excluded styles: {excluded}); "

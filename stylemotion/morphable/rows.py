@@ -12,7 +12,8 @@ from __future__ import annotations
 
 import hashlib
 import json
-from collections.abc import Callable, Mapping, Sequence
+import logging
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -21,6 +22,8 @@ from stylemotion.datamodules.clips import ClipDataModule
 from stylemotion.datasets import data_config_key
 from stylemotion.morphable.model import FitSettings, MorphableModel, fit_primitive
 from stylemotion.primitives.segmentation import parse_primitive
+
+log = logging.getLogger(__name__)
 
 #: Row name of the Morphable Graph's neutral model in Tables 5.1–5.3.
 ROW = "morphable"
@@ -33,8 +36,7 @@ def _key(data_cfg: Mapping[str, Any], primitive: str, style: str, segment: Mappi
 
 
 def neutral_models(data_cfg: Mapping[str, Any], primitives: Sequence[str], style: str, folder: Path,
-                   segment: Mapping[str, Any] | None = None, seed: int = 0,
-                   say: Callable[[str], None] = print) -> dict[str, MorphableModel]:
+                   segment: Mapping[str, Any] | None = None, seed: int = 0) -> dict[str, MorphableModel]:
     """``{primitive: model}`` fitted on ``style``'s training clips of ``data_cfg`` (or reused; module doc).
 
     Raises:
@@ -50,7 +52,7 @@ def neutral_models(data_cfg: Mapping[str, Any], primitives: Sequence[str], style
             if model.meta.get("rows_key") != key:
                 raise ConfigError(f"{path} holds a Morphable Graph model of other data or settings; delete it to fit "
                                   "again, or choose another out=…")
-            say(f"    morphable {primitive}: reused {path}")
+            log.info(f"    morphable {primitive}: reused {path}")
         else:
             dm = ClipDataModule(data=dict(data_cfg), action=action, primitives=[name], styles=[style],
                                 segment=segment)
@@ -59,8 +61,8 @@ def neutral_models(data_cfg: Mapping[str, Any], primitives: Sequence[str], style
             settings = FitSettings(seed=seed)
             if 2 < len(clips) <= settings.latent_dim:  # small data (the synthetic default): fewer dimensions
                 settings = FitSettings(seed=seed, latent_dim=len(clips) - 1)
-                say(f"    morphable {primitive}: {len(clips)} training clips, so latent_dim={settings.latent_dim} "
-                    f"(default {FitSettings.latent_dim})")
+                log.info(f"    morphable {primitive}: {len(clips)} training clips, so latent_dim={settings.latent_dim} "
+                         f"(default {FitSettings.latent_dim})")
             try:
                 model = fit_primitive(clips, settings,
                                       meta={"data": str(data_cfg.get("name")), "action": action, "primitive": name,
@@ -68,6 +70,6 @@ def neutral_models(data_cfg: Mapping[str, Any], primitives: Sequence[str], style
             except ValueError as err:
                 raise ConfigError(f"morphable=true, {primitive}: {err}") from err
             model.save(path)
-            say(f"    morphable {primitive}: fitted on {len(clips)} {style} clips → {path}")
+            log.info(f"    morphable {primitive}: fitted on {len(clips)} {style} clips → {path}")
         models[primitive] = model
     return models

@@ -22,10 +22,11 @@ The folder ``out`` (refused when it exists unless ``force``; built beside it and
 
 from __future__ import annotations
 
+import logging
 import os
 import time
 import warnings
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import asdict
 from pathlib import Path
 from typing import Any
@@ -51,7 +52,7 @@ from stylemotion.reconstruct.output import write_motion_folder
 from stylemotion.reconstruct.settings import ReconstructSettings
 from stylemotion.reconstruct.sparse import RECONSTRUCT_FEATURE_SETS, SparseReconstructor, joint_errors_cm
 
-Say = Callable[[str], None]
+log = logging.getLogger(__name__)
 _D = ReconstructSettings
 
 
@@ -92,8 +93,8 @@ def reconstruct_command(data: Mapping[str, Any], markers: str, out: str | os.Pat
                         features: str = _D.features, k: int = _D.k, joints: Sequence[str] | None = _D.joints,
                         noise_mm: float = _D.noise_mm, seed: int = _D.seed,
                         exclude_markers_take: bool = _D.exclude_markers_take, model: Mapping[str, Any] | None = None,
-                        conversion: Mapping[str, Any] | None = None, force: bool = _D.force, gif: bool = _D.gif,
-                        say: Say = print, command: str = "") -> dict[str, Any]:
+                        conversion: Mapping[str, Any] | None = None,
+                        force: bool = _D.force, gif: bool = _D.gif, command: str = "") -> dict[str, Any]:
     """Reconstruct ``markers`` on the database ``data`` (a ``data`` config) and write ``out`` (module docstring).
 
     ``model``: further :class:`SparseReconstructor` settings (variance, marker_sd, smooth_sd, prior_weight,
@@ -115,15 +116,15 @@ def reconstruct_command(data: Mapping[str, Any], markers: str, out: str | os.Pat
         warnings.simplefilter("always", MarkerGapWarning)
         tracks, take = load_tracks(str(markers or "").strip(), takeset, joints, conversion)
     for warning in caught:
-        say(f"warning: {warning.message}")
+        log.warning(f"warning: {warning.message}")
     if abs(tracks.fps - takeset.fps) > 1e-6:
         raise MarkerInputError(f"markers={markers}: {tracks.fps:g} fps, the dataset {takeset.fps:g} fps; give the "
                                f"CSV's fps as '# fps: {takeset.fps:g}' tracks or resample them")
     database = database_without(takeset, {take} if exclude_markers_take and take else set(), f"markers={markers}")
     if not 2 <= k <= database.num_frames:
         raise ConfigError(f"k={k} must be from 2 to the database's {database.num_frames} frames")
-    say(f"database {database.name}: {database.num_takes} takes, {database.num_frames} frames; markers "
-        f"{list(tracks.joints)}: {tracks.num_frames} frames")
+    log.info(f"database {database.name}: {database.num_takes} takes, {database.num_frames} frames; markers "
+             f"{list(tracks.joints)}: {tracks.num_frames} frames")
     try:
         reconstructor = SparseReconstructor(database, tracks.joints, features, k, **dict(model or {}))
     except TypeError as exc:
@@ -151,16 +152,16 @@ def reconstruct_command(data: Mapping[str, Any], markers: str, out: str | os.Pat
     summary["provenance"] = provenance(command or None)
     write_motion_folder(out, force, result.positions, database.fps, summary, started, gif=gif)
     error = summary.get("error")
-    say(f"{tracks.num_frames} frames reconstructed at {summary['frames_per_s']:g} frames/s into {out}"
-        + (f"; error {error['mean_cm']:.2f} cm mean, {error['max_cm']:.2f} cm max per joint" if error else ""))
+    log.info(f"{tracks.num_frames} frames reconstructed at {summary['frames_per_s']:g} frames/s into {out}"
+             + (f"; error {error['mean_cm']:.2f} cm mean, {error['max_cm']:.2f} cm max per joint" if error else ""))
     return summary
 
 
-def reconstruct_from_config(cfg: DictConfig, say: Say = print, command: str = "") -> dict[str, Any]:
+def reconstruct_from_config(cfg: DictConfig, command: str = "") -> dict[str, Any]:
     """:func:`reconstruct_command` with the keys of ``stylemotion/configs/reconstruct.yaml``
     (:class:`ReconstructSettings`)."""
     data, s = settings_from_config(cfg, ReconstructSettings, "reconstruct")
     return reconstruct_command(
         data, s.markers, s.out, features=s.features, k=s.k, joints=s.joints, noise_mm=s.noise_mm, seed=s.seed,
         exclude_markers_take=s.exclude_markers_take, model=asdict(s.model), conversion=conversion_keys(vars(s)),
-        force=s.force, gif=s.gif, say=say, command=command)
+        force=s.force, gif=s.gif, command=command)

@@ -36,9 +36,10 @@ Between every two consecutive keys ``k_i → k_{i+1}`` (docs/reconstruct.md, "Dy
 
 from __future__ import annotations
 
+import logging
 import time
 import warnings
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -62,7 +63,7 @@ FAR_KEY_M = 0.5
 #: frame, so a key at a huge time is refused before anything is built (docs/reconstruct.md, "Keyframe files").
 MAX_KEYS_SPAN_S = 600.0
 
-Say = Callable[[str], None]
+log = logging.getLogger(__name__)
 
 
 class KeyframeError(UserInputError, ValueError):
@@ -521,7 +522,7 @@ class DynamicMotionGraph:
         local = (1 - w[:, :, None]) * local1 + w[:, :, None] * local2
         return rotate_yaw(local, yaw[:, None]) + ground[:, None]
 
-    def connect(self, first: Keyframe, second: Keyframe, say: Say | None = None) -> PairResult:
+    def connect(self, first: Keyframe, second: Keyframe) -> PairResult:
         """The motion from ``first`` to ``second`` (module docstring, steps 2–5; NoConnectionError if none)."""
         started = time.perf_counter()
         out_tree, in_tree = self._root(first, True), self._root(second, False)
@@ -538,9 +539,8 @@ class DynamicMotionGraph:
             out_all, in_all = self._frame_table(out_tree, out_edges), self._frame_table(in_tree, in_edges)
             connections += (self._connections(self._frame_table(out_tree, new_out), in_all)
                             + self._connections(out_all, self._frame_table(in_tree, new_in)))
-            if say:
-                say(f"  iteration {iteration}: {len(out_tree.node_frame)} + {len(in_tree.node_frame)} nodes, "
-                    f"{len(connections)} connection(s)")
+            log.info(f"  iteration {iteration}: {len(out_tree.node_frame)} + {len(in_tree.node_frame)} nodes, "
+                         f"{len(connections)} connection(s)")
             if connections and met is None:
                 met = iteration
             if met is not None and iteration >= met + self.extra_iterations:
@@ -586,16 +586,15 @@ class DynamicMotionGraph:
                               f"in E15 (> {FAR_KEY_M} m); its tree starts from poses unlike it", FarKeyframeWarning,
                               stacklevel=3)
 
-    def synthesize(self, keys: Sequence[Keyframe], say: Say | None = None) -> KeyframeResult:
+    def synthesize(self, keys: Sequence[Keyframe]) -> KeyframeResult:
         """The motion through every key (module docstring); NoConnectionError naming the first pair without one."""
         keys = check_keyframes(keys)
         started = time.perf_counter()
         self._check_far(keys)
         parts, pairs, key_frames = [], [], [0]
         for i in range(len(keys) - 1):
-            if say:
-                say(f"keys {i} → {i + 1} ({keys[i].time_s:g} s → {keys[i + 1].time_s:g} s)")
-            pair = self.connect(keys[i], keys[i + 1], say)
+            log.info(f"keys {i} → {i + 1} ({keys[i].time_s:g} s → {keys[i + 1].time_s:g} s)")
+            pair = self.connect(keys[i], keys[i + 1])
             positions = pair.positions
             if self.retime:
                 positions = resample(positions, int(round((keys[i + 1].time_s - keys[i].time_s) * self.fps)) + 1)
@@ -611,8 +610,7 @@ class DynamicMotionGraph:
             pinned[f] = np.asarray(k.pose, np.float64)
         positions = pinned
         if self.clean:
-            if say:
-                say(f"cleaning {len(pinned)} frames by motion texturing (keys pinned)")
+            log.info(f"cleaning {len(pinned)} frames by motion texturing (keys pinned)")
             positions = self.texturer.apply(pinned, pinned=key_frames).positions
         done = time.perf_counter()
         for figures, error in zip(pairs, key_errors[1:]):

@@ -26,10 +26,11 @@ error), foot skating before and after cleaning, settings, timings and provenance
 from __future__ import annotations
 
 import json
+import logging
 import os
 import time
 import warnings
-from collections.abc import Callable, Mapping
+from collections.abc import Mapping
 from dataclasses import asdict
 from pathlib import Path
 from typing import Any
@@ -57,7 +58,7 @@ from stylemotion.reconstruct.output import write_motion_folder
 from stylemotion.reconstruct.settings import KeyframesSettings
 from stylemotion.skeleton import CANONICAL_JOINTS, JOINT_INDEX, NUM_JOINTS
 
-Say = Callable[[str], None]
+log = logging.getLogger(__name__)
 _D = KeyframesSettings
 _KEY_FIELDS = {"time", "take", "motion", "frame", "positions", "turn_deg", "shift_m"}
 
@@ -172,8 +173,8 @@ def read_keys(path: str | os.PathLike, takeset: TakeSet,
 
 def keyframes_command(data: Mapping[str, Any], keys: str | os.PathLike, out: str | os.PathLike, *,
                       exclude_key_takes: bool = _D.exclude_key_takes, model: Mapping[str, Any] | None = None,
-                      conversion: Mapping[str, Any] | None = None, force: bool = _D.force, gif: bool = _D.gif,
-                      say: Say = print, command: str = "") -> dict[str, Any]:
+                      conversion: Mapping[str, Any] | None = None,
+                      force: bool = _D.force, gif: bool = _D.gif, command: str = "") -> dict[str, Any]:
     """A motion through the keys of the JSON file ``keys`` on the database ``data`` (a ``data`` config), written
     to ``out`` (module docstring). ``model``: :class:`DynamicMotionGraph` settings. The defaults are
     :class:`~stylemotion.reconstruct.settings.KeyframesSettings`'s. Returns what ``summary.json`` holds.
@@ -190,17 +191,17 @@ def keyframes_command(data: Mapping[str, Any], keys: str | os.PathLike, out: str
     takeset = command_takeset(data)
     key_list, described, used = read_keys(keys, takeset, conversion)
     database = database_without(takeset, used if exclude_key_takes else set(), "the keys' takes")
-    say(f"database {database.name}: {database.num_takes} takes, {database.num_frames} frames; {len(key_list)} keys "
-        f"over {key_list[-1].time_s - key_list[0].time_s:g} s")
+    log.info(f"database {database.name}: {database.num_takes} takes, {database.num_frames} frames; "
+             f"{len(key_list)} keys over {key_list[-1].time_s - key_list[0].time_s:g} s")
     try:
         graph = DynamicMotionGraph(database, **dict(model or {}))
     except TypeError as exc:
         raise ConfigError(f"model: {exc}") from None
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", FarKeyframeWarning)
-        result = graph.synthesize(key_list, say=say)
+        result = graph.synthesize(key_list)
     for warning in caught:
-        say(f"warning: {warning.message}")
+        log.warning(f"warning: {warning.message}")
     skate_mid, skate_out = skating(result.intermediate, database.fps), skating(result.positions, database.fps)
     summary: dict[str, Any] = {
         "keys": [{**d, "frame_in_motion": f} for d, f in zip(described, result.key_frames)],
@@ -218,11 +219,11 @@ def keyframes_command(data: Mapping[str, Any], keys: str | os.PathLike, out: str
     write_motion_folder(out, force, result.positions, database.fps, summary, started, gif=gif,
                         gif_path_xz=ground[:, [0, 2]], gif_keys=result.key_frames,
                         gif_title=f"{len(key_list)} keyframes, database {database.name}")
-    say(f"{len(result.positions)} frames through {len(key_list)} keys into {out}")
+    log.info(f"{len(result.positions)} frames through {len(key_list)} keys into {out}")
     return summary
 
 
-def keyframes_from_config(cfg: DictConfig, say: Say = print, command: str = "") -> dict[str, Any]:
+def keyframes_from_config(cfg: DictConfig, command: str = "") -> dict[str, Any]:
     """:func:`keyframes_command` with the keys of ``stylemotion/configs/keyframes.yaml``
     (:class:`KeyframesSettings`)."""
     data, s = settings_from_config(cfg, KeyframesSettings, "keyframes")
@@ -230,4 +231,4 @@ def keyframes_from_config(cfg: DictConfig, say: Say = print, command: str = "") 
         raise ConfigError("keys= is empty: give a keyframe JSON file (stylemotion-keyframes --help)")
     return keyframes_command(
         data, s.keys, s.out, exclude_key_takes=s.exclude_key_takes, model=asdict(s.model),
-        conversion=conversion_keys(vars(s)), force=s.force, gif=s.gif, say=say, command=command)
+        conversion=conversion_keys(vars(s)), force=s.force, gif=s.gif, command=command)

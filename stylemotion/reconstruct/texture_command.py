@@ -14,9 +14,10 @@ joint in cm (complete mode: on the untrusted joints, with the nearest-neighbour 
 
 from __future__ import annotations
 
+import logging
 import os
 import time
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import asdict
 from pathlib import Path
 from typing import Any
@@ -36,7 +37,7 @@ from stylemotion.reconstruct.settings import TextureSettings
 from stylemotion.reconstruct.texture import LEG_JOINTS, MODES, MotionTexturer, TextureInputError, check_joints
 from stylemotion.skeleton import CANONICAL_JOINTS, JOINT_INDEX, NUM_JOINTS
 
-Say = Callable[[str], None]
+log = logging.getLogger(__name__)
 _D = TextureSettings
 
 
@@ -68,8 +69,8 @@ def _errors_cm(positions: np.ndarray, truth: np.ndarray, joints: Sequence[str]) 
 def texture_command(data: Mapping[str, Any], motion: str, out: str | os.PathLike, *, mode: str = _D.mode,
                     joints: Sequence[str] | None = _D.joints, k: int = _D.k,
                     exclude_motion_take: bool = _D.exclude_motion_take, model: Mapping[str, Any] | None = None,
-                    conversion: Mapping[str, Any] | None = None, force: bool = _D.force, gif: bool = _D.gif,
-                    say: Say = print, command: str = "") -> dict[str, Any]:
+                    conversion: Mapping[str, Any] | None = None,
+                    force: bool = _D.force, gif: bool = _D.gif, command: str = "") -> dict[str, Any]:
     """Complete or texture ``motion`` on the database ``data`` (a ``data`` config) and write ``out`` (module
     docstring). ``model``: further :class:`MotionTexturer` settings. The defaults are
     :class:`~stylemotion.reconstruct.settings.TextureSettings`'s. Returns what ``summary.json`` holds.
@@ -88,8 +89,8 @@ def texture_command(data: Mapping[str, Any], motion: str, out: str | os.PathLike
     takeset = command_takeset(data)
     positions, truth, take = load_motion(str(motion or "").strip(), takeset, trusted, conversion)
     database = database_without(takeset, {take} if exclude_motion_take and take else set(), f"motion={motion}")
-    say(f"database {database.name}: {database.num_takes} takes, {database.num_frames} frames; motion {motion}: "
-        f"{len(positions)} frames, mode {mode}")
+    log.info(f"database {database.name}: {database.num_takes} takes, {database.num_frames} frames; motion {motion}: "
+             f"{len(positions)} frames, mode {mode}")
     try:
         texturer = MotionTexturer(database, mode, trusted, k, **dict(model or {}))
     except TypeError as exc:
@@ -114,15 +115,15 @@ def texture_command(data: Mapping[str, Any], motion: str, out: str | os.PathLike
     summary["provenance"] = provenance(command or None)
     write_motion_folder(out, force, result.positions, database.fps, summary, started, gif=gif)
     error = summary.get("error")
-    say(f"{len(positions)} frames ({mode}) into {out}"
-        + (f"; error {error['mean_cm']:.2f} cm mean per joint" if error else ""))
+    log.info(f"{len(positions)} frames ({mode}) into {out}"
+             + (f"; error {error['mean_cm']:.2f} cm mean per joint" if error else ""))
     return summary
 
 
-def texture_from_config(cfg: DictConfig, say: Say = print, command: str = "") -> dict[str, Any]:
+def texture_from_config(cfg: DictConfig, command: str = "") -> dict[str, Any]:
     """:func:`texture_command` with the keys of ``stylemotion/configs/texture.yaml`` (:class:`TextureSettings`)."""
     data, s = settings_from_config(cfg, TextureSettings, "texture")
     return texture_command(
         data, s.motion, s.out, mode=s.mode, joints=s.joints, k=s.k, exclude_motion_take=s.exclude_motion_take,
-        model=asdict(s.model), conversion=conversion_keys(vars(s)), force=s.force, gif=s.gif, say=say,
+        model=asdict(s.model), conversion=conversion_keys(vars(s)), force=s.force, gif=s.gif,
         command=command)

@@ -21,9 +21,10 @@ The folder ``out`` (refused when it exists unless ``force``; built beside it and
 
 from __future__ import annotations
 
+import logging
 import os
 import time
-from collections.abc import Callable, Mapping
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -53,7 +54,7 @@ from stylemotion.search.lng import NORMALIZATIONS
 from stylemotion.search.matching import SearchResult, SegmentMatch, search_motion
 from stylemotion.search.settings import ExportSettings, FigureSettings, SearchSettings
 
-Say = Callable[[str], None]
+log = logging.getLogger(__name__)
 _D = SearchSettings
 
 
@@ -155,7 +156,7 @@ def search(data: Mapping[str, Any], query: str, out: str | os.PathLike, *, featu
            retarget_query: bool = _D.retarget_query, conversion: Mapping[str, Any] | None = None,
            export_bvh: bool = ExportSettings.bvh, export_gif: bool = ExportSettings.gif,
            export_top: int = ExportSettings.top, figure_matches: int = FigureSettings.matches,
-           figure_margin_s: float = FigureSettings.margin_s, force: bool = _D.force, say: Say = print,
+           figure_margin_s: float = FigureSettings.margin_s, force: bool = _D.force,
            command: str = "") -> dict[str, Any]:
     """Search ``data`` (a ``data`` config) for ``query`` and write the folder ``out`` (module docstring).
 
@@ -195,8 +196,8 @@ def search(data: Mapping[str, Any], query: str, out: str | os.PathLike, *, featu
     if k > available:
         raise SearchInputError(f"k={k} exceeds the database's {available} frames" +
                                (f" outside the query's take {exclude[0]}" if exclude else ""))
-    say(f"database {database.name}: {database.num_takes} takes, {database.num_frames} frames at {database.fps:g} fps; "
-        f"query {q.positions.shape[0]} frames")
+    log.info(f"database {database.name}: {database.num_takes} takes, {database.num_frames} frames at "
+             f"{database.fps:g} fps; query {q.positions.shape[0]} frames")
     t0 = time.perf_counter()
     cfg_cache = data.get("cache_dir")
     index = FrameIndex.build(database, features, engine=engine, cache_dir=cfg_cache,
@@ -231,11 +232,12 @@ def search(data: Mapping[str, Any], query: str, out: str | os.PathLike, *, featu
         report["timing_s"]["total"] = round(time.perf_counter() - started, 3)
         write_json(inside(tmp, "search.json"), report)
     if not records:
-        say(f"no match: no path through the k-NN graph of the {q.positions.shape[0]} query frames; raise k (now {k})")
+        log.info(f"no match: no path through the k-NN graph of the {q.positions.shape[0]} query frames; "
+                 f"raise k (now {k})")
     elif len(records) < top and k < database.num_frames:
-        say(f"{len(records)} of top={top} found: the {k} nearest frames of each query frame hold few paths; a larger k "
-            f"finds more (benchmarks/search.md)")
-    say(f"{len(records)} match(es) written to {out}" + (f"; best: {records[0]['take']} "
+        log.info(f"{len(records)} of top={top} found: the {k} nearest frames of each query frame hold few paths; "
+                 f"a larger k finds more (benchmarks/search.md)")
+    log.info(f"{len(records)} match(es) written to {out}" + (f"; best: {records[0]['take']} "
                                                          f"{records[0]['start']}-{records[0]['end']} cost "
                                                          f"{records[0]['cost']:.4g}" if records else ""))
     return report
@@ -270,7 +272,7 @@ def _exports(folder: Path, q: Query, result: SearchResult, index: FrameIndex, bv
     return written
 
 
-def search_from_config(cfg: DictConfig, say: Say = print, command: str = "") -> dict[str, Any]:
+def search_from_config(cfg: DictConfig, command: str = "") -> dict[str, Any]:
     """:func:`search` with the keys of ``stylemotion/configs/search.yaml`` (:class:`SearchSettings`)."""
     data, settings = settings_from_config(cfg, SearchSettings, "search")
     return search(
@@ -279,4 +281,4 @@ def search_from_config(cfg: DictConfig, say: Say = print, command: str = "") -> 
         exclude_query_take=settings.exclude_query_take, retarget_query=settings.retarget_query,
         conversion=conversion_keys(vars(settings)), export_bvh=settings.export.bvh, export_gif=settings.export.gif,
         export_top=settings.export.top, figure_matches=settings.figure.matches,
-        figure_margin_s=settings.figure.margin_s, force=settings.force, say=say, command=command)
+        figure_margin_s=settings.figure.margin_s, force=settings.force, command=command)

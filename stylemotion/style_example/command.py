@@ -27,9 +27,10 @@ example: ``positions`` (frames, 21, 3) metres, ``fps``, ``joint_names``), ``repo
 from __future__ import annotations
 
 import io
+import logging
 import os
 import time
-from collections.abc import Callable, Iterator, Mapping, Sequence
+from collections.abc import Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from dataclasses import asdict
 from pathlib import Path
@@ -65,19 +66,19 @@ from stylemotion.style_example.methods import Method, recorded_path
 from stylemotion.style_example.settings import StyleSettings
 from stylemotion.style_example.zero_shot import ZeroShotMethod
 
-Say = Callable[[str], None]
+log = logging.getLogger(__name__)
 _D = StyleSettings
 
 
 class Progress:
     """``[k/N] text  (at x min)`` lines, as ``stylemotion-reproduce`` prints its stages."""
 
-    def __init__(self, total: int, say: Say):
-        self.total, self.say, self.step, self.started = total, say, 0, time.perf_counter()
+    def __init__(self, total: int):
+        self.total, self.step, self.started = total, 0, time.perf_counter()
 
     def __call__(self, text: str) -> None:
         self.step += 1
-        self.say(f"[{self.step}/{self.total}] {text}  (at {(time.perf_counter() - self.started) / 60:.1f} min)")
+        log.info(f"[{self.step}/{self.total}] {text}  (at {(time.perf_counter() - self.started) / 60:.1f} min)")
 
 
 @contextmanager
@@ -98,7 +99,7 @@ def hydra_configs() -> Iterator[None]:
 
 
 def train_cvae(run: SourceRun, name: str, example: ConvertedExample, cut: CutExample, folder: Path,
-               progress: Progress, say: Say, threads: Any = None) -> dict[str, Path]:
+               progress: Progress, threads: Any = None) -> dict[str, Path]:
     """A :class:`~stylemotion.models.cvae.StyleCVAE` per primitive, trained as the run's CVAE stage of that
     primitive (:func:`.base_run.train_config`) on the example's clips; returns primitive → checkpoint."""
     from stylemotion.training.fit import run as train_run
@@ -116,7 +117,7 @@ def train_cvae(run: SourceRun, name: str, example: ConvertedExample, cut: CutExa
         last = model_folder / "checkpoints" / "last.ckpt"
         checkpoints[primitive] = Path(metrics.get("best_checkpoint") or last)
         test = ", ".join(f"{k} {v:.4g}" for k, v in metrics.get("test", {}).items() if isinstance(v, float))
-        say(f"    cvae {primitive}/{name} done in {(time.perf_counter() - t0) / 60:.1f} min" + (f": {test}" if test
+        log.info(f"    cvae {primitive}/{name} done in {(time.perf_counter() - t0) / 60:.1f} min" + (f": {test}" if test
                                                                                                 else ""))
     return checkpoints
 
@@ -125,8 +126,8 @@ class CVAEMethod(Method):
     """``method=cvae``: :func:`train_cvae`; the evaluation loads each StyleCVAE as the run's own."""
 
     def make(self, run: SourceRun, name: str, example: ConvertedExample, cut: CutExample, folder: Path,
-             progress: Progress, say: Say, threads: Any, options: Mapping[str, Any]) -> dict[str, Path]:
-        return train_cvae(run, name, example, cut, folder, progress, say, threads)
+             progress: Progress, threads: Any, options: Mapping[str, Any]) -> dict[str, Path]:
+        return train_cvae(run, name, example, cut, folder, progress, threads)
 
     def load(self, checkpoint: Path, primitive: str, clips: Sequence[Clip], records: Sequence[Mapping[str, Any]],
              name: str, neutral_style: str, autoencoder) -> EvalModel:
@@ -159,7 +160,7 @@ def method_options(method: str, options: Mapping[str, Any] | None) -> dict[str, 
 
 def add_style(example: str, run: str | os.PathLike, name: str, out: str | os.PathLike, method: str = _D.method,
               action: str | None = _D.action, samples: int = _D.samples, seed: int | None = _D.seed,
-              threads: Any = _D.threads, conversion: Mapping[str, Any] | None = None, say: Say = print,
+              threads: Any = _D.threads, conversion: Mapping[str, Any] | None = None,
               command: str = "", network: Any = _D.network,
               network_epochs: int | None = _D.network_epochs) -> dict[str, Any]:
     """Make the models of a new style ``name`` from ``example`` and evaluate them (see the module doc).
@@ -174,7 +175,6 @@ def add_style(example: str, run: str | os.PathLike, name: str, out: str | os.Pat
         samples: samples per model for the report; ``seed`` draws them (None: the run's seed).
         threads: torch threads while training (None: torch's default).
         conversion: ``joint_map``, ``unit_scale``, ``up_axis`` for the example (None: auto-detected, Y up).
-        say: prints a progress line.
         command: the command line to record.
         network: ``method=zero_shot``: the networks, a folder with ``<primitive>/checkpoints/best.ckpt`` or
             ``{primitive: checkpoint}``; None trains them into ``out/network/`` (:mod:`.zero_shot`).
@@ -208,7 +208,7 @@ def add_style(example: str, run: str | os.PathLike, name: str, out: str | os.Pat
     settings = conversion_settings(source, conversion)
     ours = [p for p in source.primitives if parse_primitive(p)[0] == action]
     options = METHODS[method].prepare(source, ours, options)
-    progress = Progress(3 + METHODS[method].steps(ours, options), say)
+    progress = Progress(3 + METHODS[method].steps(ours, options))
     converted = convert_example(spec, settings)
     takeset = build_dataset(source.data_cfg)
     converted = on_run_skeleton(converted, takeset, source.settings.neutral_style)
@@ -226,9 +226,9 @@ def add_style(example: str, run: str | os.PathLike, name: str, out: str | os.Pat
              + (f"; no model of {cut.skipped} (another action)" if cut.skipped else ""))
     with atomic_folder(out, on_exists=lambda: check_new_output(out)) as tmp:
         with hydra_configs():
-            checkpoints = METHODS[method].make(source, name, converted, cut, tmp, progress, say, threads, options)
+            checkpoints = METHODS[method].make(source, name, converted, cut, tmp, progress, threads, options)
         progress(f"evaluation: {samples} samples per model → {out / 'report.md'}")
-        results = evaluate(source, takeset, name, method, converted, cut, checkpoints, tmp, samples, seed, say,
+        results = evaluate(source, takeset, name, method, converted, cut, checkpoints, tmp, samples, seed,
                            options)
         results["meta"].update(provenance(command or None), seconds=time.perf_counter() - started,
                                run_relative=os.path.relpath(source.folder.resolve(), out.resolve()))
@@ -237,8 +237,8 @@ def add_style(example: str, run: str | os.PathLike, name: str, out: str | os.Pat
         write_json(tmp / "report.json", results)
         (tmp / "report.md").write_text(markdown(results))
     for line in summary_lines(results):
-        say(line)
-    say(f"report: {out / 'report.md'}")
+        log.info(line)
+    log.info(f"report: {out / 'report.md'}")
     return results
 
 
@@ -253,7 +253,7 @@ def conversion_settings(run: SourceRun, conversion: Mapping[str, Any] | None) ->
 
 
 def evaluate(run: SourceRun, takeset: TakeSet, name: str, method: str, example: ConvertedExample, cut: CutExample,
-             checkpoints: Mapping[str, Path], folder: Path, samples: int, seed: int | None, say: Say,
+             checkpoints: Mapping[str, Path], folder: Path, samples: int, seed: int | None,
              options: Mapping[str, Any] | None = None) -> dict[str, Any]:
     """The report of the new models against ``run`` and its data ``takeset`` (``report.json`` layout without
     provenance); paths inside ``folder`` relative to it; ``options``: the method's keys (see :meth:`Method.prepare`)."""
@@ -274,7 +274,7 @@ def evaluate(run: SourceRun, takeset: TakeSet, name: str, method: str, example: 
                                             settings.neutral_style, autoencoder)
         per[primitive] = evaluate_primitive(primitive, run.models(primitive, autoencoder), new, cut.used[primitive],
                                             takeset, autoencoder, settings, run.data_cfg.get("split"), samples, seed,
-                                            segmentations[action], lambda text: say("    " + text))
+                                            segmentations[action])
         models[primitive] = {"checkpoint": recorded_path(ckpt, folder),
                              "examples": new.examples,
                              "borrowed": primitive in cut.borrowed}
@@ -340,7 +340,7 @@ def _percent(value: Any) -> str:
     return "–" if value is None else f"{100 * value:.1f} %"
 
 
-def add_style_from_config(cfg: DictConfig | Mapping[str, Any], say: Say = print, command: str = "") -> dict[str, Any]:
+def add_style_from_config(cfg: DictConfig | Mapping[str, Any], command: str = "") -> dict[str, Any]:
     """:func:`add_style` with the keys of ``configs/style.yaml`` (:class:`StyleSettings`); missing mandatory keys
     are named."""
     if isinstance(cfg, DictConfig):
@@ -349,6 +349,6 @@ def add_style_from_config(cfg: DictConfig | Mapping[str, Any], say: Say = print,
                 raise ConfigError(f"{key} is missing: give {form}")
     _, s = settings_from_config(cfg, StyleSettings, "style")
     return add_style(str(s.example), s.run, s.name, s.out, method=s.method, action=s.action, samples=s.samples,
-                     seed=s.seed, threads=s.threads, conversion=conversion_keys(vars(s)), say=say, command=command,
+                     seed=s.seed, threads=s.threads, conversion=conversion_keys(vars(s)), command=command,
                      network=s.network, network_epochs=s.network_epochs)
 

@@ -18,7 +18,8 @@ Per primitive, with the evaluation library of the run's report (:mod:`stylemotio
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+import logging
+from collections.abc import Sequence
 from typing import Any
 
 import torch
@@ -35,6 +36,8 @@ from stylemotion.models.sampling import MotionSamples
 from stylemotion.primitives.segmentation import Clip, Segmentation
 from stylemotion.primitives.skating import FootSkating, foot_skating, pooled_skating
 
+log = logging.getLogger(__name__)
+
 #: Variation figures of the report, in table order.
 VARIATION_KEYS = (*VARIANCE_KEYS, "pose_across_sd")
 
@@ -50,8 +53,7 @@ def variation(motions: MotionSamples) -> dict[str, float] | None:
 
 def evaluate_primitive(primitive: str, run_models: Sequence[EvalModel], new: EvalModel, clips: Sequence[Clip],
                        takeset: TakeSet, autoencoder, settings: EvalSettings, split: dict[str, Any] | None,
-                       samples: int, seed: int, segmentation: Segmentation | None = None,
-                       say: Callable[[str], None] = print) -> dict[str, Any]:
+                       samples: int, seed: int, segmentation: Segmentation | None = None) -> dict[str, Any]:
     """The new model of ``primitive`` against the run (see the module doc).
 
     Args:
@@ -75,14 +77,14 @@ def evaluate_primitive(primitive: str, run_models: Sequence[EvalModel], new: Eva
             one the model was trained with.
     """
     check_one_autoencoder([*run_models, new])
-    real = real_side(primitive, run_models, takeset, settings, split, say, segmentation)
+    real = real_side(primitive, run_models, takeset, settings, split, segmentation)
     if new.timeline_frames != real.length:
         raise ValueError(f"{new.checkpoint}: timeline of {new.timeline_frames} frames, the run's {primitive} models "
                          f"use {real.length}: it was not trained on the run's data")
     real.examples[new.name] = list(clips)  # the new column: the user's clips, as the model was trained on them
     columns = [*real.models, new]
     grams = torch.stack([example_column_gram(autoencoder, real, m) for m in columns])
-    say(f"{primitive}: {samples} samples of {new.name}, Table 5.1 row against {len(columns)} examples")
+    log.info(f"{primitive}: {samples} samples of {new.name}, Table 5.1 row against {len(columns)} examples")
     drawn = new.source.sample(samples, seed=seed)
     row = distance_table(autoencoder, [drawn.normalized_frames.numpy()], grams, settings.gram_chunk)[0]
     names = [m.name for m in columns]

@@ -17,7 +17,8 @@ from typing import Any
 from stylemotion.models.loading import EvalModel
 from stylemotion.primitives.segmentation import Clip
 
-Say = Callable[[str], None]
+#: Prints one ``[k/N]`` progress line of the command (``command.Progress``).
+ProgressLine = Callable[[str], None]
 
 
 class Method:
@@ -43,7 +44,7 @@ class Method:
         """Progress lines :meth:`make` prints for ``primitives``."""
         return len(primitives)
 
-    def make(self, run, name: str, example, cut, folder: Path, progress: Say, say: Say, threads: Any,
+    def make(self, run, name: str, example, cut, folder: Path, progress: ProgressLine, threads: Any,
              options: Mapping[str, Any]) -> dict[str, Path]:
         """The style's checkpoints, primitive → file (made in ``folder``, or taken from elsewhere)."""
         raise NotImplementedError

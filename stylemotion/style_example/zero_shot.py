@@ -23,6 +23,7 @@ rate): ``stylemotion-generate`` binds the same clips again
 
 from __future__ import annotations
 
+import logging
 import os
 import time
 from collections.abc import Mapping, Sequence
@@ -42,7 +43,9 @@ from stylemotion.models.zero_shot import ZeroShotStyleVAE
 from stylemotion.primitives.segmentation import Clip
 from stylemotion.style_example.base_run import SourceRun, train_config
 from stylemotion.style_example.example import EXAMPLE_FILE, StyleExampleError
-from stylemotion.style_example.methods import Method, Say, recorded_path
+from stylemotion.style_example.methods import Method, ProgressLine, recorded_path
+
+log = logging.getLogger(__name__)
 
 #: The networks' folder inside ``out`` (one training folder per primitive).
 NETWORK_FOLDER = "network"
@@ -76,8 +79,8 @@ def network_config(run: SourceRun, primitive: str, folder: Path, epochs: int | N
     return cfg
 
 
-def train_networks(run: SourceRun, primitives: Sequence[str], folder: Path, epochs: int | None, progress: Say,
-                   say: Say, threads: Any = None) -> dict[str, Path]:
+def train_networks(run: SourceRun, primitives: Sequence[str], folder: Path, epochs: int | None, progress: ProgressLine,
+                   threads: Any = None) -> dict[str, Path]:
     """Train the network of each primitive into ``folder/network/<primitive>/``; primitive → best checkpoint."""
     from stylemotion.training.fit import run as train_run
 
@@ -91,8 +94,8 @@ def train_networks(run: SourceRun, primitives: Sequence[str], folder: Path, epoc
         metrics = train_run(cfg)["metrics"]
         checkpoints[primitive] = Path(metrics.get("best_checkpoint") or network_folder / "checkpoints" / "last.ckpt")
         test = ", ".join(f"{k} {v:.4g}" for k, v in metrics.get("test", {}).items() if isinstance(v, float))
-        say(f"    network {primitive} done in {(time.perf_counter() - t0) / 60:.1f} min"
-            + (f": {test}" if test else ""))
+        log.info(f"    network {primitive} done in {(time.perf_counter() - t0) / 60:.1f} min"
+                 + (f": {test}" if test else ""))
     return checkpoints
 
 
@@ -200,12 +203,12 @@ class ZeroShotMethod(Method):
     def steps(self, primitives: Sequence[str], options: Mapping[str, Any]) -> int:
         return len(primitives) if options["network"] is None else 1
 
-    def make(self, run: SourceRun, name: str, example, cut, folder: Path, progress: Say, say: Say, threads: Any,
+    def make(self, run: SourceRun, name: str, example, cut, folder: Path, progress: ProgressLine, threads: Any,
              options: Mapping[str, Any]) -> dict[str, Path]:
         if options["network"] is not None:
             progress(f"network: taken from {options['network']}, no training; the example's clips are bound to it")
             return dict(options["checkpoints"])
-        checkpoints = train_networks(run, list(cut.used), folder, options["network_epochs"], progress, say, threads)
+        checkpoints = train_networks(run, list(cut.used), folder, options["network_epochs"], progress, threads)
         weights = fingerprint(load_autoencoder(run.autoencoder_ckpt))
         for primitive, path in checkpoints.items():
             check_network(path, primitive, weights, run_timeline(run, primitive), run)

@@ -122,12 +122,10 @@ class Reproduction:
 
     Args:
         cfg: the composed ``reproduce`` config.
-        say: prints a progress line.
     """
 
-    def __init__(self, cfg: DictConfig, say=print):
+    def __init__(self, cfg: DictConfig):
         self.cfg = cfg
-        self.say = say
         self.out = Path(str(cfg.out)).expanduser()
         self.data_cfg = OmegaConf.to_container(cfg.data, resolve=True)
         self.primitives = [str(p) for p in cfg.primitives]
@@ -148,7 +146,7 @@ class Reproduction:
 
     def _line(self, step: int, text: str) -> None:
         elapsed = time.perf_counter() - self.started
-        self.say(f"[{step}/{self.total_steps()}] {text}  (at {elapsed / 60:.1f} min)")
+        log.info(f"[{step}/{self.total_steps()}] {text}  (at {elapsed / 60:.1f} min)")
 
     def plan(self, styles: Sequence[str]) -> None:
         """The training stages for the primitives and ``styles`` (called by :meth:`data_stage`)."""
@@ -204,7 +202,7 @@ class Reproduction:
         self.plan(wanted)
         self._line(1, f"data: {takeset.name}, {len(takeset)} takes, {takeset.num_frames} frames; CVAE styles {wanted}")
         for p in self.primitives:
-            self.say("    " + p + " clips: " + ", ".join(f"{s} {counts[(p, s)]}" for s in styles))
+            log.info("    " + p + " clips: " + ", ".join(f"{s} {counts[(p, s)]}" for s in styles))
         write_json(self.out / "data.json", self.data_summary)
 
     def prepare_stage(self, index: int, stage: Stage) -> bool | None:
@@ -263,7 +261,7 @@ class Reproduction:
                                                  "name": stage.name})
         test = stage.metrics.get("test", {})
         shown = ", ".join(f"{k} {v:.4g}" for k, v in test.items() if isinstance(v, float))
-        self.say(f"    {stage.name} done in {stage.seconds / 60:.1f} min" + (f": {shown}" if shown else ""))
+        log.info(f"    {stage.name} done in {stage.seconds / 60:.1f} min" + (f": {shown}" if shown else ""))
 
     def run_stage(self, index: int, stage: Stage) -> None:
         """Train ``stage`` in this process (or reuse/resume it)."""
@@ -294,7 +292,7 @@ class Reproduction:
                 metrics, seconds = outcome()
                 self.finish_stage(stage, metrics, resume, seconds)
             except Exception as exc:  # noqa: BLE001 - reported below, after the others are recorded
-                self.say(f"    {stage.name} FAILED: {type(exc).__name__}: {exc}")
+                log.info(f"    {stage.name} FAILED: {type(exc).__name__}: {exc}")
                 errors.append((stage, exc))
             write_json(self.out / "reproduce.json", self.summary())
         if errors:
@@ -340,7 +338,7 @@ class Reproduction:
         command = "stylemotion-reproduce " + " ".join(sys.argv[1:])
         extra = self.morphable_rows() if morphable else None
         results = run_evaluation(self.cfg.data, models, self.cfg.evaluation, report, int(self.cfg.seed),
-                                 autoencoder_ckpt=ae, command=command, progress=lambda text: self.say("    " + text),
+                                 autoencoder_ckpt=ae, command=command,
                                  root=self.out, extra_rows=extra)
         write_json(record, {"settings_hash": settings_hash, "report": self.recorded(report)})
         return results
@@ -351,7 +349,7 @@ class Reproduction:
 
         models = neutral_models(self.data_cfg, self.primitives, str(self.cfg.evaluation.neutral_style),
                                 self.out / "morphable", dict(self.cfg.evaluation.get("segment") or {}),
-                                int(self.cfg.seed), say=self.say)
+                                int(self.cfg.seed))
         return {p: {ROW: m} for p, m in models.items()}
 
     def recorded(self, path: str | Path | None) -> str | None:
@@ -508,7 +506,7 @@ def _data_choice() -> str | None:
     return None
 
 
-def reproduce(cfg: DictConfig, say=print) -> dict[str, Any]:
+def reproduce(cfg: DictConfig) -> dict[str, Any]:
     """Run (or resume) every stage; returns the summary written to ``<out>/reproduce.json``.
 
     Must be called with Hydra's global config search initialized (inside ``stylemotion-reproduce``,
@@ -517,9 +515,9 @@ def reproduce(cfg: DictConfig, say=print) -> dict[str, Any]:
     set_torch_threads(cfg.get("threads"), "threads")  # the evaluation's too, so reruns compute alike
     workers = positive_int(cfg.get("workers", 1), "workers")
     engine = executor_engine(cfg)
-    say(choose_budget(cfg))
+    log.info(choose_budget(cfg))
     check_out_folder(cfg.out)
-    repro = Reproduction(cfg, say)
+    repro = Reproduction(cfg)
     repro.out.mkdir(parents=True, exist_ok=True)
     repro.data_stage()
     indexed = list(enumerate(repro.stages, start=2))
@@ -534,9 +532,9 @@ def reproduce(cfg: DictConfig, say=print) -> dict[str, Any]:
     summary = repro.summary()
     summary["report"] = repro.recorded(repro.out / "report")
     write_json(repro.out / "reproduce.json", summary)
-    say(f"done in {summary['seconds'] / 60:.1f} min: "
-        + ", ".join(f"{k} {v}" for k, v in Counter(s.status for s in repro.stages).items()) + " training stages")
+    log.info(f"done in {summary['seconds'] / 60:.1f} min: "
+             + ", ".join(f"{k} {v}" for k, v in Counter(s.status for s in repro.stages).items()) + " training stages")
     for line in summary_lines(results):
-        say(line)
-    say(f"report: {repro.out / 'report' / 'report.md'}")
+        log.info(line)
+    log.info(f"report: {repro.out / 'report' / 'report.md'}")
     return summary

@@ -14,7 +14,7 @@ SYNTHETIC = {"name": "synthetic", "split": {"seed": 0, "val_fraction": 0.1, "tes
 @pytest.fixture(scope="module")
 def templates_dir(tmp_path_factory):
     out = tmp_path_factory.mktemp("annotate") / "templates"
-    learn(SYNTHETIC, out, per_class=9, say=lambda _: None)
+    learn(SYNTHETIC, out, per_class=9)
     return out
 
 
@@ -25,7 +25,7 @@ def test_learn_then_annotate_a_bvh(templates_dir, synthetic_split, tmp_path):
     takes = [(t.name, t.content, t.style, t.positions) for t in synthetic_split["test"][::4]]
     doc = join_takes(takes, 30.0)
     write_motion_bvh(doc.positions, tmp_path / "doc.bvh", 30.0)
-    report = annotate(str(tmp_path / "doc.bvh"), templates_dir, tmp_path / "out", say=lambda _: None)
+    report = annotate(str(tmp_path / "doc.bvh"), templates_dir, tmp_path / "out")
     with open(tmp_path / "out" / "labels.csv") as f:
         rows = list(csv.reader(f))
     assert rows[0] == ["frame", "label"] and len(rows) == 1 + len(doc.labels)
@@ -36,7 +36,7 @@ def test_learn_then_annotate_a_bvh(templates_dir, synthetic_split, tmp_path):
     assert (tmp_path / "out" / "timeline.png").stat().st_size > 1000
     assert report["segments"] == json.loads((tmp_path / "out" / "segments.json").read_text())["segments"]
     with pytest.raises(OutputExistsError):
-        annotate(str(tmp_path / "doc.bvh"), templates_dir, tmp_path / "out", say=lambda _: None)
+        annotate(str(tmp_path / "doc.bvh"), templates_dir, tmp_path / "out")
 
 
 def meta_classes(meta):
@@ -47,19 +47,19 @@ def test_document_shorter_than_every_template(templates_dir, synthetic_split, tm
     take = synthetic_split["test"][0]
     write_motion_bvh(take.positions[:20], tmp_path / "short.bvh", 30.0)
     with pytest.raises(AnnotateInputError, match=r"20 frames at 30 fps is shorter than every template"):
-        annotate(str(tmp_path / "short.bvh"), templates_dir, tmp_path / "out", say=lambda _: None)
+        annotate(str(tmp_path / "short.bvh"), templates_dir, tmp_path / "out")
     assert not (tmp_path / "out").exists()
 
 
 def test_unmappable_skeleton(templates_dir, tiny_bvh, write_text, tmp_path):
     path = write_text(tiny_bvh, "four_joints.bvh")
     with pytest.raises(AnnotateInputError, match="four_joints.bvh.*joint_map="):
-        annotate(str(path), templates_dir, tmp_path / "out", say=lambda _: None)
+        annotate(str(path), templates_dir, tmp_path / "out")
 
 
 def test_missing_templates_and_small_classes(tmp_path):
     with pytest.raises(AnnotateInputError, match="no model.json"):
-        annotate("x.bvh", tmp_path / "nothing", tmp_path / "out", say=lambda _: None)
+        annotate("x.bvh", tmp_path / "nothing", tmp_path / "out")
     one_each = {**SYNTHETIC, "contents": ["walk"], "styles": ["normal"]}
     with pytest.raises(AnnotateInputError, match="'walk' has 1 example motion"):
-        learn(one_each, tmp_path / "t", per_class=1, say=lambda _: None)
+        learn(one_each, tmp_path / "t", per_class=1)

@@ -66,7 +66,7 @@ def test_a_cut_off_evaluation_record_is_named(name, text, tmp_path):
     (out / name).write_text(text)
     with initialize_config_dir(config_dir=str(CONFIG_DIR), version_base="1.3"):
         cfg = compose(config_name="reproduce", overrides=[*DATA, f"out={out}"])
-    repro = Reproduction(cfg, say=lambda line: None)
+    repro = Reproduction(cfg)
     with pytest.raises(JsonFileError, match=rf"{out / name}.*evaluation record.*delete {out / 'report'}"):
         repro.evaluation_stage()
     assert (out / name).read_text() == text

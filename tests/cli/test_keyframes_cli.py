@@ -33,7 +33,7 @@ def test_keys_from_a_take_and_a_file_give_a_motion_and_its_files(tmp_path):
     keys = _write(tmp_path / "keys.json", {"keys": [
         {"time": 0.0, "take": TAKE, "frame": 20},
         {"time": 2.0, "motion": "pose.npz", "frame": 0, "turn_deg": 15, "shift_m": [0.1, 0.0, 0.0]}]})
-    summary = keyframes_command(DATA, keys, tmp_path / "out", say=lambda _: None)
+    summary = keyframes_command(DATA, keys, tmp_path / "out")
     with np.load(tmp_path / "out" / "motion.npz", allow_pickle=False) as npz:
         assert npz["positions"].shape == (61, 21, 3) and float(npz["fps"]) == 30.0
         last = npz["positions"][-1]
@@ -47,7 +47,7 @@ def test_keys_from_a_take_and_a_file_give_a_motion_and_its_files(tmp_path):
     hips = np.asarray(take.positions[80, 0], dtype=np.float64)  # the turned, shifted key: Hips moved by shift only
     np.testing.assert_allclose(last[0], hips + [0.1, 0.0, 0.0], atol=1e-5)
     with pytest.raises(OutputExistsError):
-        keyframes_command(DATA, keys, tmp_path / "out", say=lambda _: None)
+        keyframes_command(DATA, keys, tmp_path / "out")
 
 
 def test_every_s_keys_and_bad_key_files_are_named(tmp_path):
@@ -70,7 +70,7 @@ def test_every_s_keys_and_bad_key_files_are_named(tmp_path):
         with pytest.raises(KeyframeError, match=message):
             read_keys(_write(tmp_path / f"bad{i}.json", spec), takeset)
     with pytest.raises(KeyframeError, match="no such file"):
-        keyframes_command(DATA, tmp_path / "missing.json", tmp_path / "o", say=lambda _: None)
+        keyframes_command(DATA, tmp_path / "missing.json", tmp_path / "o")
     assert not (tmp_path / "o").exists()
 
 

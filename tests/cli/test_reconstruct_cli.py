@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import logging
 
 import numpy as np
 import pytest
@@ -20,7 +21,7 @@ TAKE = "synthetic_walk_normal_000"
 
 
 def test_a_take_of_the_synthetic_default_left_out_of_the_database(tmp_path):
-    summary = reconstruct_command(DATA, TAKE, tmp_path / "out", say=lambda _: None)
+    summary = reconstruct_command(DATA, TAKE, tmp_path / "out")
     with np.load(tmp_path / "out" / "motion.npz", allow_pickle=False) as npz:
         assert npz["positions"].shape == (240, 21, 3) and float(npz["fps"]) == 30.0
         assert list(npz["joint_names"]) == list(CANONICAL_JOINTS)
@@ -31,17 +32,18 @@ def test_a_take_of_the_synthetic_default_left_out_of_the_database(tmp_path):
     assert written["error"]["mean_cm"] < written["error_nearest_neighbour"]["mean_cm"]
     assert summary["error"]["mean_cm"] < 2.0 and written["frames_per_s"] > 0
     with pytest.raises(OutputExistsError):
-        reconstruct_command(DATA, TAKE, tmp_path / "out", say=lambda _: None)
+        reconstruct_command(DATA, TAKE, tmp_path / "out")
 
 
-def test_csv_with_a_gap_is_filled_and_said(tmp_path):
+def test_csv_with_a_gap_is_filled_and_said(tmp_path, caplog):
     take = load_dataset("synthetic", takes_per_pair=1).takes[0]
     joints = ["Hand_L", "Hand_R", "Hips"]
     markers = take.positions[:40, [JOINT_INDEX[j] for j in joints]].astype(np.float64)
     markers[10:13, 0] = np.nan
     write_marker_csv(tmp_path / "m.csv", joints, markers, 30)
-    said: list[str] = []
-    summary = reconstruct_command(DATA, str(tmp_path / "m.csv"), tmp_path / "out", say=said.append)
+    with caplog.at_level(logging.INFO, logger="stylemotion"):
+        summary = reconstruct_command(DATA, str(tmp_path / "m.csv"), tmp_path / "out")
+    said = caplog.messages
     assert summary["markers"]["joints"] == joints and "error" not in summary
     assert summary["markers"]["filled_frames"] == {"Hand_L": [10, 11, 12]}
     assert any("Hand_L missing at frames 10-12" in line for line in said)
@@ -52,13 +54,13 @@ def test_csv_with_a_gap_is_filled_and_said(tmp_path):
 
 def test_bad_values_are_named_and_nothing_is_written(tmp_path):
     with pytest.raises(ConfigError, match="features=EP19"):
-        reconstruct_command(DATA, TAKE, tmp_path / "a", features="EP19", say=lambda _: None)
+        reconstruct_command(DATA, TAKE, tmp_path / "a", features="EP19")
     with pytest.raises(MarkerInputError, match="'Knee_L'"):
-        reconstruct_command(DATA, TAKE, tmp_path / "a", joints=["Hips", "Knee_L"], say=lambda _: None)
+        reconstruct_command(DATA, TAKE, tmp_path / "a", joints=["Hips", "Knee_L"])
     with pytest.raises(MarkerInputError, match="no such file"):
-        reconstruct_command(DATA, str(tmp_path / "none.csv"), tmp_path / "a", say=lambda _: None)
+        reconstruct_command(DATA, str(tmp_path / "none.csv"), tmp_path / "a")
     with pytest.raises(ConfigError, match="noise_mm=-1"):
-        reconstruct_command(DATA, TAKE, tmp_path / "a", noise_mm=-1, say=lambda _: None)
+        reconstruct_command(DATA, TAKE, tmp_path / "a", noise_mm=-1)
     assert not (tmp_path / "a").exists()
 
 

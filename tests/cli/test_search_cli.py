@@ -7,6 +7,7 @@ range outside the take, an existing out) is one line naming the value, with noth
 from __future__ import annotations
 
 import json
+import logging
 from pathlib import Path
 
 import numpy as np
@@ -36,10 +37,6 @@ def command(*args: str, cwd: Path, capsys: pytest.CaptureFixture, monkeypatch: p
     """``stylemotion-search args`` in this process (:func:`cli_runner.run_command`)."""
     return run_command("search", *args, f"hydra.run.dir={cwd / 'hydra'}", cwd=cwd, capsys=capsys,
                        monkeypatch=monkeypatch)
-
-
-def quiet(_: str) -> None:
-    pass
 
 
 def test_a_take_query_finds_its_own_frames_first_and_exports_them(tmp_path: Path, capsys, monkeypatch) -> None:
@@ -74,7 +71,7 @@ def test_a_take_query_finds_its_own_frames_first_and_exports_them(tmp_path: Path
 
 
 def test_the_query_take_is_excluded_by_default_and_gifs_are_written(tmp_path: Path) -> None:
-    report = search(SYNTHETIC, f"{TAKE}:30-90", tmp_path / "out", top=3, export_gif=True, export_top=1, say=quiet)
+    report = search(SYNTHETIC, f"{TAKE}:30-90", tmp_path / "out", top=3, export_gif=True, export_top=1)
     assert report["excluded_takes"] == [TAKE] and report["matches"]
     assert all(m["take"] != TAKE for m in report["matches"])
     assert sorted(p.name for p in (tmp_path / "out" / "gif").iterdir()) == sorted(
@@ -102,7 +99,7 @@ def test_the_query_take_is_excluded_by_default_and_gifs_are_written(tmp_path: Pa
 def test_bad_input_is_refused_naming_the_value(overrides: dict, message: str, tmp_path: Path) -> None:
     kwargs = {"data": SYNTHETIC, "query": f"{TAKE}:30-90", "out": tmp_path / "out", **overrides}
     with pytest.raises((SearchInputError, ValueError)) as caught:
-        search(kwargs.pop("data"), kwargs.pop("query"), kwargs.pop("out"), say=quiet, **kwargs)
+        search(kwargs.pop("data"), kwargs.pop("query"), kwargs.pop("out"), **kwargs)
     assert str(caught.value).startswith(message), str(caught.value)
     assert not (tmp_path / "out").exists()
 
@@ -117,13 +114,13 @@ def test_an_unmappable_skeleton_and_an_existing_out_are_one_line(tmp_path: Path,
     assert not (tmp_path / "out").exists()
     (tmp_path / "taken").mkdir()
     with pytest.raises(OutputExistsError, match="already exists; choose another out="):
-        search(SYNTHETIC, TAKE, tmp_path / "taken", say=quiet)
+        search(SYNTHETIC, TAKE, tmp_path / "taken")
 
 
 @pytest.mark.realdata
 def test_a_bvh_query_of_another_skeleton(other_skeleton_paths, tmp_path: Path) -> None:
     bvh = other_skeleton_paths["cmu21_walk"]
-    report = search(SYNTHETIC, f"{bvh}:0-120", tmp_path / "out", top=5, say=quiet)
+    report = search(SYNTHETIC, f"{bvh}:0-120", tmp_path / "out", top=5)
     query = report["query"]
     assert query["kind"] == "bvh" and query["file_fps"] == 60.0 and query["file_range"] == [0, 120]
     assert query["frames"] == 60 and query["fps"] == 30.0 and query["retargeted_to"] == "normal"
@@ -140,20 +137,20 @@ def test_a_bandai_subset(tmp_path: Path, monkeypatch) -> None:
     monkeypatch.delenv("STYLEMOTION_CACHE")  # the converted Bandai takes are cached where every test finds them
     takes = load_dataset("bandai", root=str(root), contents=["walk"], styles=["normal"], workers=1).takes
     query = sorted(takes, key=lambda t: t.name)[0]  # walking in frames 60-90 (takes begin standing: docs/search.md)
-    report = search(data, f"{query.name}:60-90", tmp_path / "out", features="E15x3", top=10, say=quiet)
+    report = search(data, f"{query.name}:60-90", tmp_path / "out", features="E15x3", top=10)
     assert report["database"]["takes"] == len(takes) and report["excluded_takes"] == [query.name]
     matches = report["matches"]
     assert len(matches) == 10 and all(m["take"] != query.name and m["content"] == "walk" for m in matches)
     assert all(0 <= m["start"] < m["end"] for m in matches)
-    again = search(data, f"{query.name}:60-90", tmp_path / "self", top=1, exclude_query_take=False, say=quiet)
+    again = search(data, f"{query.name}:60-90", tmp_path / "self", top=1, exclude_query_take=False)
     assert again["matches"][0] | {"cost": 0} == {"take": query.name, "content": "walk", "style": "normal", "start": 60,
                                                  "end": 90, "cost": 0}
     assert again["matches"][0]["cost"] < 1e-3
 
 
-def test_fewer_matches_than_asked_for_says_that_a_larger_k_finds_more(tmp_path: Path) -> None:
-    lines: list[str] = []
-    report = search(SYNTHETIC, f"{TAKE}:30-90", tmp_path / "out", k=256, top=500, say=lines.append)
+def test_fewer_matches_than_asked_for_says_that_a_larger_k_finds_more(tmp_path: Path, caplog) -> None:
+    with caplog.at_level(logging.INFO, logger="stylemotion"):
+        report = search(SYNTHETIC, f"{TAKE}:30-90", tmp_path / "out", k=256, top=500)
     found = len(report["matches"])
     assert 0 < found < 500
-    assert any(f"{found} of top=500 found" in line and "larger k" in line for line in lines)
+    assert any(f"{found} of top=500 found" in line and "larger k" in line for line in caplog.messages)

@@ -88,6 +88,6 @@ def test_the_config_names_a_missing_key(tmp_path: Path, missing: str, message: s
         cfg = compose(config_name="style", overrides=[f"{k}={v}" for k, v in given.items()]
                       + [f"out={tmp_path / 'out'}"])
     with pytest.raises(ConfigError, match=re.escape(message)):
-        add_style_from_config(cfg, say=lambda _: None)
+        add_style_from_config(cfg)
     assert cfg.method == "cvae" and cfg.samples == 1000 and not (tmp_path / "out").exists()
     assert cfg.network is None and cfg.network_epochs is None

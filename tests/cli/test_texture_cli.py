@@ -19,7 +19,7 @@ TAKE = "synthetic_walk_normal_000"
 
 
 def test_a_take_completed_and_its_files(tmp_path):
-    summary = texture_command(DATA, TAKE, tmp_path / "out", say=lambda _: None)
+    summary = texture_command(DATA, TAKE, tmp_path / "out")
     with np.load(tmp_path / "out" / "motion.npz", allow_pickle=False) as npz:
         assert npz["positions"].shape == (240, 21, 3) and float(npz["fps"]) == 30.0
         assert list(npz["joint_names"]) == list(CANONICAL_JOINTS)
@@ -32,7 +32,7 @@ def test_a_take_completed_and_its_files(tmp_path):
     assert set(written["foot_skating_ratio"]) == {"input", "before_cleanup", "after_cleanup"}
     assert summary["settings"]["mode"] == "complete"
     with pytest.raises(OutputExistsError):
-        texture_command(DATA, TAKE, tmp_path / "out", say=lambda _: None)
+        texture_command(DATA, TAKE, tmp_path / "out")
 
 
 def test_a_legs_only_npz_is_completed(tmp_path):
@@ -41,7 +41,7 @@ def test_a_legs_only_npz_is_completed(tmp_path):
     upper = [i for i, j in enumerate(CANONICAL_JOINTS) if j not in LEG_JOINTS]
     legs[:, upper] = np.nan
     np.savez(tmp_path / "legs.npz", positions=legs, joint_names=np.array(CANONICAL_JOINTS), fps=30.0)
-    summary = texture_command(DATA, str(tmp_path / "legs.npz"), tmp_path / "out", say=lambda _: None)
+    summary = texture_command(DATA, str(tmp_path / "legs.npz"), tmp_path / "out")
     assert "error" not in summary
     with np.load(tmp_path / "out" / "motion.npz") as npz:
         assert np.all(np.isfinite(npz["positions"]))
@@ -51,9 +51,9 @@ def test_a_legs_only_npz_is_completed(tmp_path):
 
 def test_bad_values_are_named_and_nothing_is_written(tmp_path):
     with pytest.raises(TextureInputError, match="mode=blur"):
-        texture_command(DATA, TAKE, tmp_path / "a", mode="blur", say=lambda _: None)
+        texture_command(DATA, TAKE, tmp_path / "a", mode="blur")
     with pytest.raises(TextureInputError, match="'Knee_L'"):
-        texture_command(DATA, TAKE, tmp_path / "a", joints=["Hips", "Knee_L"], say=lambda _: None)
+        texture_command(DATA, TAKE, tmp_path / "a", joints=["Hips", "Knee_L"])
     assert not (tmp_path / "a").exists()
 
 

@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import torch
+from log_lines import logged_lines
 from vae_fixtures import TINY_DATA, tiny_autoencoder_ckpt, tiny_takeset
 
 from stylemotion.config import ConfigError
@@ -79,18 +80,19 @@ def test_extra_rows_need_a_model_of_their_primitive_and_a_free_name(evaluated) -
 
 
 def test_neutral_models_are_fitted_on_the_run_data_and_reused(tmp_path: Path) -> None:
-    lines: list[str] = []
     data = {**TINY_DATA}
-    models = neutral_models(data, [PRIMITIVE], "normal", tmp_path, seed=0, say=lines.append)
+    with logged_lines("stylemotion.morphable.rows") as lines:
+        models = neutral_models(data, [PRIMITIVE], "normal", tmp_path, seed=0)
     model = models[PRIMITIVE]
     assert (tmp_path / PRIMITIVE / "model.npz").is_file() and "fitted on" in lines[-1]
     samples = model.sample(20, seed=0)
     assert isinstance(samples, MotionSamples) and samples.normalized_frames.shape[1] == model.length
-    again = neutral_models(data, [PRIMITIVE], "normal", tmp_path, seed=0, say=lines.append)[PRIMITIVE]
+    with logged_lines("stylemotion.morphable.rows") as lines:
+        again = neutral_models(data, [PRIMITIVE], "normal", tmp_path, seed=0)[PRIMITIVE]
     assert "reused" in lines[-1]
     np.testing.assert_allclose(again.sample(5, seed=1).positions, model.sample(5, seed=1).positions, atol=1e-5)
     with pytest.raises(ConfigError, match="other data or settings"):
-        neutral_models({**data, "takes_per_pair": 5}, [PRIMITIVE], "normal", tmp_path, seed=0, say=lines.append)
+        neutral_models({**data, "takes_per_pair": 5}, [PRIMITIVE], "normal", tmp_path, seed=0)
 
 
 @pytest.mark.slow

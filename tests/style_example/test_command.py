@@ -128,7 +128,7 @@ def _refused(tmp_path: Path, error: type[Exception], message: str, **kwargs) -> 
     out = tmp_path / "style"
     with pytest.raises(error, match=message):
         add_style(kwargs.pop("example"), kwargs.pop("run"), kwargs.pop("name", "mine"), out, samples=10,
-                  say=lambda _: None, **kwargs)
+                  **kwargs)
     assert not out.exists() and not [p for p in tmp_path.iterdir() if p.name.startswith(".style")]
 
 
@@ -173,7 +173,7 @@ def test_an_unknown_method_is_refused(run, tmp_path: Path) -> None:
 def test_bad_numbers_are_refused_naming_the_key(run, tmp_path: Path, key: str, value, message: str) -> None:
     out = tmp_path / "style"
     with pytest.raises(ConfigError, match=message):
-        add_style(str(example_bvh(tmp_path)), run, "mine", out, say=lambda _: None, **{key: value})
+        add_style(str(example_bvh(tmp_path)), run, "mine", out, **{key: value})
     assert not out.exists()
 
 
@@ -182,7 +182,7 @@ def test_an_existing_out_is_refused_and_kept(run, tmp_path: Path) -> None:
     out.mkdir()
     (out / "mine.txt").write_text("kept")
     with pytest.raises(OutputExistsError, match="already exists"):
-        add_style(str(example_bvh(tmp_path)), run, "mine", out, say=lambda _: None)
+        add_style(str(example_bvh(tmp_path)), run, "mine", out)
     assert [p.name for p in out.iterdir()] == ["mine.txt"]
 
 

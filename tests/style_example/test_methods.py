@@ -21,7 +21,7 @@ def test_a_method_without_keys_takes_one_step_per_primitive_and_records_nothing_
     assert method.steps(["walk_leftStance", "walk_rightStance"], {}) == 2 and method.steps([], {}) == 0
     assert method.report({}, tmp_path, {}) == {} and method.entry("walk_leftStance", []) == {}
     with pytest.raises(NotImplementedError):
-        method.make(None, "mine", None, None, tmp_path, print, print, 1, {})
+        method.make(None, "mine", None, None, tmp_path, print, 1, {})
     with pytest.raises(NotImplementedError):
         method.load(tmp_path / "x.ckpt", "walk_leftStance", [], [], "mine", "normal", None)
 

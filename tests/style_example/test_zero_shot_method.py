@@ -13,6 +13,7 @@ from pathlib import Path
 import pytest
 import torch
 import yaml
+from log_lines import logged_lines
 from style_fixtures import NETWORK_EPOCHS, SAMPLES, example_bvh, tiny_zero_shot_style
 
 from stylemotion.config import ConfigError
@@ -46,9 +47,9 @@ def reused(zero_shot, run) -> tuple[Path, dict, dict[str, int]]:
     networks = zero_shot[0] / "network"
     before = {str(p): p.stat().st_mtime_ns for p in networks.rglob("*") if p.is_file()}
     out = zero_shot[0].parent / "weary_again"
-    lines: list[str] = []
-    results = add_style(str(example_bvh(zero_shot[0].parent)), run, "weary", out, method="zero_shot",
-                        network=str(networks), samples=SAMPLES, say=lines.append)
+    with logged_lines("stylemotion.style_example") as lines:
+        results = add_style(str(example_bvh(zero_shot[0].parent)), run, "weary", out, method="zero_shot",
+                            network=str(networks), samples=SAMPLES)
     return out, {"results": results, "lines": lines}, before
 
 
@@ -125,7 +126,7 @@ def test_a_second_style_with_the_first_network_trains_nothing_and_gives_the_same
 def _refused(tmp_path: Path, error: type[Exception], message: str, run: Path, **kwargs) -> None:
     out = tmp_path / "style"
     with pytest.raises(error, match=message):
-        add_style(str(example_bvh(tmp_path)), run, "mine", out, samples=10, say=lambda _: None, **kwargs)
+        add_style(str(example_bvh(tmp_path)), run, "mine", out, samples=10, **kwargs)
     assert not out.exists() and not [p for p in tmp_path.iterdir() if p.name.startswith(".style")]
 
 
