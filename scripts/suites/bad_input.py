@@ -660,11 +660,11 @@ def build_cases(p: Inputs) -> list[Case]:
     add(gn, "force_out_link_to_decoy", [run, *quick, "out=linked", "force=true"], "refused", "out folder links out",
         ("linked",), setup=_link("linked", p.decoy), out=())
     add(gn, "short_path", [run, *quick, f"path.file={i('path_short.json')}", "out=out"], "either", "short walk",
-        ("path_short.json",), timeout=240)
+        ("path_short.json", "the path"), timeout=240)
     add(gn, "good", [run, *quick, f"path.file={i('path_good.json')}", "out=out"], "answered", "valid input",
         timeout=240)
     add(gn, "interrupt", [run, *quick, "out=out"], "interrupt", "Ctrl-C mid-run", trigger="hydra",
-        interrupt_after=6.0, timeout=240)
+        interrupt_after=2.0, timeout=240)
 
     # --- stylemotion-segment ------------------------------------------------------------------------------------
     sg = "stylemotion-segment"
@@ -983,6 +983,8 @@ def classify(case: Case | Mapping[str, Any], result: Mapping[str, Any]) -> tuple
     if result.get("leftover"):
         return "silent-wrong", "left half-written: " + ", ".join(result["leftover"][:3])
     if expect == "interrupt":
+        if result.get("finished_before_signal"):
+            return "correct", "finished before Ctrl-C could stop it"
         if rc == 0 and not result.get("signalled"):
             return ("silent-wrong", result["problem"]) if result.get("problem") else (
                 "correct", "finished before Ctrl-C could be sent")
@@ -1037,6 +1039,7 @@ def run_case(case: Case, root: Path, cache: Path, logs: Path) -> dict[str, Any]:
         proc = subprocess.Popen(case.argv(), cwd=folder, stdin=subprocess.DEVNULL, stdout=out, stderr=err, env=env,
                                 start_new_session=True, preexec_fn=limits)
     timed_out = signalled = False
+    signalled_at = 0.0
     trigger_seen: float | None = None if case.trigger else start
     status, usage = None, None
     while status is None:
@@ -1050,7 +1053,7 @@ def run_case(case: Case, root: Path, cache: Path, logs: Path) -> dict[str, Any]:
                 trigger_seen = now
             if trigger_seen is not None and now - trigger_seen >= case.interrupt_after:
                 _signal_group(proc.pid, signal.SIGINT)
-                signalled = True
+                signalled, signalled_at = True, time.time()
         if now - start > case.timeout:
             timed_out = True
             _signal_group(proc.pid, signal.SIGKILL)
@@ -1072,13 +1075,17 @@ def run_case(case: Case, root: Path, cache: Path, logs: Path) -> dict[str, Any]:
         problem = check_outputs(folder, case.out)
         if problem is None and case.check is not None:
             problem = case.check(folder)
+    finished_first = False
     if case.expect == "interrupt" and proc.returncode != 0 and case.command not in RESUMABLE:
-        half = [o for o in case.out if o not in ("hydra", "cache") and (folder / o).exists()]
-        if half:
-            problem = f"left {', '.join(half)} after Ctrl-C"
+        left = [o for o in case.out if o not in ("hydra", "cache") and (folder / o).exists()]
+        late = [o for o in left if _newest_mtime(folder / o) >= signalled_at]
+        if late:
+            problem = f"left {', '.join(late)} after Ctrl-C"
+        finished_first = bool(left) and not late  # complete before the signal came
+    result_extra = {"finished_before_signal": finished_first}
     result = {"returncode": proc.returncode, "stderr": stderr, "stdout": stdout[-2000:], "timed_out": timed_out,
               "timeout": case.timeout, "peak_rss_kb": usage.ru_maxrss if usage else None, "signalled": signalled,
-              "problem": problem, **sorted_}
+              "problem": problem, **sorted_, **result_extra}
     outcome, note = classify(case, result)
     return {"id": case.id, "command": case.command,
             "argv": shlex.join(a.replace(str(root), "$ROOT") for a in case.argv()),
@@ -1087,6 +1094,13 @@ def run_case(case: Case, root: Path, cache: Path, logs: Path) -> dict[str, Any]:
                 str(root), "$ROOT"),
             "seconds": round(seconds, 2), "peak_rss_mb": round((usage.ru_maxrss if usage else 0) / 1024, 1),
             "changed_outside": sorted_["outside"][:10], "changed_earlier": sorted_["earlier"][:10]}
+
+
+def _newest_mtime(path: Path) -> float:
+    """The latest modification time (s since the epoch) of ``path`` or any file below it."""
+    times = [path.lstat().st_mtime] + [p.lstat().st_mtime for p in path.rglob("*")] if path.is_dir() else [
+        path.lstat().st_mtime]
+    return max(times)
 
 
 def _signal_group(pid: int, sig: int) -> None:

@@ -62,6 +62,7 @@ def _result(rc: int = 2, stderr: str = "", **extra):
     ("interrupt", _result(130, f"{CMD}: interrupted\n", signalled=True, problem="left out after Ctrl-C"),
      "silent-wrong"),
     ("interrupt", _result(0, ""), "correct"),  # finished before the signal was sent
+    ("interrupt", _result(1, "", signalled=True, finished_before_signal=True), "correct"),  # outputs older than it
 ])
 def test_outcomes(suite, expect, result, outcome):
     assert suite.classify(_case(expect), result)[0] == outcome
