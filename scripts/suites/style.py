@@ -20,7 +20,7 @@ from multiprocessing import get_context
 from pathlib import Path
 from typing import Any
 
-from suites.common import DATA_ROOT, fmt, fmt_range, fmt_spread, md_table, provenance_line, spread
+from suites.common import DATA_ROOT, fmt, fmt_range, fmt_spread, md_table, progress_printed, provenance_line, spread
 
 DESCRIPTION = "style VAEs/CVAEs (Du ch. 5): Table 5.1 diagonal, recognition and variation over seeds"
 DEFAULT_SEEDS = (0, 1, 2)
@@ -119,7 +119,8 @@ def reproduce_seed(data: str, seed: int, out: Path, workers: int, primitives: li
 
     cfg = compose_reproduce(reproduce_overrides(data, seed, out, workers, primitives, styles, alpha))
     try:
-        reproduce(cfg, say=lambda line: print(f"[seed {seed}] {line}", flush=True))
+        with progress_printed(f"[seed {seed}]"):
+            reproduce(cfg)
     finally:
         GlobalHydra.instance().clear()
     return read_json_object(out / "report" / "report.json", "the reproduction's report", "rerun the suite")
@@ -285,6 +286,22 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
             "primitives": primitives, "summary": summary, "overall": overall, "per_seed": per_seed}
 
 
+def alpha_blocks(choice: dict[str, Any], prov: str) -> dict[str, str]:
+    """The ``alpha`` block: every candidate's validation figures per style, its score and the choice."""
+    names = sorted({n for per in choice["values"].values() for n in per})
+    rows = [[f"**{a}**" if float(a) == choice["chosen"] else a,
+             *(f"{fmt(v[n]['val/style'], 4)} / {fmt(v[n]['val/mpjpe'], 4)}" if n in v else "failed" for n in names),
+             fmt(choice["scores"][a], 3)]
+            for a, v in choice["values"].items()]
+    return {"alpha": (f"Style weight α chosen on **validation** clips before any figure was reported with it: CVAEs "
+                      f"of {', '.join(names)} trained with seed {choice['seed']} (not a reported seed) on the "
+                      f"autoencoder of seed {choice['autoencoder_of_seed']}'s run; each cell is val/style (Gram "
+                      f"distance to the example) / val/mpjpe (m, reconstruction of held-out neutral clips) at the best "
+                      f"val/loss epoch. Rule (fixed before the run): {choice['rule']}. Chosen: α = "
+                      f"{choice['chosen']:g}.\n\n"
+                      + md_table(["α", *names, "score (lower is better)"], rows) + f"\n\n{prov}")}
+
+
 def render(record: dict[str, Any]) -> dict[str, str]:
     r = record["results"]
     seeds = len(record.get("seeds", []))
@@ -322,20 +339,8 @@ def render(record: dict[str, Any]) -> dict[str, str]:
                 + prov)
 
     blocks = {"headline": headline}
-    choice = r.get("alpha_choice")
-    if choice:
-        names = sorted({n for per in choice["values"].values() for n in per})
-        alpha_rows = [[f"**{a}**" if float(a) == choice["chosen"] else a,
-                       *(f"{fmt(v[n]['val/style'], 4)} / {fmt(v[n]['val/mpjpe'], 4)}" if n in v else "failed"
-                         for n in names), fmt(choice["scores"][a], 3)]
-                      for a, v in choice["values"].items()]
-        blocks["alpha"] = (f"Style weight α chosen on **validation** clips before the seeds above were run: CVAEs of "
-                           f"{', '.join(names)} trained with seed {choice['seed']} (not a reported seed) on the "
-                           f"autoencoder of seed {choice['autoencoder_of_seed']}'s run; each cell is val/style (Gram "
-                           f"distance to the example) / val/mpjpe (m, reconstruction of held-out neutral clips) at "
-                           f"the best val/loss epoch. Rule (fixed before the run): {choice['rule']}. "
-                           f"Chosen: α = {choice['chosen']:g}.\n\n"
-                           + md_table(["α", *names, "score (lower is better)"], alpha_rows) + f"\n\n{prov}")
+    if r.get("alpha_choice"):
+        blocks |= alpha_blocks(r["alpha_choice"], prov)
     recog_rows, ratio_rows, vs_rows = [], [], []
     for p in r["primitives"]:
         s = r["summary"][p]
