@@ -118,6 +118,12 @@ def test_leave_one_style_out_without_leakage_against_a_hand_computed_reference(r
                           cvae.target_gram, length)
     assert row["real"]["recognition"] == share and row["real"]["clips"] == len(truth)
     assert row["real"]["table_5_1_row"][STYLE] == pytest.approx(own, rel=1e-5)
+    with torch.no_grad():  # the same clips through the generator's autoencoder: what its features keep of the style
+        rebuilt = load_autoencoder(ae_ckpt)(frames.float())
+    share, own = hand_row(source, judge, clips_of, rebuilt, torch.tensor([c.duration_s for c in truth]), STYLE,
+                          cvae.target_gram, length)
+    assert row["reconstructed"]["recognition"] == share
+    assert row["reconstructed"]["table_5_1_row"][STYLE] == pytest.approx(own, rel=1e-5)
     assert json.loads((out / "zero_shot.json").read_text())["splits"] == results["splits"]
     assert "LEAKY" not in (out / "zero_shot.md").read_text()
     # resumed: both trainings reused, the same figures
@@ -146,7 +152,7 @@ def _evaluate(source, network, shared: bool = False) -> dict:
 
 def figures(row: dict) -> dict:
     return {kind: {k: row[kind][k] for k in ("recognition", "table_5_1_row", "pose_across_sd")}
-            for kind in ("zero_shot", "cvae", "real")}
+            for kind in ("zero_shot", "cvae", "real", "reconstructed")}
 
 
 @pytest.mark.slow  # one network trained (shared with the next test), three evaluations: ~15 s

@@ -33,7 +33,13 @@ DEFAULT_SEEDS = (0, 1, 2)
 ROOT = Path(__file__).resolve().parents[2]
 #: The rows of each left-out style, and their names in the tables.
 ROWS = {"zero_shot": "zero-shot network (never saw the style)", "cvae": "CVAE of the style (trained on its example)",
-        "real": "real clips of the style"}
+        "real": "real clips of the style",
+        "reconstructed": "real clips through the generator's autoencoder (what its features keep of the style)"}
+#: Column names of the rows.
+SHORT = {"zero_shot": "zero-shot", "cvae": "CVAE", "real": "real clips", "reconstructed": "real through generator AE",
+         "zero_shot_leaky": "LEAKY zero-shot"}
+#: The row ``--leaky`` adds: the earlier protocol's network, on the judge's autoencoder.
+LEAKY_ROW = {"zero_shot_leaky": "LEAKY: zero-shot network on the judge's autoencoder (which saw the style)"}
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -54,6 +60,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "stopped); the autoencoders train as the judge run's autoencoder stage")
     parser.add_argument("--samples", type=int, default=1000, help="samples per model and seed")
     parser.add_argument("--workers", type=int, default=2, help="training stages at once of the judge reproduction")
+    parser.add_argument("--leaky", action="store_true",
+                        help="also the earlier, leaky protocol per seed (networks on the judge's autoencoder, which "
+                             "saw the style), as a labelled row: what the leakage changes")
 
 
 def judge_run(args: argparse.Namespace) -> Path:
@@ -106,9 +115,19 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
         with progress_printed(f"[seed {seed}]"):
             result = leave_one_style_out(judge, out, args.styles, args.primitives, args.epochs, args.samples, seed,
                                          threads=1, resume=True)
+        if getattr(args, "leaky", False):
+            with progress_printed(f"[seed {seed}, leaky]"):
+                leaky = leave_one_style_out(judge, base / f"seed{seed}_leaky", args.styles, args.primitives,
+                                            args.epochs, args.samples, seed, threads=1, resume=True,
+                                            shared_autoencoder=True)
+            for p, res in leaky["primitives"].items():
+                for s, row in res["styles"].items():
+                    result["primitives"][p]["styles"][s]["zero_shot_leaky"] = row["zero_shot"]
+            result["summary"]["zero_shot_leaky"] = leaky["summary"]["zero_shot"]
         per_seed[str(seed)] = {"out": relative(out), "primitives": result["primitives"], "summary": result["summary"],
                                "seconds": result["meta"]["seconds"]}
     first = next(iter(per_seed.values()))
+    kinds = [k for k in {**ROWS, **LEAKY_ROW} if k in first["summary"]]
     left_out = [(p, s) for p, res in first["primitives"].items() for s in res["styles"]]
     per_style: dict[str, dict[str, Any]] = {}
     for p, s in left_out:
@@ -118,7 +137,7 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
                    "own_column_is_minimum": sum(bool(r[kind]["own_column_is_minimum"]) for r in rows),
                    "nearest_columns": [r[kind]["nearest_column"] for r in rows],
                    "spread_vs_real": spread(r[kind]["pose_across_sd"] / r["real"]["pose_across_sd"] for r in rows)}
-            for kind in ROWS}
+            for kind in kinds}
         per_style[p][s]["seeds"] = len(rows)
         per_style[p][s]["train_minutes"] = [
             round(((r["zero_shot"].get("train_seconds") or 0) + (r["generator_autoencoder"].get("train_seconds") or 0))
@@ -126,7 +145,7 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
     headline = {kind: {"mean_recognition": spread(v["summary"][kind]["mean_recognition"] for v in per_seed.values()),
                        "own_column_is_minimum": spread(v["summary"][kind]["own_column_is_minimum"]
                                                        for v in per_seed.values()),
-                       "rows": first["summary"][kind]["rows"]} for kind in ROWS}
+                       "rows": first["summary"][kind]["rows"]} for kind in kinds}
     classifier = {p: res["classifier"] for p, res in first["primitives"].items()}
     splits = read_splits(per_seed, base, seeds)
     return {"data": args.data, "judge": {"run": relative(judge), "seed": source.seed,
@@ -134,6 +153,7 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
                                          "cvae_styles": {p: source.styles(p) for p in source.primitives}},
             "subsample": {"primitives": args.primitives, "styles": args.styles,
                           "how": None if not (args.primitives or args.styles) else "narrowed on the command line"},
+            "kinds": kinds,
             "epochs": args.epochs, "samples": args.samples, "left_out": [f"{p}/{s}" for p, s in left_out],
             "splits": {**splits, "seed_varies": "the autoencoders and networks without each style (initialization, "
                                                 "batches) and every model's samples; the judge run, its CVAEs and its "
@@ -178,8 +198,11 @@ def render(record: dict[str, Any]) -> dict[str, str]:
                 f"run's CVAE of the style (trained on its example: supervised); real: the style's clips but its "
                 f"example. {r['samples']:,} samples per model and seed"
                 + (f"; networks trained {r['epochs']} epochs" if r.get("epochs") else "") + ".")
+    names = {**ROWS, **LEAKY_ROW}
+    kinds = r.get("kinds") or list(ROWS)
     rows = []
-    for kind, name in ROWS.items():
+    for kind in kinds:
+        name = names[kind]
         h = r["headline"][kind]
         rows.append([name, f"{fmt_spread(h['mean_recognition'], 3)} ({fmt_range(h['mean_recognition'], 3)})",
                      f"{fmt_spread(h['own_column_is_minimum'], 2)} ({fmt_range(h['own_column_is_minimum'], 0)}) "
@@ -196,22 +219,22 @@ def render(record: dict[str, Any]) -> dict[str, str]:
     for p, styles in r["per_style"].items():
         for s, v in styles.items():
             style_rows.append([p, s, *(f"{fmt_spread(v[k]['recognition'], 3)} ({fmt_range(v[k]['recognition'], 3)})"
-                                       for k in ROWS),
-                               *(f"{v[k]['own_column_is_minimum']}/{v['seeds']}" for k in ROWS),
+                                       for k in kinds),
+                               *(f"{v[k]['own_column_is_minimum']}/{v['seeds']}" for k in kinds),
                                *(f"{fmt_spread(v[k]['spread_vs_real'], 2)}" for k in ("zero_shot", "cvae"))])
     per_style = (f"{label}Per left-out style ({r['data']}, {seeds} seeds): recognition of the style, mean ± sd "
                  f"(min–max) over seeds; seeds whose Table 5.1 row has the style's own example as its minimum; the "
                  f"samples' spread across samples (pose_across_SD) relative to the style's real clips.\n\n"
-                 + md_table(["primitive", "left-out style", "zero-shot recognition", "CVAE recognition",
-                             "real clips recognition", "zero-shot own column", "CVAE own column", "real own column",
-                             "zero-shot spread / real", "CVAE spread / real"], style_rows)
+                 + md_table(["primitive", "left-out style", *(f"{SHORT[k]} recognition" for k in kinds),
+                             *(f"{SHORT[k]} own column" for k in kinds), "zero-shot spread / real",
+                             "CVAE spread / real"], style_rows)
                  + f"\n\n{protocol} {prov}")
-    seed_rows = [[k, *(fmt(v["summary"][kind]["mean_recognition"], 3) for kind in ROWS),
-                  *(f"{v['summary'][kind]['own_column_is_minimum']}/{v['summary'][kind]['rows']}" for kind in ROWS),
+    seed_rows = [[k, *(fmt(v["summary"][kind]["mean_recognition"], 3) for kind in kinds),
+                  *(f"{v['summary'][kind]['own_column_is_minimum']}/{v['summary'][kind]['rows']}" for kind in kinds),
                   v["out"]] for k, v in r["per_seed"].items()]
     minutes = [m for styles in r["per_style"].values() for v in styles.values() for m in v["train_minutes"] if m]
-    per_seed = (md_table(["seed", "zero-shot recognition", "CVAE recognition", "real recognition",
-                          "zero-shot own column", "CVAE own column", "real own column", "trainings"], seed_rows)
+    per_seed = (md_table(["seed", *(f"{SHORT[k]} recognition" for k in kinds),
+                          *(f"{SHORT[k]} own column" for k in kinds), "trainings"], seed_rows)
                 + f"\n\nTrainings (autoencoder + network per left-out style) took "
                   f"{fmt(min(minutes), 1) if minutes else '—'}–{fmt(max(minutes), 1) if minutes else '—'} min each "
                   f"when this command trained them (reused ones count 0; a loaded machine: no timing figure). {prov}")

@@ -32,12 +32,12 @@ def planted(seed: int) -> dict:
                 "table_5_1_row": {}}
 
     styles = {s: {"zero_shot": {**row(SHARES[seed][s], OWN[seed][s], 1.0), "train_seconds": 60.0},
-                  "cvae": row(1.0, True, 0.5), "real": row(0.8, True, 2.0),
+                  "cvae": row(1.0, True, 0.5), "real": row(0.8, True, 2.0), "reconstructed": row(0.5, False, 1.5),
                   "generator_autoencoder": {"train_seconds": 120.0}} for s in ("feminine", "youthful")}
     primitives = {"walk_leftStance": {"styles": styles, "classifier": {"heldout_accuracy": 0.9, "chance": 0.25}}}
     summary = {kind: {"mean_recognition": sum(st[kind]["recognition"] for st in styles.values()) / 2,
                       "own_column_is_minimum": sum(st[kind]["own_column_is_minimum"] for st in styles.values()),
-                      "rows": 2} for kind in ("zero_shot", "cvae", "real")}
+                      "rows": 2} for kind in ("zero_shot", "cvae", "real", "reconstructed")}
     return {"primitives": primitives, "summary": summary, "meta": {"seconds": 1.0},
             "splits": {"data": {"kind": "by take", "seed": 0, "val_fraction": 0.1, "test_fraction": 0.1}}}
 
@@ -52,6 +52,10 @@ def suite(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> list[dict]:
         calls.append({"out": Path(out), "seed": seed, "styles": styles, "epochs": epochs, **kwargs})
         Path(out).mkdir(parents=True, exist_ok=True)
         result = planted(seed)
+        if kwargs.get("shared_autoencoder"):  # the leaky protocol: every network recognized
+            for row in result["primitives"]["walk_leftStance"]["styles"].values():
+                row["zero_shot"]["recognition"] = 1.0
+            result["summary"]["zero_shot"]["mean_recognition"] = 1.0
         (Path(out) / "zero_shot.json").write_text(json.dumps(result))
         return result
 
@@ -63,13 +67,15 @@ def suite(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> list[dict]:
 def args(tmp_path: Path, **changes) -> argparse.Namespace:
     values = {"data": "synthetic", "run": tmp_path / "judge", "judge_seed": 0, "runs": tmp_path / "runs",
               "styles": ["feminine", "youthful"], "primitives": ["walk_leftStance"], "epochs": 30, "samples": 100,
-              "workers": 1}
+              "workers": 1, "leaky": False}
     return argparse.Namespace(**{**values, **changes})
 
 
 def test_spreads_and_counts_are_over_seeds(suite, tmp_path: Path) -> None:
     results = zero_shot.run(args(tmp_path), [0, 1, 2])
     assert [c["seed"] for c in suite] == [0, 1, 2] and all(c["resume"] and c["epochs"] == 30 for c in suite)
+    assert not any(c.get("shared_autoencoder") for c in suite) and results["kinds"] == [
+        "zero_shot", "cvae", "real", "reconstructed"]
     assert len({c["out"].parent for c in suite}) == 1 and suite[0]["out"].name == "seed0"
     feminine = results["per_style"]["walk_leftStance"]["feminine"]["zero_shot"]
     assert feminine["recognition"]["mean"] == pytest.approx(0.5) and feminine["recognition"]["sd"] == pytest.approx(
@@ -92,3 +98,16 @@ def test_spreads_and_counts_are_over_seeds(suite, tmp_path: Path) -> None:
 def test_a_judge_of_other_data_is_refused(suite, tmp_path: Path) -> None:
     with pytest.raises(library.ZeroShotRunError, match="holds 'synthetic' data, not --data bandai"):
         zero_shot.run(args(tmp_path, data="bandai"), [0])
+
+
+def test_the_leaky_protocol_is_a_labelled_row_of_its_own_folder(suite, tmp_path: Path) -> None:
+    results = zero_shot.run(args(tmp_path, leaky=True), [0, 1])
+    leaky = [c for c in suite if c.get("shared_autoencoder")]
+    assert [c["seed"] for c in leaky] == [0, 1] and leaky[0]["out"].name == "seed0_leaky"
+    row = results["per_style"]["walk_leftStance"]["feminine"]
+    assert row["zero_shot_leaky"]["recognition"]["mean"] == 1.0
+    assert row["zero_shot"]["recognition"]["mean"] == pytest.approx(0.3)
+    assert results["headline"]["zero_shot_leaky"]["mean_recognition"]["mean"] == 1.0
+    record = {"results": results, "seeds": [0, 1], "command": "c", "commit": "x", "started": "2026-01-01",
+              "machine": {}, "seconds": 0}
+    assert "LEAKY: zero-shot network on the judge's autoencoder" in zero_shot.render(record)["headline"]
