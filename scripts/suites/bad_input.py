@@ -754,7 +754,8 @@ def build_cases(p: Inputs) -> list[Case]:
                  "keys_positions_wrong_shape", "keys_positions_nan", "keys_every_zero", "keys_cut", "keys_turn_huge"):
         # key times are relative: a first key at -5 s is an offset, not an error
         add(kf, f"file_{name}", [*DATA, f"keys={i(name + '.json')}", "out=out", "gif=false"],
-            "either" if name == "keys_time_negative" else "refused", "keys file", (f"{name}.json",))
+            "either" if name == "keys_time_negative" else "refused", "keys file",
+            (f"{name}.json", *(("every_s",) if "every" in name else ())))
     add(kf, "keys_missing", [*DATA, "keys=/nonexistent/keys.json", "out=out"], "refused", "keys file",
         ("keys.json",))
     add(kf, "keys_fifo", [*DATA, f"keys={i('fifo.bvh')}", "out=out"], "refused", "FIFO", ("fifo.bvh",))
