@@ -128,6 +128,10 @@ def annotate(document: str, templates: str | os.PathLike, out: str | os.PathLike
     out = check_new_output(out, force)
     if not (isinstance(settings.tau, (int, float)) and settings.tau > 0):
         raise AnnotateInputError(f"tau={settings.tau} must be a positive number (the thesis used 0.13)")
+    tolerance = settings.keyframe_tolerance
+    if not (isinstance(tolerance, (int, float)) and 0 <= tolerance <= 1):
+        raise AnnotateInputError(f"keyframes.tolerance={tolerance} must be a fraction in [0, 1] (of a key frame's "
+                                 "features a matching frame may contradict)")
     try:
         model = load_model(templates)
     except ModelFolderError as exc:

@@ -85,6 +85,10 @@ def _number(entry: Mapping[str, Any], key: str, where: str, default: float | Non
     return float(value)
 
 
+#: Farthest a key's joint may lie from the origin (m): far beyond any capture volume, well within float range.
+MAX_KEY_DISTANCE_M = 1e5
+
+
 def _turned(pose: np.ndarray, entry: Mapping[str, Any], where: str) -> np.ndarray:
     """The pose turned by ``turn_deg`` about its Hips' vertical and moved by ``shift_m``."""
     turn = np.deg2rad(_number(entry, "turn_deg", where, 0.0))
@@ -94,7 +98,13 @@ def _turned(pose: np.ndarray, entry: Mapping[str, Any], where: str) -> np.ndarra
     from stylemotion.geometry import rotate_yaw
 
     hips = pose[JOINT_INDEX["Hips"]] * np.array([1.0, 0.0, 1.0])
-    return rotate_yaw(pose - hips, turn) + hips + shift
+    with np.errstate(over="ignore", invalid="ignore"):
+        moved = rotate_yaw(pose - hips, turn) + hips + shift
+    if not np.isfinite(moved).all() or np.abs(moved).max() > MAX_KEY_DISTANCE_M:
+        raise KeyframeError(f"{where}: turn_deg={entry.get('turn_deg', 0.0)!r}, shift_m={entry.get('shift_m')!r} "
+                            f"put the pose more than {MAX_KEY_DISTANCE_M:g} m from the origin; give a shift of "
+                            "metres in the motion's space")
+    return moved
 
 
 def read_keys(path: str | os.PathLike, takeset: TakeSet,
@@ -119,8 +129,11 @@ def read_keys(path: str | os.PathLike, takeset: TakeSet,
         positions, take = _motion_positions(str(spec.get("motion", "")), where, takes, path.parent, takeset.fps,
                                             conversion)
         end = spec.get("end_s")
-        keys = keys_from_motion(positions, takeset.fps, _number(spec, "every_s", where),
-                                _number(spec, "start_s", where, 0.0), None if end is None else float(end))
+        try:
+            keys = keys_from_motion(positions, takeset.fps, _number(spec, "every_s", where),
+                                    _number(spec, "start_s", where, 0.0), None if end is None else float(end))
+        except KeyframeError as exc:  # named after the file the value came from
+            raise KeyframeError(f"{where}: {exc}") from None
         described = [{"time_s": k.time_s, "motion": spec["motion"],
                       "frame": int(round((_number(spec, "start_s", where, 0.0) + k.time_s) * takeset.fps))}
                      for k in keys]

@@ -57,7 +57,7 @@ from omegaconf import DictConfig, OmegaConf, open_dict
 
 from stylemotion.config import ConfigError, positive_int, set_torch_threads  # also registers the configs' resolvers
 from stylemotion.datasets import build_dataset, data_config_key
-from stylemotion.evaluation.run import recorded_path, run_evaluation, summary_lines
+from stylemotion.evaluation.run import recorded_path, run_evaluation, settings_from_config, summary_lines
 from stylemotion.io.errors import OutputWriteError, UserInputError
 from stylemotion.io.jsonfile import JsonFileError, read_json_object, write_json
 from stylemotion.io.outputs import check_new_output, inside, safe_name
@@ -514,6 +514,8 @@ def reproduce(cfg: DictConfig) -> dict[str, Any]:
     """
     set_torch_threads(cfg.get("threads"), "threads")  # the evaluation's too, so reruns compute alike
     workers = positive_int(cfg.get("workers", 1), "workers")
+    # a bad evaluation value is named now, not after hours of training
+    settings_from_config(cfg.get("evaluation") or {}, int(cfg.get("seed") or 0))
     engine = executor_engine(cfg)
     log.info(choose_budget(cfg))
     check_out_folder(cfg.out)

@@ -63,3 +63,13 @@ def test_missing_templates_and_small_classes(tmp_path):
     one_each = {**SYNTHETIC, "contents": ["walk"], "styles": ["normal"]}
     with pytest.raises(AnnotateInputError, match="'walk' has 1 example motion"):
         learn(one_each, tmp_path / "t", per_class=1)
+
+
+def test_a_keyframe_tolerance_outside_zero_to_one_is_refused(tmp_path):
+    from stylemotion.annotate.annotation import AnnotationSettings
+    from stylemotion.annotate.command import AnnotateInputError, annotate
+
+    with pytest.raises(AnnotateInputError, match=r"keyframes.tolerance=5 must be a fraction in \[0, 1\]"):
+        annotate("walk.bvh", tmp_path / "templates", tmp_path / "out",
+                 settings=AnnotationSettings(keyframes=True, keyframe_tolerance=5))
+    assert not (tmp_path / "out").exists()

@@ -37,3 +37,15 @@ def test_the_command_refuses_the_huge_time_in_one_line(tmp_path, capsys, monkeyp
     assert lines[-1].startswith("stylemotion-keyframes: ") and "200000 s" in lines[-1] and str(keys) in lines[-1]
     assert "Traceback" not in done.stderr
     assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize("spec, message", [
+    ({"motion": TAKE, "every_s": 0}, "every_s=0.0 must be at least one frame"),
+    ({"keys": [{"time": 0, "take": TAKE, "frame": 0},
+               {"time": 1, "take": TAKE, "frame": 30, "shift_m": [1e308, 0, 0]}]}, "more than 100000 m from"),
+])
+def test_keys_whose_values_go_out_of_range_name_the_file(tmp_path, spec, message):
+    keys = tmp_path / "keys.json"
+    keys.write_text(json.dumps(spec))
+    with pytest.raises(KeyframeError, match=f"keys={re.escape(str(keys))}.*{message}"):
+        read_keys(keys, load_dataset("synthetic", takes_per_pair=1))

@@ -20,6 +20,7 @@ DATA = ["data.takes_per_pair=2", "data.duration_s=3.0", "data.styles=[normal,eld
     (["primitives=[nope]"], "primitives: unknown motion primitive 'nope'"),
     (["primitives=[run_leftStance]"], "primitives: ['run_leftStance'] have no clips in dataset 'synthetic'"),
     (["evaluation.neutral_style=nope"], "evaluation.neutral_style: the neutral style 'nope' is not in dataset"),
+    (["evaluation.samples.table_5_1=0"], "evaluation.samples.table_5_1 must be at least 2"),  # not after training
 ])
 def test_unknown_styles_and_primitives_end_in_one_line_before_training(overrides, message, tmp_path, capsys,
                                                                        monkeypatch):
