@@ -9,8 +9,9 @@ For one primitive and constraints ``c``, eq. 4.9 minimizes ``O(s, c) − ln p(s)
 * the prior: ``√λ · L_k⁻¹ (s − μ_k)`` for the mixture component ``k`` holding the tree's candidate, i.e.
   ``−ln p(s)`` up to a constant where that component dominates (the exact ``−ln p(s)`` is reported).
 
-The start is the tree's best code, never a random draw: its branch-and-bound search over keyframe boxes
-for constraints at the primitive's first or last frame, its beam search otherwise (:func:`.bounds.best_code`).
+For keyframe constraints (:func:`solve_constraints`) the start is the tree's best code: its branch-and-bound
+search over keyframe boxes for constraints at the primitive's first or last frame, its beam search otherwise
+(:func:`.bounds.best_code`).
 
 **Path following.** :class:`MorphablePrimitive` wraps a model so that
 :func:`stylemotion.synthesis.controller.follow_path` uses it like a VAE: the controller sets each step's
@@ -18,6 +19,14 @@ target (end position and heading from the median step length, the previous clip'
 as the transition keyframe), calls :meth:`MorphablePrimitive.search_step`, decodes, stitches and cleans
 up exactly as for the VAEs. The step residuals are the controller's cost terms (position, heading, pose,
 speed, each over its scale in :class:`~stylemotion.synthesis.controller.FollowSettings`) and the prior.
+
+**Walks that vary (§4.6.3).** A step's start is drawn at random, as the thesis does: ``random_starts`` codes
+drawn from the primitive's mixture (the prior itself, by the walk's seeded generator), the cheapest under the
+step's objective is the start. As in the thesis' authors' implementation, a start that already meets the step
+(its step residual cost ``½‖r‖²`` without the prior at most ``accept_cost``) is kept as drawn; otherwise LM refines
+it. LM converges to the same MAP code from any start of one mixture component, so without that acceptance
+repeated walks would differ only where the start's component differs. One seed gives one walk.
+``random_starts = 0`` takes the tree's beam-search candidate instead (deterministic: every seed, the same walk).
 """
 
 from __future__ import annotations
@@ -63,6 +72,12 @@ class MapSettings:
         tolerance_m: a constraint missed by more than this after the solve is reported.
         lookahead_steps: ``T``, steps over which a primitive's variants are compared (§4.5.1; 1 = greedy, the
             default: chosen among 1–3 on a validation path, a corner, by suite ``morphable --lookahead``).
+        random_starts: codes drawn from the mixture per path step, the cheapest of them LM's start (§4.6.3: another
+            seed, another walk). 100: the value of the thesis' authors' implementation (``n_random_samples``),
+            kept, not tuned. 0: the tree's candidate (the same walk for every seed).
+        accept_cost: a random start whose step residual cost (``½‖r‖²`` of the position, heading, pose and speed
+            residuals over their ``follow.*`` scales, without the prior) is at most this is kept without LM
+            (the authors' implementation's ``start_error_threshold``); 0: every start is refined.
     """
 
     candidates: int = 4
@@ -72,11 +87,16 @@ class MapSettings:
     max_evaluations: int = 300
     tolerance_m: float = 0.05
     lookahead_steps: int = 1
+    random_starts: int = 100
+    accept_cost: float = 0.0
 
     def __post_init__(self) -> None:
         if self.candidates < 1 or self.tree_evaluations < 1 or self.max_evaluations < 1 or self.lookahead_steps < 1:
             raise ValueError(f"MapSettings need candidates, tree_evaluations, max_evaluations and lookahead_steps "
                              f"≥ 1; got {self}")
+        if self.random_starts < 0 or not self.accept_cost >= 0:
+            raise ValueError(f"MapSettings need random_starts ≥ 0 (0: the tree's candidate) and accept_cost ≥ 0; "
+                             f"got {self}")
         if not self.constraint_scale_m > 0 or not self.tolerance_m > 0 or self.prior_weight < 0:
             raise ValueError(f"MapSettings need constraint_scale_m > 0, tolerance_m > 0, prior_weight ≥ 0; got {self}")
 
@@ -244,11 +264,15 @@ class MorphablePrimitive:
     def search_step(self, goal, follow, generator: torch.Generator | None = None
                     ) -> tuple[torch.Tensor, float, float, dict[str, float]]:
         """One step of :func:`~stylemotion.synthesis.controller.follow_path`: the variant chosen by look-ahead,
-        then the tree's best code for the step's target, refined by LM on eq. 4.9. Returns ``(code, candidate
-        cost, final cost, terms)``; costs are ``½‖r‖²`` of the step residuals plus ``λ (−ln p(s))`` (``λ``:
-        ``follow.prior_weight``)."""
+        then the best of ``settings.random_starts`` codes drawn from its mixture by ``generator`` (or, with 0 or
+        no generator, the tree's best code) for the step's target, refined by LM on eq. 4.9. Returns ``(code,
+        candidate cost, final cost, terms)``; costs are ``½‖r‖²`` of the step residuals plus ``λ (−ln p(s))``
+        (``λ``: ``follow.prior_weight``)."""
         self.last_variant = self.choose_variant(goal, follow)
-        return _map_step(self.variants[self.last_variant], goal, follow, self.settings)
+        rng = None
+        if generator is not None and self.settings.random_starts > 0:
+            rng = np.random.default_rng(int(torch.randint(0, 2 ** 62, (1,), generator=generator)))
+        return _map_step(self.variants[self.last_variant], goal, follow, self.settings, rng)
 
 
 def _variant_names(models: Sequence[MorphableModel]) -> list[str]:
@@ -273,9 +297,20 @@ def _step_residuals(model: MorphableModel, latent: np.ndarray, goal, follow) -> 
     return np.concatenate(parts, axis=1)
 
 
-def _map_step(model: MorphableModel, goal, follow, settings: MapSettings
+def random_start(model: MorphableModel, objective, draws: int, rng: np.random.Generator
+                 ) -> tuple[np.ndarray, float]:
+    """The cheapest of ``draws`` codes drawn from ``model``'s mixture under ``objective`` (``(m, d)`` codes →
+    ``(m,)`` costs): §4.6.3's random initial code. Returns ``(code (d,), its cost)``."""
+    codes = model.gmm.sample(draws, rng)
+    costs = objective(codes)
+    best = int(np.argmin(costs))
+    return codes[best], float(costs[best])
+
+
+def _map_step(model: MorphableModel, goal, follow, settings: MapSettings, rng: np.random.Generator | None = None
               ) -> tuple[torch.Tensor, float, float, dict[str, float]]:
-    """The tree's best code for one step, refined by LM (see :meth:`MorphablePrimitive.search_step`)."""
+    """The start (the best of ``settings.random_starts`` mixture draws by ``rng``, else the tree's best code) for
+    one step, refined by LM (see :meth:`MorphablePrimitive.search_step`)."""
     lam = follow.prior_weight
     offset = model.gmm.max_log_prob()
 
@@ -283,16 +318,26 @@ def _map_step(model: MorphableModel, goal, follow, settings: MapSettings
         r = _step_residuals(model, latent, goal, follow)
         return 0.5 * (r ** 2).sum(-1) + lam * (offset - model.gmm.log_prob(latent))
 
-    found = model.ensure_tree().search(total, settings.candidates)
-    prior = _prior_residual(model, found.latent, lam)
-    fit = least_squares(lambda s: np.concatenate([_step_residuals(model, s[None], goal, follow)[0], prior(s)]),
-                        found.latent, method="lm", max_nfev=settings.max_evaluations)
-    final = float(total(fit.x[None])[0])
-    best = fit.x if final <= found.cost else found.latent
+    refine = True
+    if rng is not None and settings.random_starts > 0:
+        start, start_cost = random_start(model, total, settings.random_starts, rng)
+        spent = settings.random_starts
+        refine = 0.5 * float((_step_residuals(model, start[None], goal, follow) ** 2).sum()) > settings.accept_cost
+    else:
+        found = model.ensure_tree().search(total, settings.candidates)
+        start, start_cost, spent = found.latent, float(found.cost), found.evaluations
+    best, final = start, start_cost
+    if refine:
+        prior = _prior_residual(model, start, lam)
+        fit = least_squares(lambda s: np.concatenate([_step_residuals(model, s[None], goal, follow)[0], prior(s)]),
+                            start, method="lm", max_nfev=settings.max_evaluations)
+        final = float(total(fit.x[None])[0])
+        best = fit.x if final <= start_cost else start
+        spent += fit.nfev
     r = _step_residuals(model, best[None], goal, follow)[0]
     terms = {"position": float((r[:2] ** 2).sum()), "heading": float(r[2] ** 2),
              "prior": float(lam * (offset - model.gmm.log_prob(best))),
-             "evaluations": float(found.evaluations + fit.nfev)}
+             "evaluations": float(spent), "refined": float(refine)}
     if goal.previous_pose is not None:
         terms["pose"], terms["speed"] = float((r[3:-1] ** 2).sum()), float(r[-1] ** 2)
-    return torch.from_numpy(best.astype(np.float32)), float(found.cost), min(final, found.cost), terms
+    return torch.from_numpy(best.astype(np.float32)), start_cost, min(final, start_cost), terms
