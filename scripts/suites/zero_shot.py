@@ -235,7 +235,9 @@ def render(record: dict[str, Any]) -> dict[str, str]:
     minutes = [m for styles in r["per_style"].values() for v in styles.values() for m in v["train_minutes"] if m]
     per_seed = (md_table(["seed", *(f"{SHORT[k]} recognition" for k in kinds),
                           *(f"{SHORT[k]} own column" for k in kinds), "trainings"], seed_rows)
-                + f"\n\nTrainings (autoencoder + network per left-out style) took "
-                  f"{fmt(min(minutes), 1) if minutes else '—'}–{fmt(max(minutes), 1) if minutes else '—'} min each "
-                  f"when this command trained them (reused ones count 0; a loaded machine: no timing figure). {prov}")
+                + "\n\n" + (f"Trainings (autoencoder + network per left-out style) took {fmt(min(minutes), 1)}–"
+                              f"{fmt(max(minutes), 1)} min each where this command trained them" if minutes else
+                              "This command trained none of the leakage-free models: it reused those an earlier run "
+                              "of it had trained")
+                + f" (reused trainings are not timed; a loaded machine: no timing figure). {prov}")
     return {"headline": headline, "per_style": per_style, "per_seed": per_seed}
