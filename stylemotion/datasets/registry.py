@@ -95,6 +95,9 @@ def load_dataset(name: str, **options: Any) -> TakeSet:
         raise DatasetOptionError(f"unknown dataset {name!r}; registered: {sorted(DATASETS)}")
     loader = DATASETS[name]
     params = inspect.signature(loader).parameters
+    for key, what in (("styles", "style"), ("contents", "content")):
+        if isinstance(options.get(key), (list, tuple)) and not options[key]:  # null means all; [] means none
+            raise DatasetOptionError(f"data.{key}=[] selects no {what}: give at least one, or null for all")
     retarget = check_retarget(options.pop("retarget", None))
     if "settings" in params:
         conv = {k: options.pop(k) for k in _CONVERSION_KEYS if k in options}

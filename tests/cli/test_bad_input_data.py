@@ -12,6 +12,7 @@ from cli_runner import run_command
     (["data.fps=0"], "data.fps must be a positive finite number, got 0"),
     (["data.fps=nan"], "data.fps must be a positive finite number, got nan"),
     (["data.duration_s=-1"], "data.duration_s must be a positive finite number, got -1"),
+    (["data.styles=[]"], "data.styles=[] selects no style: give at least one, or null for all"),
     (["data.split.val_fraction=1.5"], "data.split: fractions must be in [0, 1) and sum below 1, got val=1.5"),
     (["data=bvh_folder", "data.root=.", "+data.default_labels={style: ../x}"],
      "data.default_labels: style label '../x' is not a safe file name"),
