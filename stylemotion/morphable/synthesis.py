@@ -78,6 +78,9 @@ class MapSettings:
         accept_cost: a random start whose step residual cost (``½‖r‖²`` of the position, heading, pose and speed
             residuals over their ``follow.*`` scales, without the prior) is at most this is kept without LM
             (the authors' implementation's ``start_error_threshold``); 0: every start is refined.
+        prior_centre: where LM's prior residual ``√λ L_k⁻¹ (s − c)`` is centred: ``mixture`` (``c = μ_k``, eq. 4.9,
+            the thesis') or ``start`` (``c`` = the drawn start: LM meets the step and keeps the draw where the step
+            leaves the code free, a perturb-and-MAP draw; the prior still counts in the costs compared).
     """
 
     candidates: int = 4
@@ -89,11 +92,14 @@ class MapSettings:
     lookahead_steps: int = 1
     random_starts: int = 100
     accept_cost: float = 0.0
+    prior_centre: str = "mixture"
 
     def __post_init__(self) -> None:
         if self.candidates < 1 or self.tree_evaluations < 1 or self.max_evaluations < 1 or self.lookahead_steps < 1:
             raise ValueError(f"MapSettings need candidates, tree_evaluations, max_evaluations and lookahead_steps "
                              f"≥ 1; got {self}")
+        if self.prior_centre not in ("mixture", "start"):
+            raise ValueError(f"MapSettings.prior_centre is 'mixture' or 'start', got {self.prior_centre!r}")
         if self.random_starts < 0 or not self.accept_cost >= 0:
             raise ValueError(f"MapSettings need random_starts ≥ 0 (0: the tree's candidate) and accept_cost ≥ 0; "
                              f"got {self}")
@@ -126,9 +132,10 @@ class ConstrainedResult:
     unreachable: list[str] = field(default_factory=list)
 
 
-def _prior_residual(model: MorphableModel, start: np.ndarray, weight: float):
+def _prior_residual(model: MorphableModel, start: np.ndarray, weight: float, centre: np.ndarray | None = None):
     k = int(np.argmax(model.gmm.component_log_prob(start)))
-    chol, mean = np.linalg.cholesky(model.gmm.covariances[k]), model.gmm.means[k]
+    chol = np.linalg.cholesky(model.gmm.covariances[k])
+    mean = model.gmm.means[k] if centre is None else centre
     scale = np.sqrt(weight)
 
     def residual(s: np.ndarray) -> np.ndarray:
@@ -328,7 +335,7 @@ def _map_step(model: MorphableModel, goal, follow, settings: MapSettings, rng: n
         start, start_cost, spent = found.latent, float(found.cost), found.evaluations
     best, final = start, start_cost
     if refine:
-        prior = _prior_residual(model, start, lam)
+        prior = _prior_residual(model, start, lam, start if settings.prior_centre == "start" else None)
         fit = least_squares(lambda s: np.concatenate([_step_residuals(model, s[None], goal, follow)[0], prior(s)]),
                             start, method="lm", max_nfev=settings.max_evaluations)
         final = float(total(fit.x[None])[0])
