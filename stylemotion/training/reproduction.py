@@ -59,7 +59,7 @@ from stylemotion.config import ConfigError, positive_int, set_torch_threads  # a
 from stylemotion.datasets import build_dataset, data_config_key
 from stylemotion.evaluation.run import recorded_path, run_evaluation, settings_from_config, summary_lines
 from stylemotion.io.errors import OutputWriteError, UserInputError
-from stylemotion.io.jsonfile import JsonFileError, read_json_object, write_json
+from stylemotion.io.jsonfile import JsonFileError, json_text, read_json_object, write_json
 from stylemotion.io.outputs import check_new_output, inside, safe_name
 from stylemotion.primitives.segmentation import SegmentSettings, action_of, parse_primitive, segment_takes
 from stylemotion.provenance import provenance
@@ -203,7 +203,23 @@ class Reproduction:
         self._line(1, f"data: {takeset.name}, {len(takeset)} takes, {takeset.num_frames} frames; CVAE styles {wanted}")
         for p in self.primitives:
             log.info("    " + p + " clips: " + ", ".join(f"{s} {counts[(p, s)]}" for s in styles))
-        write_json(self.out / "data.json", self.data_summary)
+        self._keep_or_write_data_summary()
+
+    def _keep_or_write_data_summary(self) -> None:
+        """Write ``data.json`` unless the run already holds the same summary (its ``seconds`` aside): a rerun
+        into an existing run touches none of its files before its stages are accepted."""
+        path = self.out / "data.json"
+
+        def same(summary: Any) -> str:
+            return json_text({k: v for k, v in summary.items() if k != "seconds"} if isinstance(summary, dict)
+                             else summary)
+
+        try:
+            kept = json.loads(path.read_text()) if path.is_file() else None
+        except (OSError, ValueError):
+            kept = None
+        if kept is None or same(kept) != same(json.loads(json_text(self.data_summary))):
+            write_json(path, self.data_summary)
 
     def prepare_stage(self, index: int, stage: Stage) -> bool | None:
         """Hash ``stage``'s settings, refuse a folder of other settings, reuse a finished stage.

@@ -71,3 +71,16 @@ def test_a_cut_off_evaluation_record_is_named(name, text, tmp_path):
     with pytest.raises(JsonFileError, match=rf"{out / name}.*evaluation record.*delete {out / 'report'}"):
         repro.evaluation_stage()
     assert (out / name).read_text() == text
+
+
+def test_a_refused_rerun_leaves_the_runs_data_summary_as_it_was(tmp_path, capsys, monkeypatch):
+    (tmp_path / "run" / "autoencoder").mkdir(parents=True)
+    (tmp_path / "run" / "autoencoder" / "done.json").write_text('{"settings_hash": "ab')
+    for _ in range(2):
+        done = run_command("reproduce", *DATA, "out=run", "hydra.run.dir=hydra", capsys=capsys,
+                           monkeypatch=monkeypatch, cwd=tmp_path)
+        assert done.returncode == 2, done.stderr
+        if _ == 0:
+            data_json = tmp_path / "run" / "data.json"
+            first = (data_json.stat().st_mtime_ns, data_json.stat().st_ino, data_json.read_bytes())
+    assert (data_json.stat().st_mtime_ns, data_json.stat().st_ino, data_json.read_bytes()) == first
