@@ -81,4 +81,4 @@ def test_a_chosen_alpha_reaches_every_seed_and_its_table(tiny_run, monkeypatch: 
     assert passed == [5.0, 5.0, 5.0] and results["alpha_choice"] == choice
     blocks = style.render({"results": results, "seeds": [0, 1, 2], "command": "c", "commit": "x",
                            "started": "2026-01-01", "machine": {}, "seconds": 0})
-    assert "| **5** | 1.0000 / 0.0150 | 0.405 |" in blocks["alpha"] and "α = 5, chosen" in blocks["headline"]
+    assert "| **5** | 1.00 / 0.0150 / — | 0.405 |" in blocks["alpha"] and "α = 5, chosen" in blocks["headline"]

@@ -133,13 +133,19 @@ def train_candidate(container: dict[str, Any], folder: str) -> dict[str, float]:
 
     from stylemotion.io.jsonfile import read_json_object, write_json
     from stylemotion.training.fit import run as train_run
+    from stylemotion.training.style_weight import prior_sample_spread
 
     path = Path(folder)
     record = path / "candidate.json"
     if record.is_file():
-        return dict(read_json_object(record, "an α candidate's record", f"delete {path}")["val"])
-    train_run(OmegaConf.create(container))
-    val = dict(read_json_object(path / "metrics.json", "an α candidate's metrics", f"delete {path}").get("val") or {})
+        val = dict(read_json_object(record, "an α candidate's record", f"delete {path}")["val"])
+    else:
+        train_run(OmegaConf.create(container))
+        val = dict(read_json_object(path / "metrics.json", "an α candidate's metrics", f"delete {path}").get("val")
+                   or {})
+    if "samples/pose_across_sd" not in val:  # records written before the rule read the samples' spread
+        val["samples/pose_across_sd"] = prior_sample_spread(path / "checkpoints" / "best.ckpt",
+                                                            seed=int(container.get("seed", 0)))
     write_json(record, {"val": val})
     return val
 
@@ -194,8 +200,8 @@ def choose_alpha(args: argparse.Namespace, seed: int, primitives: list[str] | No
     return {"candidates": sorted(args.alphas), "styles": chosen_styles, "seed": args.alpha_seed,
             "autoencoder_of_seed": seed, "values": {f"{a:g}": v for a, v in values.items()},
             "scores": {f"{a:g}": scores[a] for a in sorted(scores)}, "chosen": chosen,
-            "rule": "min over α of mean over styles of log(val/style ÷ min) + log(val/mpjpe ÷ min) "
-                    "(stylemotion/training/style_weight.py)"}
+            "rule": "min over α of the mean over styles of log(val/style ÷ min) + log(val/mpjpe ÷ min) + "
+                    "log(max ÷ samples/pose_across_sd) (stylemotion/training/style_weight.py)"}
 
 
 def seed_figures(report: dict[str, Any]) -> dict[str, Any]:
@@ -290,14 +296,16 @@ def alpha_blocks(choice: dict[str, Any], prov: str) -> dict[str, str]:
     """The ``alpha`` block: every candidate's validation figures per style, its score and the choice."""
     names = sorted({n for per in choice["values"].values() for n in per})
     rows = [[f"**{a}**" if float(a) == choice["chosen"] else a,
-             *(f"{fmt(v[n]['val/style'], 4)} / {fmt(v[n]['val/mpjpe'], 4)}" if n in v else "failed" for n in names),
+             *(f"{fmt(v[n]['val/style'], 2)} / {fmt(v[n]['val/mpjpe'], 4)} / "
+               f"{fmt(v[n].get('samples/pose_across_sd'), 2)}" if n in v else "failed" for n in names),
              fmt(choice["scores"][a], 3)]
             for a, v in choice["values"].items()]
     return {"alpha": (f"Style weight α chosen on **validation** clips before any figure was reported with it: CVAEs "
                       f"of {', '.join(names)} trained with seed {choice['seed']} (not a reported seed) on the "
                       f"autoencoder of seed {choice['autoencoder_of_seed']}'s run; each cell is val/style (Gram "
                       f"distance to the example) / val/mpjpe (m, reconstruction of held-out neutral clips) at the best "
-                      f"val/loss epoch. Rule (fixed before the run): {choice['rule']}. Chosen: α = "
+                      f"val/loss epoch / pose_across_SD (cm) of 256 prior samples of that checkpoint. Rule: "
+                      f"{choice['rule']}. Chosen: α = "
                       f"{choice['chosen']:g}.\n\n"
                       + md_table(["α", *names, "score (lower is better)"], rows) + f"\n\n{prov}")}
 

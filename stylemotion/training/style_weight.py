@@ -1,25 +1,36 @@
 """Choosing the style CVAE's style weight α on validation clips (Du ch. 5, eq. 5.9–5.11).
 
-α trades the style term against the reconstruction: a larger α pulls the decoded clips towards the style example's
-Gram matrix (``val/style`` falls) and away from the content of the neutral clips they encode (``val/mpjpe`` rises).
-Both are read on the **validation** clips at the epoch of the best ``val/loss`` (what
-:func:`stylemotion.training.fit.objective` returns for ``sweep_objective: [val/style, val/mpjpe]``). Neither is
-minimized by one α, so the rule, fixed before any figure was seen, is scale-free: each metric is divided by its
-smallest value over the candidates (per style), and α minimizes the mean over styles of
+α trades the style term against the rest: a larger α pulls the decoded clips towards the style example's Gram
+matrix (``val/style`` falls), away from the content of the neutral clips they encode (``val/mpjpe`` rises) and, at
+the thesis' α = 200, every sample onto the example (the samples' spread collapses). Three figures, none read on a
+test clip, measure these:
 
-    log(val/style ÷ its minimum) + log(val/mpjpe ÷ its minimum)
+* ``val/style`` and ``val/mpjpe``: the **validation** clips at the epoch of the best ``val/loss`` (what
+  :func:`stylemotion.training.fit.objective` returns for ``sweep_objective: [val/style, val/mpjpe]``);
+* ``samples/pose_across_sd`` (cm): the spread of prior samples of the best checkpoint across samples at aligned
+  frames (:func:`stylemotion.evaluation.tables.across_sample_sd`; no data read), which ``val/mpjpe`` — a
+  reconstruction through the encoder — cannot see.
 
-(the geometric balance of the two relative costs). A candidate with a missing or non-finite value for any style
+No α is best on all three, so the rule is scale-free: per style each figure is divided by its best value over the
+candidates (the smallest distance or error, the largest spread), and α minimizes the mean over styles of
+
+    log(val/style ÷ min) + log(val/mpjpe ÷ min) + log(max ÷ samples/pose_across_sd)
+
+(the geometric balance of the three relative costs). A candidate with a missing or non-finite value for any style
 (a failed training) scores +inf: a failure is never chosen. Ties go to the smaller α.
+
+The spread term was added after the first candidates' validation figures showed ``val/mpjpe`` flat across α
+(no test figure had been computed with any candidate).
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Mapping
+from pathlib import Path
 
-#: The two validation metrics the rule balances.
-METRICS = ("val/style", "val/mpjpe")
+#: The figures the rule balances, each with whether smaller (True) or larger (False) is better.
+METRICS: dict[str, bool] = {"val/style": True, "val/mpjpe": True, "samples/pose_across_sd": False}
 
 
 def _finite(value: object) -> float | None:
@@ -34,31 +45,33 @@ def style_weight_scores(values: Mapping[float, Mapping[str, Mapping[str, object]
     """The rule's score of each α (lower is better; module doc).
 
     Args:
-        values: α → style → {``val/style``: Gram distance, ``val/mpjpe``: metres} at the best validation epoch.
+        values: α → style → {``val/style``: Gram distance, ``val/mpjpe``: metres, ``samples/pose_across_sd``:
+            cm} (:data:`METRICS`).
 
     Returns:
-        α → mean over styles of the summed log ratios to the per-style minima; +inf for a failed candidate.
+        α → mean over styles of the summed log ratios to the per-style best values; +inf for a failed candidate.
     """
     alphas = sorted(values)
     styles = sorted({s for per_style in values.values() for s in per_style})
     if not alphas or not styles:
         raise ValueError("no candidates: pass α → style → validation metrics")
-    minima: dict[tuple[str, str], float] = {}
+    best: dict[tuple[str, str], float] = {}
     for style in styles:
-        for metric in METRICS:
+        for metric, smaller in METRICS.items():
             seen = [v for a in alphas if (v := _finite(values[a].get(style, {}).get(metric))) is not None]
             if seen:
-                minima[(style, metric)] = min(seen)
+                best[(style, metric)] = min(seen) if smaller else max(seen)
     scores: dict[float, float] = {}
     for a in alphas:
         total = 0.0
         for style in styles:
-            for metric in METRICS:
+            for metric, smaller in METRICS.items():
                 v = _finite(values[a].get(style, {}).get(metric))
                 if v is None:
                     total = math.inf
                     break
-                total += math.log(v / minima[(style, metric)])
+                ratio = v / best[(style, metric)]
+                total += math.log(ratio if smaller else 1.0 / ratio)
             if math.isinf(total):
                 break
         scores[a] = total / len(styles) if math.isfinite(total) else math.inf
@@ -76,3 +89,13 @@ def choose_style_weight(values: Mapping[float, Mapping[str, Mapping[str, object]
     if math.isinf(scores[best]):
         raise ValueError("every α candidate failed (a missing or non-finite validation metric)")
     return best
+
+
+def prior_sample_spread(checkpoint: str | Path, samples: int = 256, seed: int = 0) -> float:
+    """``samples/pose_across_sd``: pose_across_SD (cm) of ``samples`` prior samples (``z ~ N(0, I)``, seeded) of a
+    VAE/CVAE checkpoint, on the canonical timeline (:func:`stylemotion.evaluation.tables.across_sample_sd`)."""
+    from stylemotion.evaluation.tables import across_sample_sd
+    from stylemotion.models.loading import load_generative
+
+    drawn = load_generative(checkpoint).sample(samples, seed=seed)
+    return across_sample_sd(drawn.normalized_frames.detach().cpu().numpy())

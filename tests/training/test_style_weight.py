@@ -9,8 +9,8 @@ import pytest
 from stylemotion.training.style_weight import choose_style_weight, style_weight_scores
 
 
-def metrics(style: float, mpjpe: float) -> dict[str, float]:
-    return {"val/style": style, "val/mpjpe": mpjpe}
+def metrics(style: float, mpjpe: float, spread: float = 1.0) -> dict[str, float]:
+    return {"val/style": style, "val/mpjpe": mpjpe, "samples/pose_across_sd": spread}
 
 
 def test_the_balanced_alpha_wins_and_scores_are_log_products() -> None:
@@ -33,7 +33,8 @@ def test_the_rule_is_scale_free_per_style_and_averages_styles() -> None:
 
 def test_a_failed_candidate_is_never_chosen() -> None:
     values = {1.0: {"a": metrics(4, 1), "b": metrics(4, 1)},
-              5.0: {"a": metrics(1, 1), "b": {"val/style": float("nan"), "val/mpjpe": 1.0}}}
+              5.0: {"a": metrics(1, 1), "b": {"val/style": float("nan"), "val/mpjpe": 1.0,
+                                               "samples/pose_across_sd": 1.0}}}
     assert style_weight_scores(values)[5.0] == math.inf
     assert choose_style_weight(values) == 1.0
     with pytest.raises(ValueError, match="every α candidate failed"):
@@ -43,3 +44,12 @@ def test_a_failed_candidate_is_never_chosen() -> None:
 def test_ties_go_to_the_smaller_alpha() -> None:
     values = {10.0: {"a": metrics(1, 2)}, 2.0: {"a": metrics(2, 1)}}
     assert choose_style_weight(values) == 2.0
+
+
+def test_a_collapsing_spread_costs_as_much_as_the_style_it_buys() -> None:
+    # α=200 halves the style distance but its samples spread 4× less: 1/2 · 4 = 2 > 1 (α=5's product)
+    values = {5.0: {"a": metrics(2, 1, spread=8)}, 200.0: {"a": metrics(1, 1, spread=2)}}
+    assert style_weight_scores(values) == pytest.approx({5.0: math.log(2), 200.0: math.log(4)})
+    assert choose_style_weight(values) == 5.0
+    values[200.0]["a"]["samples/pose_across_sd"] = 8.0  # no collapse: the stronger style wins
+    assert choose_style_weight(values) == 200.0
