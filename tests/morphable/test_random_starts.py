@@ -13,13 +13,15 @@ from stylemotion.synthesis import follow_path, s_curve
 from stylemotion.synthesis.graph import MotionGraph
 
 
-def _walk(left_model, right_model, seed: int, random_starts: int, accept_cost: float = 0.0):
-    settings = MapSettings(random_starts=random_starts, max_evaluations=40, accept_cost=accept_cost)
+def _walk(left_model, right_model, seed: int, random_starts: int, accept_cost: float = 0.0,
+          prior_centre: str = "mixture"):
+    settings = MapSettings(random_starts=random_starts, max_evaluations=40, accept_cost=accept_cost,
+                           prior_centre=prior_centre)
     graph = MotionGraph("walk", "normal", {"leftStance": MorphablePrimitive(left_model, settings),
                                            "rightStance": MorphablePrimitive(right_model, settings)})
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        return follow_path(graph, s_curve(2.5, amplitude_m=0.2, waves=0.5), seed=seed)
+        return follow_path(graph, s_curve(1.8, amplitude_m=0.2, waves=0.5), seed=seed)
 
 
 def test_one_seed_one_walk_and_another_seed_another(left_model, right_model):
@@ -38,6 +40,13 @@ def test_refined_starts_still_follow_the_path(left_model, right_model):
     drawn = _walk(left_model, right_model, 5, 100)
     assert all(s.terms["refined"] == 1.0 for s in drawn.steps)
     assert all(s.cost_final <= s.cost_best_candidate + 1e-9 for s in drawn.steps)
+
+
+def test_refined_towards_the_start_walks_still_differ(left_model, right_model):
+    """prior_centre='start': every step is refined by LM, pulled towards its own draw, so seeds still differ."""
+    a, b = (_walk(left_model, right_model, s, 100, prior_centre="start") for s in (3, 4))
+    assert all(s.terms["refined"] == 1.0 for s in a.steps)
+    assert not np.allclose(a.steps[0].latent, b.steps[0].latent, atol=1e-2)
 
 
 def test_without_random_starts_every_seed_walks_the_same(left_model, right_model):
@@ -68,6 +77,8 @@ def test_the_cheapest_draw_is_the_start(left_model):
     assert cost == pytest.approx(objective(draws).min()) and objective(start[None])[0] == pytest.approx(cost)
 
 
-def test_negative_random_starts_are_refused():
+def test_bad_start_settings_are_refused():
     with pytest.raises(ValueError, match="random_starts ≥ 0"):
         MapSettings(random_starts=-1)
+    with pytest.raises(ValueError, match="prior_centre"):
+        MapSettings(prior_centre="mode")
