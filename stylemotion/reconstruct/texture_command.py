@@ -27,7 +27,7 @@ from omegaconf import DictConfig
 
 from stylemotion.config import ConfigError, settings_from_config
 from stylemotion.datasets import TakeSet
-from stylemotion.datasets.user_motion import conversion_keys
+from stylemotion.datasets.user_motion import conversion_keys, parse_example
 from stylemotion.io.outputs import check_new_output
 from stylemotion.provenance import provenance
 from stylemotion.reconstruct.inputs import command_takeset, database_without
@@ -51,6 +51,17 @@ def load_motion(text: str, takeset: TakeSet, joints: Sequence[str],
         return positions, positions, text
     if not text:
         raise TextureInputError("motion= is empty: give a BVH or NPZ file or a take of the dataset")
+    name, _, frames = text.rpartition(":")
+    if name in names and not Path(text).expanduser().is_file():  # <take>:start-end, frames of the take
+        spec = parse_example(text, "motion")
+        if spec.start is None or spec.end is None:
+            raise TextureInputError(f"motion={text}: after a take's name give a frame range START-END "
+                                    f"(e.g. motion={name}:0-120)")
+        if spec.end > len(names[name].positions):
+            raise TextureInputError(f"motion={text}: the frame range {frames} runs past the take's "
+                                    f"{len(names[name].positions)} frames (END exclusive)")
+        positions = np.asarray(names[name].positions[spec.start:spec.end], dtype=np.float64)
+        return positions, positions, name
     tracks = read_markers(text, joints, takeset.fps, dict(conversion or {}))
     if tracks.full is not None:
         return np.asarray(tracks.full, dtype=np.float64), np.asarray(tracks.full, dtype=np.float64), None

@@ -33,3 +33,16 @@ def test_a_take_with_a_frame_range_gives_those_frames(takeset):
 def test_a_bad_range_of_a_take_is_named(takeset, suffix, message):
     with pytest.raises(UserInputError, match=f"markers={TAKE}{suffix}: .*{message}"):
         load_tracks(f"{TAKE}{suffix}", takeset, None)
+
+
+def test_texture_reads_a_take_with_a_frame_range_and_names_a_bad_one(takeset):
+    from stylemotion.reconstruct.texture import LEG_JOINTS
+    from stylemotion.reconstruct.texture_command import load_motion
+
+    motion, truth, take = load_motion(f"{TAKE}:10-40", takeset, LEG_JOINTS)
+    whole = next(t for t in takeset.takes if t.name == TAKE).positions
+    assert take == TAKE and motion.shape == (30, *whole.shape[1:]) and (motion == whole[10:40]).all()
+    assert (truth == motion).all()
+    for suffix, message in [(":40-10", "empty"), (":0-99999", "runs past the take's"), (":abc", "START-END")]:
+        with pytest.raises(UserInputError, match=f"motion={TAKE}{suffix}: .*{message}"):
+            load_motion(f"{TAKE}{suffix}", takeset, LEG_JOINTS)
