@@ -314,8 +314,7 @@ def make_inputs(paths: Inputs, seed: int, say: Callable[[str], None]) -> dict[st
         return json.dumps({"keys": list(items)})
 
     key_files = {
-        "keys_good": keys({"time": 0, "take": "synthetic_walk_normal_001", "frame": 0},
-                          {"time": 1.0, "take": "synthetic_walk_normal_001", "frame": 30}),
+        "keys_good": keys({"time": 0, "take": TAKE, "frame": 0}, {"time": 1.0, "take": TAKE, "frame": 30}),
         "keys_time_huge": keys({"time": 0, "take": TAKE, "frame": 0}, {"time": 200000, "take": TAKE, "frame": 30}),
         "keys_time_1e9": keys({"time": 0, "take": TAKE, "frame": 0}, {"time": 1e9, "take": TAKE, "frame": 30}),
         "keys_time_negative": keys({"time": -5, "take": TAKE, "frame": 0}, {"time": 1, "take": TAKE, "frame": 30}),
