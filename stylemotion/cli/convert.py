@@ -33,10 +33,11 @@ def convert(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--unit-scale", type=_unit, default=None,
                         help="metres per file unit or a unit name (m, cm, mm, inch, cmu); default: detect")
     parser.add_argument("--up-axis", choices=["y", "z"], default="y")
+    parser.add_argument("--force", action="store_true", help="replace an existing DST")
     args = parser.parse_args(argv)
     check_arguments(args.dst, args.fps)
     settings = ConversionSettings(args.fps, args.joint_map, args.unit_scale, args.up_axis)
-    positions = convert_file(args.src, args.dst, settings)
+    positions = convert_file(args.src, args.dst, settings, args.force)
     print(f"{args.dst}: {positions.shape[0]} frames at {args.fps:g} fps, 21 joints, metres, Y up")
     return 0
 

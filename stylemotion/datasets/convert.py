@@ -47,14 +47,18 @@ def check_arguments(dst: str | Path, fps: Any) -> Path:
     return path
 
 
-def convert_file(src: str | Path, dst: str | Path, settings: ConversionSettings) -> np.ndarray:
+def convert_file(src: str | Path, dst: str | Path, settings: ConversionSettings, force: bool = False) -> np.ndarray:
     """Convert ``src`` (a BVH file, or ``archive.zip::member``) and write ``dst`` atomically.
 
     Returns the positions ``(frames, 21, 3)`` float32, metres. Raises :class:`ConvertError` for a bad
-    ``dst`` or ``settings.fps`` (checked before reading) and :class:`~stylemotion.io.errors.MotionDataError`
-    for a file that cannot be converted.
+    ``dst`` or ``settings.fps``, an existing ``dst`` without ``force`` or a ``dst`` that is a link (all checked
+    before reading), :class:`~stylemotion.io.errors.MotionDataError` for a file that cannot be converted.
     """
     dst = check_arguments(dst, settings.fps)
+    if Path(dst).is_symlink():
+        raise ConvertError(f"{dst} is a link; nothing is written through a link or over it: give another DST")
+    if Path(dst).exists() and not force:
+        raise ConvertError(f"{dst} already exists; give another DST or pass --force to replace it")
     src = str(src)
     source = FileSource(*src.split("::", 1)) if "::" in src else FileSource(src)
     positions = load_canonical_positions(source, settings)

@@ -35,9 +35,15 @@ def check_new_output(path: str | os.PathLike, force: bool = False, key: str = "o
     :class:`~stylemotion.io.errors.OutputWriteError` if it could not be made: the nearest existing folder above it
     is read-only (or a file).
 
+    A link (to a folder, a file or nowhere) is refused with :class:`UnsafePathError`, with or without ``force``:
+    nothing is written through a link or over it.
+
     Call it before any work, and again when the result is swapped into place.
     """
     path = Path(path).expanduser()
+    if path.is_symlink():
+        raise UnsafePathError(f"{key}={path}: {path} is a link to {Path(os.readlink(path))}; nothing is written "
+                              f"through a link or over it: choose another {key}")
     if path.exists() and not force:
         hint = f"another {key} or pass --force" if key.startswith("--") else f"another {key}=… or pass force=true"
         raise OutputExistsError(f"{path} already exists; choose {hint} to replace it")

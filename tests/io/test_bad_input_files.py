@@ -76,3 +76,17 @@ def test_the_data_set_names_the_fifo_and_the_loop_among_its_broken_files(fifo, t
         refused.value)
     skipped = load_bvh_folder(tmp_path, skip_broken=True, cache_dir=tmp_path / "cache", use_cache=False).skipped
     assert [name for name, _ in skipped] == [str(tmp_path / "loop.bvh"), str(fifo)]
+
+
+def test_convert_refuses_an_existing_or_linked_dst_unless_forced(tmp_path, capsys, tiny_bvh):
+    src = tmp_path / "walk.bvh"
+    src.write_text(tiny_bvh)
+    mine = tmp_path / "mine.npz"
+    mine.write_bytes(b"my own file")
+    (tmp_path / "linked.npz").symlink_to(mine)
+    for dst, message in [(mine, "already exists; give another DST or pass --force"), (tmp_path / "linked.npz",
+                                                                                      "is a link; nothing is written")]:
+        assert convert_main([str(src), str(dst), "--joint-map", "bandai"]) == 2
+        (line,) = capsys.readouterr().err.strip().splitlines()
+        assert line.startswith(f"stylemotion-convert: {dst} ") and message in line, line
+    assert mine.read_bytes() == b"my own file" and (tmp_path / "linked.npz").is_symlink()

@@ -60,3 +60,14 @@ def test_check_new_output(tmp_path):
     with pytest.raises(OutputExistsError, match="report="):
         check_new_output(target, key="report")
     assert check_new_output(target, force=True) == target
+
+
+@pytest.mark.parametrize("force", [False, True])
+@pytest.mark.parametrize("target", ["folder", "file", "nowhere"])
+def test_an_output_that_is_a_link_is_refused_with_or_without_force(tmp_path, force, target):
+    (tmp_path / "folder").mkdir()
+    (tmp_path / "file").write_text("mine")
+    (tmp_path / "out").symlink_to(tmp_path / target)
+    with pytest.raises(UnsafePathError, match=f"--out={tmp_path / 'out'}: .* is a link to {tmp_path / target}"):
+        check_new_output(tmp_path / "out", force, key="--out")
+    assert (tmp_path / "file").read_text() == "mine" and not any((tmp_path / "folder").iterdir())
