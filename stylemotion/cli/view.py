@@ -21,11 +21,15 @@ from stylemotion.viewer.motions import read_inputs
 from stylemotion.viewer.page import LAYOUTS, write_viewer
 from stylemotion.viewer.serve import bind, serve_folder, url
 
+#: Widest spacing of motions side by side (m).
+MAX_SPACING_M = 1000.0
+
 
 def _check_numbers(args: argparse.Namespace) -> None:
     """Refuse numbers no page can use (a NaN spacing would reach the page's data)."""
-    if not (math.isfinite(args.spacing) and args.spacing >= 0):
-        raise UserInputError(f"--spacing {args.spacing}: expected a finite number of metres ≥ 0")
+    if not (math.isfinite(args.spacing) and 0 <= args.spacing <= MAX_SPACING_M):
+        raise UserInputError(f"--spacing {args.spacing}: expected metres in 0–{MAX_SPACING_M:g} (motions side by "
+                             "side; more would put them out of sight and, far enough, out of float range)")
     if not (math.isfinite(args.fps) and args.fps > 0):
         raise UserInputError(f"--fps {args.fps}: expected a finite number of frames per second > 0")
     if args.max_samples < 1:

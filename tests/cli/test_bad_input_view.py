@@ -30,3 +30,11 @@ def test_a_pickled_npz_is_named_in_one_line(kind, tmp_path, capsys):
     assert line.startswith(f"stylemotion-view: {bad}: ") and "pickled Python objects, which are never loaded" in line
     assert "allow_pickle" not in line and "Traceback" not in line, line
     assert not (tmp_path / "page").exists()
+
+
+@pytest.mark.parametrize("spacing", ["nan", "-1", "1e308", "1001"])
+def test_a_spacing_out_of_range_is_refused(spacing, tmp_path, capsys):
+    assert main(["walk.bvh", "--out", str(tmp_path / "page"), "--spacing", spacing]) == 2
+    (line,) = capsys.readouterr().err.strip().splitlines()
+    assert line.startswith(f"stylemotion-view: --spacing {float(spacing)}: expected metres in 0–1000"), line
+    assert not (tmp_path / "page").exists()
