@@ -77,7 +77,8 @@ class MapSettings:
             kept, not tuned. 0: the tree's candidate (the same walk for every seed).
         accept_cost: a random start whose step residual cost (``½‖r‖²`` of the position, heading, pose and speed
             residuals over their ``follow.*`` scales, without the prior) is at most this is kept without LM
-            (the authors' implementation's ``start_error_threshold``); 0: every start is refined.
+            (the authors' implementation's ``start_error_threshold``); 0: every start is refined (chosen with
+            ``prior_centre`` on a validation path, a corner, by suite ``morphable_variation``).
         prior_centre: where LM's prior residual ``√λ L_k⁻¹ (s − c)`` is centred: ``mixture`` (``c = μ_k``, eq. 4.9,
             the thesis') or ``start`` (``c`` = the drawn start: LM meets the step and keeps the draw where the step
             leaves the code free, a perturb-and-MAP draw; the prior still counts in the costs compared).
