@@ -24,8 +24,10 @@ speed, each over its scale in :class:`~stylemotion.synthesis.controller.FollowSe
 drawn from the primitive's mixture (the prior itself, by the walk's seeded generator), the cheapest under the
 step's objective is the start. As in the thesis' authors' implementation, a start that already meets the step
 (its step residual cost ``½‖r‖²`` without the prior at most ``accept_cost``) is kept as drawn; otherwise LM refines
-it. LM converges to the same MAP code from any start of one mixture component, so without that acceptance
-repeated walks would differ only where the start's component differs. One seed gives one walk.
+it (``accept_cost = 0``, the default chosen on a validation path: every start is refined). LM converges to
+nearly the same MAP code from any start of one mixture component, so refined walks differ where the draws fall in
+other components or basins, and from then on through the previous step's pose and speed; ``accept_cost`` and
+``prior_centre = "start"`` keep more of the draw. One seed gives one walk.
 ``random_starts = 0`` takes the tree's beam-search candidate instead (deterministic: every seed, the same walk).
 """
 
