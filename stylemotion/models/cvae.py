@@ -16,10 +16,9 @@ Which ``z`` (``style_latents``): the thesis writes ``decoder(z)`` next to the re
 styles as many fresh prior draws instead; ``both`` (default) styles both, so reconstructions and
 samples agree.
 
-α (``style_weight``) is 5 by default. The thesis' 200 is far too strong in our units (the Gram is
-divided by the number of time steps): on Bandai walk stances every sample collapses onto the
-example. α = 5 keeps the style (Table 5.1 diagonal, classifier recognition) and most of the
-variation; see ``docs/style.md`` (which data chose α) and ``configs/model/style_cvae.yaml``.
+α (``style_weight``) is 5 by default, chosen on Bandai validation clips (suite ``style_alpha``,
+benchmarks/evaluation.md): the thesis' 200 is far too strong in our units (the Gram is divided by the
+number of time steps) and collapses the samples onto the example; see ``docs/style.md``.
 
 Two departures from the thesis, off by default (measured in issue 12; history in
 ``git show 1c0f1b8:benchmarks/evaluation.md``, "Issue 12: the style term"): ``style_term=margin`` replaces
