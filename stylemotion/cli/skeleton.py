@@ -280,6 +280,7 @@ def hydra_command(command: str, config_name: str, work: Callable[[Any, str], Any
         from stylemotion.config import CONFIG_PACKAGE
 
         stop_on_sigterm()
+        started.clear()  # main runs once per process, but more than once in-process (tests, a notebook)
         with one_line_errors(command):
             register_schemas_for(config_name)
             check_overrides(config_name, sys.argv[1:])
