@@ -131,11 +131,13 @@ def test_a_moved_run_reuses_its_own_stages(reproduced, tmp_path: Path) -> None:
     out, _, _ = reproduced
     moved = tmp_path / "moved"
     shutil.copytree(out, moved)
+    record = (moved / "reproduce.json").read_bytes()
     lines: list[str] = []
     summary = reproduce(tiny_overrides(moved), lines)
     reused = [line for line in lines if line.startswith("[") and ": reused " in line]
     assert len(reused) == 8 and all(str(moved) in line for line in reused), lines
     assert {s["status"] for s in summary["stages"]} == {"reused"}
+    assert (moved / "reproduce.json").read_bytes() == record  # a finished run's record is left as it was
 
 
 def test_changed_settings_are_refused_not_overwritten(tiny_run, tmp_path: Path) -> None:

@@ -138,6 +138,7 @@ class Reproduction:
         self.started = time.perf_counter()
         self.stages: list[Stage] = []
         self.data_summary: dict[str, Any] = {}
+        self.evaluated = False  # whether this run (re)computed the report
 
     # -- stages
 
@@ -357,6 +358,7 @@ class Reproduction:
                                  autoencoder_ckpt=ae, command=command,
                                  root=self.out, extra_rows=extra)
         write_json(record, {"settings_hash": settings_hash, "report": self.recorded(report)})
+        self.evaluated = True
         return results
 
     def morphable_rows(self) -> dict[str, dict[str, Any]]:
@@ -543,13 +545,17 @@ def reproduce(cfg: DictConfig) -> dict[str, Any]:
     in_process = 1 if parallel else len(indexed)  # stage 1 is the autoencoder the others need
     for index, stage in indexed[:in_process]:
         repro.run_stage(index, stage)
-        write_json(repro.out / "reproduce.json", repro.summary())
+        if stage.status != "reused":
+            write_json(repro.out / "reproduce.json", repro.summary())
     if indexed[in_process:]:
         repro.run_stages_in_parallel(indexed[in_process:], workers)
     results = repro.evaluation_stage()
     summary = repro.summary()
     summary["report"] = repro.recorded(repro.out / "report")
-    write_json(repro.out / "reproduce.json", summary)
+    # a rerun that reused every stage and the report leaves the finished run's record as it was
+    if repro.evaluated or any(s.status != "reused" for s in repro.stages) \
+            or not (repro.out / "reproduce.json").is_file():
+        write_json(repro.out / "reproduce.json", summary)
     log.info(f"done in {summary['seconds'] / 60:.1f} min: "
              + ", ".join(f"{k} {v}" for k, v in Counter(s.status for s in repro.stages).items()) + " training stages")
     for line in summary_lines(results):

@@ -88,7 +88,7 @@ def test_the_query_take_is_excluded_by_default_and_gifs_are_written(tmp_path: Pa
     ({"k": 6721, "exclude_query_take": False}, "k=6721 exceeds the database's 6720 frames"),
     ({"k": 6481}, f"k=6481 exceeds the database's 6480 frames outside the query's take {TAKE}"),
     ({"k": 0}, "k must be a whole number ≥ 1, got 0"),
-    ({"data": {**SYNTHETIC, "contents": []}}, "data=synthetic: dataset 'synthetic' has no takes to search"),
+    ({"data": {**SYNTHETIC, "contents": []}}, "data=synthetic: data.contents=[] selects no content"),
     ({"query": f"{TAKE}:200-300"}, f"query={TAKE}:200-300: the frame range 200-300 ends after the take's last "
                                    f"frame: {TAKE} has 240 frames (0-240) at 30 fps"),
     ({"query": f"{TAKE}:9-3"}, f"query={TAKE}:9-3: the frame range '9-3' must be START-END"),
