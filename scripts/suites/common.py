@@ -6,11 +6,12 @@ path). Protocol: docs/benchmarks.md.
 
 from __future__ import annotations
 
+import argparse
 import logging
 import math
 import os
 import sys
-from collections.abc import Iterable, Iterator, Mapping, Sequence
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
@@ -120,3 +121,14 @@ def take_split_record(split: Mapping[str, Sequence[Any]], seed: int, val_fractio
             "takes": {part: len(takes) for part, takes in split.items()},
             "val_takes": sorted(getattr(t, "name", str(t)) for t in split.get("val", [])),
             "test_takes": sorted(getattr(t, "name", str(t)) for t in split.get("test", []))}
+
+
+def bandai_arguments(base: Any) -> Callable[[argparse.ArgumentParser], None]:
+    """``add_arguments`` of the suite module ``base`` with ``--data`` defaulting to ``bandai``: the Bandai twin of a
+    suite whose default is the synthetic smoke run, so that its results get a file of their own."""
+
+    def add_arguments(parser: argparse.ArgumentParser) -> None:
+        base.add_arguments(parser)
+        parser.set_defaults(data="bandai")
+
+    return add_arguments

@@ -8,23 +8,11 @@ synthetic smoke run (``benchmarks/results/zero_shot_bandai.json``). The same opt
 
 from __future__ import annotations
 
-import argparse
-from typing import Any
-
 from suites import zero_shot
+from suites.common import bandai_arguments
 
 DESCRIPTION = "zero-shot style network on Bandai walks: leave one style out without leakage, over seeds"
 DEFAULT_SEEDS = zero_shot.DEFAULT_SEEDS
-
-
-def add_arguments(parser: argparse.ArgumentParser) -> None:
-    zero_shot.add_arguments(parser)
-    parser.set_defaults(data="bandai")
-
-
-def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
-    return zero_shot.run(args, seeds)
-
-
-def render(record: dict[str, Any]) -> dict[str, str]:
-    return zero_shot.render(record)
+add_arguments = bandai_arguments(zero_shot)
+run = zero_shot.run
+render = zero_shot.render
