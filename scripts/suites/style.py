@@ -287,7 +287,8 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
                                     "clips of the model's style (variation_vs_style)",
                        "clips": clips,
                        "chosen_here": (f"α = {alpha:g}, chosen on validation clips (alpha_choice)" if alpha_choice
-                                       else "nothing: α and the style-term options are the configs' defaults")},
+                                       else "nothing: α (chosen by suite style_alpha) and the style-term "
+                                            "options are the configs' defaults")},
             "alpha_choice": alpha_choice,
             "primitives": primitives, "summary": summary, "overall": overall, "per_seed": per_seed}
 
@@ -317,7 +318,10 @@ def render(record: dict[str, Any]) -> dict[str, str]:
              if r["data"] == "synthetic" else "")
     split = r["splits"]["data"]
     sub = r.get("subsample") or {}
-    if sub.get("styles") or sub.get("primitives"):
+    if sub.get("primitives") and not sub.get("styles"):
+        label += (f"**Primitives {', '.join(sub['primitives'])} only** (every style; the thesis' Table 5.1 "
+                  "primitive; the other stance is not trained here). ")
+    elif sub.get("styles") or sub.get("primitives"):
         label += ("**Subsampled to fit the machine** (not the thesis' full setup: a smaller Table 5.1 is easier): "
                   + (f"CVAE styles {', '.join(sub['styles'])} (a seeded choice, the same for every seed)"
                      if sub.get("styles") else "every style")
@@ -343,7 +347,8 @@ def render(record: dict[str, Any]) -> dict[str, str]:
                   f"(min–max {fmt_range(o['recognition_mean_styled'], 3)}). "
                 + split_line + " "
                 + (f"α = {r['alpha_choice']['chosen']:g}, chosen on validation clips by this command (block alpha). "
-                   if r.get("alpha_choice") else f"α: {r['splits'].get('chosen_here', 'the config default')}. ")
+                   if r.get("alpha_choice") else "α: the config default, chosen on Bandai validation clips by suite "
+                   "style_alpha; the style-term options: the configs' defaults. ")
                 + prov)
 
     blocks = {"headline": headline}
