@@ -143,9 +143,11 @@ def train_candidate(container: dict[str, Any], folder: str) -> dict[str, float]:
         train_run(OmegaConf.create(container))
         val = dict(read_json_object(path / "metrics.json", "an α candidate's metrics", f"delete {path}").get("val")
                    or {})
-    if "samples/pose_across_sd" not in val:  # records written before the rule read the samples' spread
-        val["samples/pose_across_sd"] = prior_sample_spread(path / "checkpoints" / "best.ckpt",
-                                                            seed=int(container.get("seed", 0)))
+    if "samples/pose_across_sd" in val:
+        return val
+    # trained now, or recorded before the rule read the samples' spread
+    val["samples/pose_across_sd"] = prior_sample_spread(path / "checkpoints" / "best.ckpt",
+                                                        seed=int(container.get("seed", 0)))
     write_json(record, {"val": val})
     return val
 

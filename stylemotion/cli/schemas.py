@@ -18,68 +18,32 @@ first (registering twice is harmless).
 
 from __future__ import annotations
 
+import importlib
 from collections.abc import Callable, Sequence
+from functools import partial
 
-
-def _segment() -> type:
-    from stylemotion.primitives.segmentation import SegmentSettings
-
-    return SegmentSettings
-
-
-def _evaluation() -> type:
-    from stylemotion.evaluation.settings import EvalSettings
-
-    return EvalSettings
-
-
-def _follow() -> type:
-    from stylemotion.synthesis.controller import FollowSettings
-
-    return FollowSettings
-
-
-def _search() -> type:
-    from stylemotion.search.settings import SearchSettings
-
-    return SearchSettings
-
-
-def _annotate() -> type:
-    from stylemotion.annotate.settings import AnnotateSettings
-
-    return AnnotateSettings
-
-
-def _reconstruct() -> type:
-    from stylemotion.reconstruct.settings import ReconstructSettings
-
-    return ReconstructSettings
-
-
-def _keyframes() -> type:
-    from stylemotion.reconstruct.settings import KeyframesSettings
-
-    return KeyframesSettings
-
-
-def _texture() -> type:
-    from stylemotion.reconstruct.settings import TextureSettings
-
-    return TextureSettings
-
-
-def _style() -> type:
-    from stylemotion.style_example.settings import StyleSettings
-
-    return StyleSettings
-
-
-#: Schema name (``schema/<name>`` in a defaults list) → the dataclass, imported when registered.
-SCHEMAS: dict[str, Callable[[], type]] = {
-    "segment": _segment, "evaluation": _evaluation, "follow": _follow, "search": _search, "annotate": _annotate,
-    "reconstruct": _reconstruct, "keyframes": _keyframes, "texture": _texture, "style": _style,
+#: Schema name (``schema/<name>`` in a defaults list) → ``module:Class`` of its dataclass.
+SCHEMA_CLASSES: dict[str, str] = {
+    "segment": "stylemotion.primitives.segmentation:SegmentSettings",
+    "evaluation": "stylemotion.evaluation.settings:EvalSettings",
+    "follow": "stylemotion.synthesis.controller:FollowSettings",
+    "search": "stylemotion.search.settings:SearchSettings",
+    "annotate": "stylemotion.annotate.settings:AnnotateSettings",
+    "reconstruct": "stylemotion.reconstruct.settings:ReconstructSettings",
+    "keyframes": "stylemotion.reconstruct.settings:KeyframesSettings",
+    "texture": "stylemotion.reconstruct.settings:TextureSettings",
+    "style": "stylemotion.style_example.settings:StyleSettings",
 }
+
+
+def _import_class(path: str) -> type:
+    """The class ``module:Class`` names, its module imported now (not when this module is)."""
+    module, _, name = path.partition(":")
+    return getattr(importlib.import_module(module), name)
+
+
+#: Schema name → the dataclass, imported when registered.
+SCHEMAS: dict[str, Callable[[], type]] = {name: partial(_import_class, path) for name, path in SCHEMA_CLASSES.items()}
 
 #: Where each schema sits in the configs that take it: a key (``- schema@segment: segment``) or the top level
 #: (``""``: ``- schema@_here_: search``, the command's own keys).
