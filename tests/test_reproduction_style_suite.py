@@ -29,6 +29,8 @@ def test_diagonal_counts_match_the_distance_matrix(tiny_run) -> None:
         assert (got["diagonal_rows"], got["diagonal_columns"], got["models"]) == (rows, columns, len(d))
         detail = report["style_recognition"]["per_model_detail"][primitive]
         assert got["recognition"] == {m: v["share"] for m, v in detail.items()}
+    assert figures["autoencoder"]["test_mpjpe_m"] == report["autoencoder"]["test_mpjpe_m"] > 0
+    assert figures["autoencoder"]["test_local_mpjpe_m"] == report["autoencoder"]["test_local_mpjpe_m"] > 0
 
 
 def test_spreads_are_over_seeds(tiny_run, monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
@@ -56,6 +58,8 @@ def test_spreads_are_over_seeds(tiny_run, monkeypatch: pytest.MonkeyPatch, tmp_p
     blocks = style.render(record)
     assert {"headline", "recognition", "variation", "variation_vs_style", "per_seed"} <= set(blocks)
     assert "Synthetic data" in blocks["headline"] and "0.500 ± 0.300" in blocks["recognition"]
+    mpjpe_cm = 100 * report["autoencoder"]["test_mpjpe_m"]  # the same checkpoint in every seed: sd 0
+    assert f"{mpjpe_cm:.2f} ± 0.00 ({mpjpe_cm:.2f}–{mpjpe_cm:.2f})" in blocks["autoencoder"]
 
 
 def test_a_chosen_alpha_reaches_every_seed_and_its_table(tiny_run, monkeypatch: pytest.MonkeyPatch,
