@@ -48,7 +48,9 @@ NEUTRAL = "neutral"
 
 
 class LoadError(UserInputError, ValueError):
-    """A path :func:`load` cannot read as a model (the message names it and says what it expected)."""
+    """A path :func:`load` cannot read as a model, or a request the model cannot answer (sampling an autoencoder, a
+    zero-shot network without an example, a style a run does not have); the message names it and says what it
+    expected."""
 
 
 class NotFoundError(UserInputError, FileNotFoundError):
@@ -363,16 +365,30 @@ def _style_set(folder: Path, meta: Mapping[str, Any]) -> ModelSet:
 
 
 def load(path: str | os.PathLike) -> Model | ModelSet:
-    """The model(s) at ``path``: a checkpoint (``.ckpt``), a training run folder, a Morphable Graph ``model.npz``
-    (or its run folder), a ``stylemotion-reproduce`` run folder or a ``stylemotion-style`` folder.
+    """The model(s) at ``path``, whatever command wrote them (the table in the module doc).
+
+    Args:
+        path: a checkpoint (``.ckpt``: VAE, CVAE, zero-shot network or autoencoder), a ``stylemotion-train`` run
+            folder, a Morphable Graph ``model.npz`` (or its run folder), a ``stylemotion-reproduce`` run folder or a
+            ``stylemotion-style`` folder.
 
     Returns:
-        :class:`Model` for one model, :class:`ModelSet` for a reproduce or style folder; both ``sample(n, seed=0,
-        example=None)`` and ``describe()``.
+        :class:`Model` for one model, :class:`ModelSet` for a reproduce or style folder; both have
+        ``sample(n, seed=0, example=None)`` (→ :class:`~stylemotion.models.sampling.MotionSamples`) and
+        ``describe()`` (→ :class:`Description`).
 
     Raises:
         NotFoundError: nothing at ``path``.
         LoadError: something that is none of these (the message says what was looked for).
+
+    Example::
+
+        run = stylemotion.load("runs/reproduce/synthetic")
+        print(run.describe())                                   # kind, data, command, commit, its models
+        motions = run.sample(100, seed=0, style="elderly")      # positions (100, frames, 21, 3) metres
+        vae = stylemotion.load("runs/reproduce/synthetic/vae/walk_leftStance")   # one model
+        network = stylemotion.load("runs/style/mine/network/walk_leftStance")    # a zero-shot network:
+        tired = network.sample(10, seed=0, example="my_walk.bvh:120-480")        #   the example's style
     """
     from stylemotion.synthesis.graph import style_folder_meta
 
@@ -401,8 +417,23 @@ def load(path: str | os.PathLike) -> Model | ModelSet:
 
 def sample(model: str | os.PathLike | Model | ModelSet, n: int, seed: int | None = 0, example: Any = None,
            **choice: Any) -> Any:
-    """``n`` motions of ``model`` (a path, loaded with :func:`load`, or a loaded model); ``choice``: ``style=`` and
-    ``primitive=`` of a run or style folder. Returns :class:`~stylemotion.models.sampling.MotionSamples`."""
+    """``n`` motions of a model in one call: :func:`load` then ``sample``.
+
+    Args:
+        model: a path :func:`load` reads, or a model it returned.
+        n: how many motions.
+        seed: the same seed gives the same motions (None: a fresh draw).
+        example: a zero-shot network's style example (see :meth:`Model.sample`).
+        choice: ``style=`` and ``primitive=`` of a run or style folder (:meth:`ModelSet.model`).
+
+    Returns:
+        :class:`~stylemotion.models.sampling.MotionSamples`: ``positions`` ``(n, frames, 21, 3)`` metres at ``fps``,
+        padded past each ``num_frames[i]`` (``samples.motion(i)`` is motion ``i`` alone).
+
+    Example::
+
+        motions = stylemotion.sample("runs/reproduce/synthetic", 16, seed=1, style="youthful")
+    """
     loaded = model if isinstance(model, (Model, ModelSet)) else load(model)
     if choice and not isinstance(loaded, ModelSet):
         raise LoadError(f"{loaded.path} is one model; style=/primitive= choose among a run folder's models")

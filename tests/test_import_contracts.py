@@ -17,8 +17,9 @@ package ``__init__``). Contracts:
   with training's run record);
 * no private name (``_x``) is imported from another top-level package.
 
-Plus, in fresh interpreters: importing the commands that read a user's motion, and ``stylemotion.config``,
-loads no Lightning, and no torch or scikit-learn (the numpy side).
+Plus, in fresh interpreters: importing the package (``import stylemotion``: its public API loads on first use), the
+commands that read a user's motion, and ``stylemotion.config``, loads no Lightning, and no torch or scikit-learn
+(the numpy side).
 """
 
 from __future__ import annotations
@@ -231,7 +232,7 @@ def test_the_contracts_catch_a_bad_import(monkeypatch):
         graph.cache_clear()
 
 
-LIGHT = ["stylemotion.config", "stylemotion.search.command", "stylemotion.annotate.command",
+LIGHT = ["stylemotion", "stylemotion.config", "stylemotion.search.command", "stylemotion.annotate.command",
          "stylemotion.reconstruct.command", "stylemotion.datasets.user_motion"]
 
 
@@ -245,7 +246,7 @@ def test_reading_a_users_motion_loads_no_lightning(module):
     assert done.stdout.strip() == "", f"import {module} loads {done.stdout.strip()}"
 
 
-NUMPY_SIDE = ["stylemotion.config", "stylemotion.search.command", "stylemotion.reconstruct.command",
+NUMPY_SIDE = ["stylemotion", "stylemotion.config", "stylemotion.search.command", "stylemotion.reconstruct.command",
               "stylemotion.annotate.command", "stylemotion.datasets.user_motion"]
 
 
@@ -259,3 +260,26 @@ def test_the_numpy_side_loads_no_torch_or_scikit_learn(module):
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, done.stderr
     assert done.stdout.strip() == "", f"import {module} loads {done.stdout.strip()}"
+
+
+def test_the_public_api_resolves_and_explains_itself():
+    """Every name of ``stylemotion.__all__`` loads from its module (not at ``import stylemotion``) and has a docstring
+    with its arguments or an example for a newcomer."""
+    code = ("import stylemotion, inspect\n"
+            "for name in stylemotion.__all__:\n"
+            "    obj = getattr(stylemotion, name)\n"
+            "    doc = inspect.getdoc(obj) or ''\n"
+            "    told = any(w in doc for w in ('Args:', 'Example', 'Attributes:'))\n"
+            "    print(name, len(doc), told)")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    rows = [line.split() for line in done.stdout.splitlines()]
+    import stylemotion
+
+    assert [r[0] for r in rows] == list(stylemotion.__all__)
+    assert {"load", "sample", "evaluate", "walk", "search_motion", "reconstruct_motion", "annotate_motion",
+            "view"} <= set(stylemotion.__all__)
+    assert all(int(r[1]) > 80 for r in rows), rows
+    explained = {r[0] for r in rows if r[2] == "True"}
+    assert {"load", "sample", "evaluate", "walk", "search_motion", "reconstruct_motion", "annotate_motion",
+            "view"} <= explained
