@@ -17,12 +17,24 @@ Speed (ms per alignment or k-NN query) is not measured here: it needs an idle ma
 from __future__ import annotations
 
 import argparse
+import time
 from collections import Counter, defaultdict
 from pathlib import Path
 from typing import Any
 
 import numpy as np
-from suites.common import DATA_ROOT, fmt, fmt_spread, md_table, provenance_line, spread, take_split_record
+from suites.common import (
+    DATA_ROOT,
+    fmt,
+    fmt_spread,
+    md_table,
+    provenance_line,
+    quantiles,
+    spread,
+    take_split_record,
+)
+
+from stylemotion.search.settings import SearchSettings
 
 DESCRIPTION = ("motion-database search: LNG vs exact subsequence DTW (k chosen on val queries), precision@10 by "
                "content, queries from other captures")
@@ -37,10 +49,18 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--ks", type=int, nargs="+", default=[64, 256, 1024], help="candidate neighbours per frame")
     parser.add_argument("--lng-queries", type=int, default=20,
                         help="LNG vs DTW queries per seed, query length and split (val, test)")
-    parser.add_argument("--lengths-s", type=float, nargs="+", default=[1.0, 3.0], help="LNG vs DTW query lengths")
+    parser.add_argument("--lengths-s", type=float, nargs="+", default=[1.0, 3.0, 5.0], help="LNG vs DTW query lengths")
+    parser.add_argument("--grow-rules", nargs="+", default=["stable", "path"], help="k growth rules chosen among")
+    parser.add_argument("--grow-bounds", type=int, nargs="+", default=[4096, 16384],
+                        help="k_max candidates of the growth")
+    parser.add_argument("--eps", type=float, nargs="+", default=[0.1, 0.5], help="ε-approximate k-NN evaluated")
+    parser.add_argument("--radii", type=float, nargs="+", default=[0.2], help="fixed radii (E15 units) evaluated")
+    parser.add_argument("--approx-lengths-s", type=float, nargs="+", default=[1.0, 3.0],
+                        help="test query lengths on which ε and radius searches are evaluated")
     parser.add_argument("--retrieval-s", type=float, default=2.0, help="retrieval query length, s")
     parser.add_argument("--capture-windows", type=int, default=4, help="windows per capture file, length and seed")
-    parser.add_argument("--capture-lengths-s", type=float, nargs="+", default=[1.0, 2.0])
+    parser.add_argument("--capture-lengths-s", type=float, nargs="+", default=[1.0, 2.0],
+                        help="capture window lengths (the files hold 2.1–2.7 s)")
     parser.add_argument("--rank-frames", type=int, default=256, help="frames per seed of the rank agreement")
     parser.add_argument("--rank-k", type=int, default=512, help="nearest frames per frame of the rank agreement")
     parser.add_argument("--rank-features", nargs="+", default=None, help="feature sets (default: all)")
@@ -70,11 +90,104 @@ def _choose_k(val: dict[int, list[float]], ks: list[int]) -> tuple[int, str]:
                                                     f"highest share")
 
 
+def _growth_name(grow: str, k_max: int) -> str:
+    """Key of a growth rule in the results: ``grow <rule> to <k_max>``."""
+    return f"grow {grow} to {k_max}"
+
+
+def _val_share(per: dict[Any, list], seeds: list[int], lengths: list[float], ks: list[int]) -> dict[int, list[float]]:
+    """Per fixed k, the per-seed share of val 1 s queries whose LNG best is DTW's."""
+    first = min(lengths)
+    return {k: [float(np.mean([r["same_segment"] for r in per[("val", seed, first, k)]])) for seed in seeds]
+            for k in ks}
+
+
+def _choose_growth(per: dict[Any, list], used: dict[Any, list], seeds: list[int], lengths: list[float],
+                   candidates: list[tuple[str, int]], start_k: int) -> dict[str, Any]:
+    """The growth rule (grow, k_max) chosen on every val query (all lengths): among those that answer every
+    query and return DTW's best segment for the aim's share (mean over seeds), the one of least mean k used;
+    else the highest share (then least mean k). Remaining ties (a bound no val query reached costs nothing
+    more on val) go to the larger k_max: headroom for queries unlike validation's."""
+    scores = {}
+    for grow, km in candidates:
+        name = _growth_name(grow, km)
+        records = {seed: [r for sec in lengths for r in per[("val", seed, sec, name)]] for seed in seeds}
+        ks_used = [u for seed in seeds for sec in lengths for u in used[("val", seed, sec, name)]]
+        scores[name] = {"grow": grow, "k_max": km,
+                        "same_segment": [float(np.mean([r["same_segment"] for r in rs])) for rs in records.values()],
+                        "no_path": int(sum(r["no_path"] for rs in records.values() for r in rs)),
+                        "queries": int(sum(len(rs) for rs in records.values())),
+                        "mean_k_used": float(np.mean(ks_used)), "max_k_used": int(np.max(ks_used))}
+    mean = {n: float(np.mean(v["same_segment"])) for n, v in scores.items()}
+    reaching = [n for n, v in scores.items() if v["no_path"] == 0 and mean[n] >= SAME_SEGMENT_AIM]
+    if reaching:
+        name = min(reaching, key=lambda n: (scores[n]["mean_k_used"], -scores[n]["k_max"]))
+        why = (f"least mean k used among the rules answering every val query with DTW's best segment for "
+               f"≥ {SAME_SEGMENT_AIM:.0%} of them (ties: the larger k_max)")
+    else:
+        name = max(scores, key=lambda n: (mean[n], -scores[n]["mean_k_used"], scores[n]["k_max"]))
+        why = f"no rule reached {SAME_SEGMENT_AIM:.0%} with every val query answered: the highest share"
+    return {"candidates": scores, "start_k": start_k, "rule": why, "aim": SAME_SEGMENT_AIM, "chosen_name": name,
+            "chosen": [scores[name]["grow"], scores[name]["k_max"]],
+            "default_at_run": [SearchSettings.grow, SearchSettings.k_max], "lengths_s": lengths}
+
+
+def _test_variants(chosen: list[Any]) -> list[tuple[str, int]]:
+    """The growth rules run on test: the chosen one and, beside it, its other rule to the same bound."""
+    grow, km = chosen
+    other = "path" if grow == "stable" else "stable"
+    return [(grow, km), (other, km)]
+
+
+def _as_best(result: Any, index: Any) -> tuple[int, int, float, int] | None:
+    if not result.matches:
+        return None
+    top = result.matches[0]
+    return top.global_start, top.global_end - 1, top.cost, int(index.database.take_id[top.global_start])
+
+
+def _test_extras(features: np.ndarray, index: Any, cache: Any, seconds: float, args: argparse.Namespace,
+                 chosen: list[Any], start_k: int, costs: dict[Any, list], used: dict[Any, list],
+                 seed: int) -> dict[str, Any]:
+    """On a test query: the gap-tolerant steps at the start k; seconds of the chosen growth (and of the ε and
+    fixed-radius searches with it) as a ratio to the fixed start k, timed back to back; their answers."""
+    from stylemotion.search import search_features
+    from stylemotion.search.lng import GAP_STEPS, lng_match
+
+    grow, km = chosen
+    dist, ind = cache(start_k)
+    found = lng_match(ind, dist, index.database.take_bounds, steps=GAP_STEPS, top=1)
+    out = {f"gaps at {start_k}": (found[0].start, found[0].end, found[0].cost, found[0].take) if found else None}
+    used[("test", seed, seconds, f"gaps at {start_k}")].append(start_k)
+
+    def timed(**options: Any) -> tuple[Any, float]:
+        t0 = time.perf_counter()
+        result = search_features(features, index, start_k, 1, **options)
+        return result, time.perf_counter() - t0
+
+    _, old = timed()
+    result, new = timed(k_max=km, grow=grow)
+    costs[(seconds, _growth_name(grow, km))].append(new / old)
+    if seconds in args.approx_lengths_s:
+        for eps in args.eps:
+            result, t = timed(k_max=km, grow=grow, eps=eps)
+            out[f"eps {eps:g}"] = _as_best(result, index)
+            used[("test", seed, seconds, f"eps {eps:g}")].append(result.k)
+            costs[(seconds, f"eps {eps:g}")].append(t / old)
+        for radius in args.radii:
+            result, t = timed(k_max=km, grow=grow, radius=radius)
+            out[f"radius {radius:g}"] = _as_best(result, index)
+            used[("test", seed, seconds, f"radius {radius:g}")].append(result.k)
+            costs[(seconds, f"radius {radius:g}")].append(t / old)
+    return out
+
+
 def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
     from stylemotion.datasets import TakeSet, load_dataset
     from stylemotion.search import DEFAULT_K, FrameIndex
     from stylemotion.search.evaluation import (
         STILL_SPEED_M_S,
+        NeighbourCache,
         compare_lng_dtw,
         mean_joint_speed,
         random_segments,
@@ -90,48 +203,78 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
                  "test": TakeSet("bandai-train+val", split["train"] + split["val"], bandai.fps)}
     indexes = {part: FrameIndex.build(ts, "E15") for part, ts in databases.items()}
 
-    # 1. LNG vs DTW: per split, seed, length and k, the per-query comparisons.
-    per: dict[str, Any] = defaultdict(list)  # (part, seed, seconds, k) -> records
+    # 1. LNG vs DTW: per split, seed, length and k (or k-rule), the per-query comparisons. Validation first: it
+    # chooses the fixed k (as before) and the growth rule; test then reports both.
+    per: dict[Any, list] = defaultdict(list)  # (part, seed, seconds, key) -> records
+    used: dict[Any, list] = defaultdict(list)  # (part, seed, seconds, key) -> k used per query
     classes: dict[tuple[str, float], list[str]] = defaultdict(list)
+    costs: dict[Any, list] = defaultdict(list)  # (seconds, key) -> test seconds per query
     swept = []
+    candidates = [(rule, km) for rule in args.grow_rules for km in sorted(set(args.grow_bounds))]
+    growth_choice: dict[str, Any] = {}
     for p, part in enumerate(("val", "test")):
         index, takes = indexes[part], split[part]
         bounds = index.database.take_bounds
+        if part == "test":
+            chosen, rule = _choose_k(_val_share(per, seeds, args.lengths_s, ks), ks)
+            growth_choice = _choose_growth(per, used, seeds, args.lengths_s, candidates, DEFAULT_K)
+            candidates = _test_variants(growth_choice["chosen"])
         for seed in seeds:
             for seconds in args.lengths_s:
                 m = int(round(seconds * bandai.fps))
                 rng = np.random.default_rng([seed, p, m])
                 for t, start in random_segments([tk.num_frames for tk in takes], m, args.lng_queries, rng):
                     clip = np.asarray(takes[t].positions[start:start + m])
-                    result = compare_lng_dtw(index.features_of(clip), index, bounds, ks)
+                    features = index.features_of(clip)
+                    cache = NeighbourCache(index, features, bounds)
+                    cache(max(ks))
+                    variants = {}
+                    for grow, km in candidates:
+                        name = _growth_name(grow, km)
+                        variants[name], k_used = cache.grown(DEFAULT_K, km, grow)
+                        used[(part, seed, seconds, name)].append(k_used)
+                    bounding = list(variants)
+                    if part == "test":
+                        variants.update(_test_extras(features, index, cache, seconds, args, growth_choice["chosen"],
+                                                     DEFAULT_K, costs, used, seed))
+                        bounding += [v for v in variants if v.startswith(("eps", "radius"))]
+                    result = compare_lng_dtw(features, index, bounds, ks, variants, cache, bounding)
                     swept.append(result.takes_swept)
                     still = "still" if mean_joint_speed(clip, bandai.fps) < STILL_SPEED_M_S else "moving"
                     classes[(part, seconds)].append(still)
-                    for k in ks:
-                        per[(part, seed, seconds, k)].append(result.record(k))
-    summaries = [{"split": part, "seed": seed, "query_s": seconds, "k": k,
-                  **summarize_lng(per[(part, seed, seconds, k)])}
-                 for part in ("val", "test") for seed in seeds for seconds in args.lengths_s for k in ks]
-    val_share = {k: [s["same_segment"] for s in summaries if s["split"] == "val" and s["k"] == k
-                     and s["query_s"] == min(args.lengths_s)] for k in ks}
-    chosen, rule = _choose_k(val_share, ks)
+                    for key in result.lng:
+                        per[(part, seed, seconds, key)].append(result.record(key))
+    keys = sorted({key[3] for key in per}, key=str)
+    summaries = [{"split": part, "seed": seed, "query_s": seconds, "k": key,
+                  **summarize_lng(per[(part, seed, seconds, key)])}
+                 for part in ("val", "test") for seed in seeds for seconds in args.lengths_s for key in keys
+                 if per.get((part, seed, seconds, key))]
+    val_share = _val_share(per, seeds, args.lengths_s, ks)
     pooled = []
     for part in ("val", "test"):
         for seconds in args.lengths_s:
-            for k in ks:
-                records = [r for seed in seeds for r in per[(part, seed, seconds, k)]]
+            for key in keys:
+                records = [r for seed in seeds for r in per.get((part, seed, seconds, key), [])]
+                if not records:
+                    continue
                 labels = classes[(part, seconds)]
-                row = {"split": part, "query_s": seconds, "k": k, **summarize_lng(records)}
+                row = {"split": part, "query_s": seconds, "k": key, **summarize_lng(records)}
+                ks_used = [u for seed in seeds for u in used.get((part, seed, seconds, key), [])]
+                if ks_used:
+                    row["k_used"] = {"mean": float(np.mean(ks_used)), **quantiles(ks_used),
+                                     "counts": {str(k): int(n) for k, n in sorted(Counter(ks_used).items())}}
                 for label in ("still", "moving"):
                     chosen_records = [r for r, c in zip(records, labels) if c == label]
                     row[label] = summarize_lng(chosen_records) if chosen_records else {"queries": 0}
                 pooled.append(row)
+    timing = {f"{seconds:g}|{key}": {"ratio": spread(v), **quantiles(v)} for (seconds, key), v in costs.items()}
 
     # 2. Retrieval precision@10 by content, test takes against train + val, chosen k.
     retrieval = _retrieval(indexes["test"], split["test"], seeds, args.retrieval_s, chosen)
 
     # 3. Other captures against all of Bandai with the command's defaults.
-    captures = _captures(bandai, seeds, args.capture_windows, args.capture_lengths_s, DEFAULT_K)
+    captures = _captures(bandai, seeds, args.capture_windows, args.capture_lengths_s, DEFAULT_K,
+                         growth_choice["chosen"])
 
     # 4. Rank agreement between feature sets (Fig. 2.5/2.7) on the train + val database.
     from stylemotion.search import feature_names
@@ -155,6 +298,9 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
             "still_speed_m_s": STILL_SPEED_M_S,
             "k_choice": {"candidates": ks, "val_same_segment_1s": {str(k): val_share[k] for k in ks},
                          "rule": rule, "aim": SAME_SEGMENT_AIM, "chosen": chosen, "default_at_run": DEFAULT_K},
+            "growth": growth_choice, "time_ratio": timing,
+            "approx": {"eps": args.eps, "radii": args.radii, "lengths_s": args.approx_lengths_s,
+                       "note": "evaluated on test with the chosen growth; not tuned, defaults eps=0, radius=None"},
             "dtw_takes_swept": {"mean": float(np.mean(swept)), "max": int(np.max(swept))},
             "lng_per_seed": summaries, "lng_pooled": pooled, "retrieval": retrieval, "captures": captures,
             "ranks": ranks, "turns_by_features": turns}
@@ -227,19 +373,27 @@ def _retrieval(index: Any, takes: list[Any], seeds: list[int], seconds: float, k
             "turn_opposite_share": {c: spread(v) for c, v in sorted(opposite_share.items())}}
 
 
-def _captures(bandai: Any, seeds: list[int], windows: int, lengths_s: list[float], k: int) -> dict[str, Any]:
-    from stylemotion.search import FrameIndex, search_motion
+def _captures(bandai: Any, seeds: list[int], windows: int, lengths_s: list[float], k: int,
+              growth: list[Any]) -> dict[str, Any]:
+    """Windows of the other-skeletons walks against all of Bandai: from the command's k, growing by the rule
+    chosen on validation (``growth``: grow, k_max), and, beside it, the fixed k alone (the search before
+    growth); each against exact subsequence DTW."""
+    from stylemotion.search import FrameIndex, search_features
     from stylemotion.search.command import load_query
-    from stylemotion.search.evaluation import precision_at
+    from stylemotion.search.dtw import best_subsequence_match
+    from stylemotion.search.evaluation import precision_at, spearman_with_misses
 
+    grow, k_max = growth
     index = FrameIndex.build(bandai, "E15")
+    bounds = index.database.take_bounds
     folder = DATA_ROOT / "other-skeletons"
     files = {name: load_query(str(folder / name), bandai, index.database) for name in CAPTURES}
     rows = []
     for seconds in lengths_s:
         per_seed: dict[str, list[float]] = defaultdict(list)
         contents: Counter = Counter()
-        answered = queries = 0
+        answered = answered_fixed = queries = same = same_fixed = 0
+        lng_costs, fixed_costs, dtw_costs, ks_used, ratios = [], [], [], [], []
         for seed in seeds:
             rng = np.random.default_rng([seed, 3, int(seconds * 1000)])
             p10, walk10, near_walk = [], [], []
@@ -249,14 +403,29 @@ def _captures(bandai: Any, seeds: list[int], windows: int, lengths_s: list[float
                 for _ in range(windows):
                     start = int(rng.integers(0, total - span + 1))
                     query = load_query(f"{folder / name}:{start}-{start + span}", bandai, index.database)
-                    result = search_motion(query.positions, index, k, 10)
+                    features = index.features_of(query.positions)
+                    t0 = time.perf_counter()
+                    fixed = search_features(features, index, k, 10)
+                    t1 = time.perf_counter()
+                    result = search_features(features, index, k, 10, k_max=k_max, grow=grow)
+                    ratios.append((time.perf_counter() - t1) / (t1 - t0))
+                    ks_used.append(result.k)
                     found = result.matches
+                    upper = found[0].cost if found else None
+                    best, _ = best_subsequence_match(features, index.features, bounds, upper_bound=upper)
+                    dtw_costs.append(best.cost)
+                    lng_costs.append(found[0].cost if found else None)
+                    fixed_costs.append(fixed.matches[0].cost if fixed.matches else None)
+                    same += bool(found) and (found[0].global_start, found[0].global_end - 1) == (best.start, best.end)
+                    same_fixed += bool(fixed.matches) and (fixed.matches[0].global_start,
+                                                           fixed.matches[0].global_end - 1) == (best.start, best.end)
                     labels = [x.content for x in found]
-                    nearest = [index.database.contents[t] for t in index.database.take_id[result.indices[:, 0]]]
+                    nearest = [index.database.contents[t] for t in index.database.take_id[fixed.indices[:, 0]]]
                     near_walk.append(sum(c in LOCOMOTION for c in nearest) / len(nearest))
                     contents.update(labels)
                     queries += 1
                     answered += bool(found)
+                    answered_fixed += bool(fixed.matches)
                     p10.append(precision_at(labels, "walk", 10))
                     walk10.append(sum(c in LOCOMOTION for c in labels[:10]) / 10)
             per_seed["p10_walk"].append(float(np.mean(p10)))
@@ -264,17 +433,101 @@ def _captures(bandai: Any, seeds: list[int], windows: int, lengths_s: list[float
             per_seed["nearest_walk_or_turn"].append(float(np.mean(near_walk)))
         total_matches = sum(contents.values())
         rows.append({"query_s": seconds, "queries": queries, "answered": answered, "matches": total_matches,
+                     "answered_fixed_k": answered_fixed, "same_segment": same / queries,
+                     "same_segment_fixed_k": same_fixed / queries,
+                     "spearman_rho": spearman_with_misses(lng_costs, dtw_costs),
+                     "spearman_rho_fixed_k": spearman_with_misses(fixed_costs, dtw_costs),
+                     "k_used": {"mean": float(np.mean(ks_used)), **quantiles(ks_used)},
+                     "time_ratio": {"mean": float(np.mean(ratios)), **quantiles(ratios)},
                      "contents": {c: n for c, n in contents.most_common()},
                      "p10_walk": spread(per_seed["p10_walk"]),
                      "p10_walk_or_turn": spread(per_seed["p10_walk_or_turn"]),
                      "nearest_walk_or_turn": spread(per_seed["nearest_walk_or_turn"])})
-    return {"files": list(CAPTURES), "k": k, "top": 10, "features": "E15", "windows_per_file_length_seed": windows,
+    return {"files": list(CAPTURES), "k": k, "k_max": k_max, "grow": grow,
+            "defaults": [SearchSettings.grow, SearchSettings.k_max], "top": 10,
+            "features": "E15", "windows_per_file_length_seed": windows,
             "database_takes": index.database.num_takes, "database_frames": index.database.num_frames,
             "file_fps": {n: q.record["file_fps"] for n, q in files.items()},
             "file_frames": {n: q.record["file_frames"] for n, q in files.items()}, "rows": rows}
 
 
 # --- rendering ---------------------------------------------------------------------------------------------------
+
+
+def _growth_blocks(r: dict[str, Any], seeds: int, prov: str) -> dict[str, str]:
+    """Blocks ``growth_choice`` (val), ``growth`` (test: every query answers?) and ``approx`` (ε, radius)."""
+    growth = r["growth"]
+    name, start = growth["chosen_name"], growth["start_k"]
+    crow = []
+    for cname, c in growth["candidates"].items():
+        crow.append([c["grow"], f"{c['k_max']:,}", _pct(float(np.mean(c["same_segment"]))),
+                     ", ".join(_pct(v) for v in c["same_segment"]), f"{c['no_path']} of {c['queries']}",
+                     fmt(c["mean_k_used"], 0), f"{c['max_k_used']:,}", "**chosen**" if cname == name else ""])
+    default = growth["default_at_run"]
+    note = ("the command's default (grow, k_max)" if list(default) == list(growth["chosen"])
+            else f"**differs from the command's default at the run ({default[0]}, {default[1]})**")
+    choice_block = (md_table(["grow", "k_max", "val: same best segment (mean)", "per seed", "no path",
+                              "mean k used", "max k used", ""], crow)
+                    + f"\n\nEvery val query of {', '.join(f'{x:g}' for x in growth['lengths_s'])} s (all seeds) from "
+                      f"the val takes against the train takes, k starting at {start} (the command's k) and doubled: "
+                      f"`stable` until the best segment at 2k is the one at k, `path` until a path exists, never past "
+                      f"k_max. Rule: {growth['rule']} (aim {_pct(growth['aim'])}); chosen {name}: {note}. {prov}")
+    lengths = sorted({p["query_s"] for p in r["lng_pooled"]})
+    variants = [start, *[_growth_name(*v) for v in _test_variants(growth["chosen"])], f"gaps at {start}"]
+    rows = []
+    for seconds in lengths:
+        for v in variants:
+            p = next((x for x in r["lng_pooled"] if x["split"] == "test" and x["query_s"] == seconds
+                      and x["k"] == v), None)
+            if p is None:
+                continue
+            ratio = r["time_ratio"].get(f"{seconds:g}|{v}", {})
+            ku = p.get("k_used") or {}
+            label = (f"k = {v} alone (before)" if isinstance(v, int) else
+                     f"{v} (**chosen**)" if v == name else str(v))
+            rows.append([f"{seconds:g} s", label, f"{p['queries'] - p['no_path']} of {p['queries']}",
+                         fmt_spread(_seed_spread(r, "test", seconds, v, "same_segment")),
+                         fmt_spread(_seed_spread(r, "test", seconds, v, "spearman_rho"), 3),
+                         f"{fmt(p['cost_ratio_mean'], 3)} / {fmt(p['cost_ratio_max'], 3)}",
+                         f"{fmt(ku.get('p50'), 0)} / {fmt(ku.get('p95'), 0)} / {fmt(ku.get('p100'), 0)}"
+                         if ku else f"{v}" if isinstance(v, int) else "—",
+                         (f"{fmt(ratio['ratio']['mean'], 2)} / {fmt(ratio['p95'], 2)} / {fmt(ratio['p100'], 2)}"
+                          if ratio else "1 (reference)" if isinstance(v, int) else "—")])
+    growth_block = (md_table(["query", "search", "answered", "same best segment", "Spearman ρ (no path = worst rank)",
+                              "LNG / DTW cost: mean / max", "k used: median / p95 / max",
+                              f"time × k = {start} alone: mean / p95 / max"], rows)
+                    + f"\n\nTest queries (random windows of the test takes, 3 lengths × "
+                      f"{r['lng_pooled'][0]['queries'] // max(seeds, 1)} per seed) against the train + val takes, "
+                      f"against exact subsequence DTW with the thesis' steps; a query without a path is a miss "
+                      f"everywhere. `gaps at {start}`: the gap-tolerant steps (thesis + the online skips (1,2), "
+                      f"(2,1), (2,2), a skipped query frame costing its k-th distance) at k = {start}, compared with "
+                      f"the same thesis-step DTW (their cheaper skipping paths are not DTW's). Time: the whole search "
+                      f"(k-NN + LNG, every k tried) over the search at k = {start} alone, timed back to back per query "
+                      f"on a shared machine (ratios only). {prov}")
+    approx = r["approx"]
+    arows = []
+    for seconds in approx["lengths_s"]:
+        for v in [name, *(f"eps {e:g}" for e in approx["eps"]), *(f"radius {x:g}" for x in approx["radii"])]:
+            p = next((x for x in r["lng_pooled"] if x["split"] == "test" and x["query_s"] == seconds
+                      and x["k"] == v), None)
+            if p is None:
+                continue
+            ratio = r["time_ratio"].get(f"{seconds:g}|{v}", {})
+            ku = p.get("k_used") or {}
+            arows.append([f"{seconds:g} s", "exact k-NN" if v == name else v,
+                          f"{p['queries'] - p['no_path']} of {p['queries']}",
+                          fmt_spread(_seed_spread(r, "test", seconds, v, "same_segment")),
+                          fmt_spread(_seed_spread(r, "test", seconds, v, "spearman_rho"), 3),
+                          f"{fmt(ku.get('p50'), 0)} / {fmt(ku.get('p100'), 0)}",
+                          f"{fmt(ratio['ratio']['mean'], 2)} / {fmt(ratio['p100'], 2)}" if ratio else "—"])
+    approx_block = (md_table(["query", "k-NN search", "answered", "same best segment", "Spearman ρ",
+                              "k used: median / max", f"time × k = {start} alone: mean / max"], arows)
+                    + f"\n\nThe chosen growth ({name} from k = {start}) with cKDTree's ε-approximate search (each "
+                      f"distance within 1 + ε of the true one) and with a fixed radius (feature units; only neighbours "
+                      f"within it, at most k; a frame with none left ends every path through it), on the test "
+                      f"queries above, against the same exact DTW. Not tuned: the command keeps eps = 0 and no "
+                      f"radius. {prov}")
+    return {"growth_choice": choice_block, "growth": growth_block, "approx": approx_block}
 
 
 def _pct(value: float | None) -> str:
@@ -299,19 +552,33 @@ def render(record: dict[str, Any]) -> dict[str, str]:
 
     # headline
     rows = []
+    growth = r.get("growth")
     for seconds in lengths:
         p = _pooled(r, "test", seconds, k)
         rows.append([f"LNG vs exact DTW, {seconds:g} s test queries (k = {k}, chosen on val)",
                      f"same best segment {fmt_spread(_seed_spread(r, 'test', seconds, k, 'same_segment'))}; "
                      f"ρ {fmt_spread(_seed_spread(r, 'test', seconds, k, 'spearman_rho'), 3)}; "
                      f"no path {p['no_path']} of {p['queries']}"])
+        if growth:
+            g = growth["chosen_name"]
+            p = _pooled(r, "test", seconds, g)
+            ratio = r["time_ratio"].get(f"{seconds:g}|{g}", {})
+            rows.append([f"LNG vs exact DTW, {seconds:g} s test queries, k from {growth['start_k']} {g} "
+                         f"(chosen on val)",
+                         f"same best segment {fmt_spread(_seed_spread(r, 'test', seconds, g, 'same_segment'))}; "
+                         f"ρ {fmt_spread(_seed_spread(r, 'test', seconds, g, 'spearman_rho'), 3)}; "
+                         f"answered {p['queries'] - p['no_path']} of {p['queries']}; k used median "
+                         f"{fmt(p['k_used']['p50'], 0)}, max {fmt(p['k_used']['p100'], 0)}; time × "
+                         f"{fmt(ratio.get('ratio', {}).get('mean'), 1)} of k = {growth['start_k']} alone"])
     ret = r["retrieval"]
     rows.append([f"precision@10 by content, {ret['query_s']:g} s test queries (missing matches wrong)",
                  f"{fmt_spread(ret['all']['p10'])}; no match for {fmt(ret['all']['none']['mean'], 1)} of "
                  f"{ret['queries_per_seed']} queries per seed"])
     for row in r["captures"]["rows"]:
+        extra = (f"; same best segment as DTW {_pct(row['same_segment'])}, ρ {fmt(row['spearman_rho'], 3)}"
+                 if "same_segment" in row else "")
         rows.append([f"other captures, {row['query_s']:g} s walk queries vs all of Bandai (command defaults)",
-                     f"answered {row['answered']} of {row['queries']}; precision@10 walk or turn "
+                     f"answered {row['answered']} of {row['queries']}{extra}; precision@10 walk or turn "
                      f"{fmt_spread(row['p10_walk_or_turn'])}"])
     headline = (md_table(["search (E15, thesis steps)", f"mean ± sd over {seeds} seeds of query choice"], rows)
                 + f"\n\nEvery query counts: one without an LNG path is a miss (ρ: worst rank). {prov}")
@@ -386,20 +653,36 @@ def render(record: dict[str, Any]) -> dict[str, str]:
     # other captures
     cap = r["captures"]
     caprow = []
+    grown = "k_max" in cap
     for row in cap["rows"]:
         top = ", ".join(f"{c} {n}" for c, n in row["contents"].items()) or "none"
-        caprow.append([f"{row['query_s']:g} s", str(row["queries"]), str(row["answered"]),
-                       fmt(row["matches"] / row["queries"], 1), top, fmt_spread(row["p10_walk"]),
-                       fmt_spread(row["p10_walk_or_turn"]), fmt_spread(row["nearest_walk_or_turn"])])
-    cap_block = (md_table(["query", "queries", "answered (≥ 1 match)", "matches per query", "contents of the matches",
-                           "precision@10 walk", "precision@10 walk or turn",
+        cells = [f"{row['query_s']:g} s", str(row["queries"]), str(row["answered"])]
+        if grown:
+            cells += [f"{row['answered_fixed_k']}",
+                      f"{_pct(row['same_segment'])} ({_pct(row['same_segment_fixed_k'])})",
+                      f"{fmt(row['spearman_rho'], 3)} ({fmt(row['spearman_rho_fixed_k'], 3)})",
+                      f"{fmt(row['k_used']['p50'], 0)} / {fmt(row['k_used']['p100'], 0)}",
+                      f"{fmt(row['time_ratio']['mean'], 1)} / {fmt(row['time_ratio']['p100'], 1)}"]
+        cells += [fmt(row["matches"] / row["queries"], 1), top, fmt_spread(row["p10_walk"]),
+                  fmt_spread(row["p10_walk_or_turn"]), fmt_spread(row["nearest_walk_or_turn"])]
+        caprow.append(cells)
+    fixed_head = ([f"answered at k = {cap['k']} alone", "same best segment as DTW (k alone)", "Spearman ρ vs DTW "
+                   "(k alone)", "k used: median / max", "time × k alone: mean / max"] if grown else [])
+    cap_block = (md_table(["query", "queries", "answered (≥ 1 match)", *fixed_head, "matches per query",
+                           "contents of the matches", "precision@10 walk", "precision@10 walk or turn",
                            "query frames whose nearest frame is a walk or turn"], caprow)
                  + f"\n\nOther captures: {cap['windows_per_file_length_seed']} random windows per file, length and "
                    f"seed of the three other-skeletons walks (two 21-joint 60 fps, one Xia 31-joint 120 fps), read and "
                    f"put on Bandai's skeleton as `stylemotion-search query=<file>:<start>-<end>` does, against all "
                    f"{cap['database_takes']:,} Bandai takes ({cap['database_frames']:,} frames) with the command's "
-                   f"defaults (E15, k = {cap['k']}, top {cap['top']}); precision counts missing matches wrong, "
-                   f"mean ± sd over seeds. {prov}")
+                   f"defaults (E15, k = {cap['k']}"
+                   + (f" growing to k_max = {cap['k_max']} by grow = {cap['grow']}, as chosen on validation"
+                      + ("" if cap.get("defaults") == [cap["grow"], cap["k_max"]] else
+                         f" (**the command's default at the run was {cap.get('defaults')}**)") if grown else "")
+                   + f", top {cap['top']}); precision counts missing matches wrong, mean ± sd over seeds"
+                   + ("; same best segment and ρ against exact subsequence DTW over all of Bandai (thesis steps), "
+                      "no path counted as a miss, pooled over seeds; time: the growing search's seconds over the "
+                      "fixed k's, timed back to back on each query" if grown else "") + f". {prov}")
     rk = r["ranks"]
     names = rk["features"]
     rank_rows = [[a, *(fmt(rk["rho"][a][b]["mean"]) for b in names)] for a in names]
@@ -429,5 +712,6 @@ def render(record: dict[str, Any]) -> dict[str, str]:
                     f"every set) against the train + val takes, k = {ret['k']} (chosen above on E15), top 10; "
                     f"mean ± sd over the seeds. The query's actor, content and style are in the database: easier "
                     f"than a user's query. {prov}") if tb else "No turn comparison in this results file."
-    return {"headline": headline, "turns": turn_block, "ranks": rank_block, "k_choice": k_block, "lng": lng_block,
-            "lng_still": still_block, "retrieval": ret_block, "captures": cap_block}
+    blocks = _growth_blocks(r, seeds, prov) if growth else {}
+    return {**blocks, "headline": headline, "turns": turn_block, "ranks": rank_block, "k_choice": k_block,
+            "lng": lng_block, "lng_still": still_block, "retrieval": ret_block, "captures": cap_block}

@@ -50,8 +50,8 @@ from stylemotion.provenance import provenance
 from stylemotion.search.database import MotionDatabase
 from stylemotion.search.features import feature_names, feature_spec
 from stylemotion.search.index import ENGINES, FrameIndex
-from stylemotion.search.lng import NORMALIZATIONS
-from stylemotion.search.matching import SearchResult, SegmentMatch, search_motion
+from stylemotion.search.lng import NORMALIZATIONS, STEP_SETS
+from stylemotion.search.matching import GROWTH, SearchResult, SegmentMatch, search_motion
 from stylemotion.search.settings import ExportSettings, FigureSettings, SearchSettings
 
 log = logging.getLogger(__name__)
@@ -139,19 +139,35 @@ def _checked_settings(features: Any, k: Any, top: Any, engine: Any, normalize: A
     return str(features), positive_int(k, "k"), positive_int(top, "top")
 
 
-def _checked_search(eps: Any, radius: Any) -> tuple[float, float | None]:
-    def number(value: Any) -> float:
-        return float(value) if isinstance(value, (int, float)) and not isinstance(value, bool) else float("nan")
+def _number(value: Any) -> float:
+    return float(value) if isinstance(value, (int, float)) and not isinstance(value, bool) else float("nan")
 
-    if not (number(eps) >= 0 and np.isfinite(number(eps))):
+
+def _checked_search(eps: Any, radius: Any) -> tuple[float, float | None]:
+    if not (_number(eps) >= 0 and np.isfinite(_number(eps))):
         raise SearchInputError(f"eps={eps} must be a finite number ≥ 0")
-    if radius is not None and not (number(radius) > 0 and np.isfinite(number(radius))):
+    if radius is not None and not (_number(radius) > 0 and np.isfinite(_number(radius))):
         raise SearchInputError(f"radius={radius} must be a positive number of feature units, or null")
-    return number(eps), None if radius is None else number(radius)
+    return _number(eps), None if radius is None else _number(radius)
+
+
+def _checked_growth(k: int, k_max: Any, grow: Any, steps: Any, skip_cost: Any) -> tuple[int, str, str, float | None]:
+    k_max = positive_int(k_max, "k_max")
+    if k_max < k:
+        raise SearchInputError(f"k_max={k_max} is below k={k}: the growth bound must be at least the first k")
+    if grow not in GROWTH:
+        raise SearchInputError(f"grow={grow} is none of {list(GROWTH)}")
+    if steps not in STEP_SETS:
+        raise SearchInputError(f"steps={steps} is none of {list(STEP_SETS)}")
+    if skip_cost is not None and not (_number(skip_cost) >= 0 and np.isfinite(_number(skip_cost))):
+        raise SearchInputError(f"skip_cost={skip_cost} must be a finite number ≥ 0 (feature units), or null")
+    return k_max, str(grow), str(steps), None if skip_cost is None else _number(skip_cost)
 
 
 def search(data: Mapping[str, Any], query: str, out: str | os.PathLike, *, features: str = _D.features,
-           k: int = _D.k, top: int = _D.top, eps: float = _D.eps, radius: float | None = _D.radius,
+           k: int = _D.k, k_max: int = _D.k_max, grow: str = _D.grow, steps: str = _D.steps,
+           skip_cost: float | None = _D.skip_cost, top: int = _D.top, eps: float = _D.eps,
+           radius: float | None = _D.radius,
            engine: str = _D.engine, normalize: str = _D.normalize, exclude_query_take: bool = _D.exclude_query_take,
            retarget_query: bool = _D.retarget_query, conversion: Mapping[str, Any] | None = None,
            export_bvh: bool = ExportSettings.bvh, export_gif: bool = ExportSettings.gif,
@@ -173,6 +189,7 @@ def search(data: Mapping[str, Any], query: str, out: str | os.PathLike, *, featu
     out = check_new_output(out, force)
     features, k, top = _checked_settings(features, k, top, engine, normalize)
     eps, radius = _checked_search(eps, radius)
+    k_max, grow, steps, skip_cost = _checked_growth(k, k_max, grow, steps, skip_cost)
     export_top = positive_int(export_top, "export.top")
     figure_matches = positive_int(figure_matches, "figure.matches")
     try:
@@ -205,12 +222,15 @@ def search(data: Mapping[str, Any], query: str, out: str | os.PathLike, *, featu
     build_s = time.perf_counter() - t0
     try:
         result = search_motion(q.positions, index, k, top, exclude_takes=exclude, eps=eps, radius=radius,
-                               normalize=normalize)
+                               normalize=normalize, k_max=k_max, grow=grow, steps=STEP_SETS[steps],
+                               skip_cost=skip_cost)
     except ValueError as exc:
         raise SearchInputError(f"query={query}: {exc}") from None
     records = [m.record() for m in result.matches]
     report = {
-        "query": {"value": str(query), **q.record}, "features": features, "k": k, "top": top, "eps": eps,
+        "query": {"value": str(query), **q.record}, "features": features, "k": k, "k_max": k_max, "grow": grow,
+        "k_used": result.k, "k_tried": list(result.k_tried), "steps": steps, "skip_cost": skip_cost,
+        "top": top, "eps": eps,
         "radius": radius, "engine": engine, "normalize": normalize, "excluded_takes": list(result.excluded_takes),
         "database": {"name": database.name, "takes": database.num_takes, "frames": database.num_frames,
                      "fps": database.fps, "digest": database.digest},
@@ -227,16 +247,18 @@ def search(data: Mapping[str, Any], query: str, out: str | os.PathLike, *, featu
 
             plot_distance_matrix(result, index, inside(tmp, "distance_matrix.png"), figure_matches,
                                  int(round(figure_margin_s * database.fps)),
-                                 f"{database.name}, features={features}, k={k}: query {query}")
+                                 f"{database.name}, features={features}, k={result.k}: query {query}")
         report["files"] = _exports(tmp, q, result, index, export_bvh, export_gif, export_top)
         report["timing_s"]["total"] = round(time.perf_counter() - started, 3)
         write_json(inside(tmp, "search.json"), report)
     if not records:
-        log.info(f"no match: no path through the k-NN graph of the {q.positions.shape[0]} query frames; "
-                 f"raise k (now {k})")
-    elif len(records) < top and k < database.num_frames:
-        log.info(f"{len(records)} of top={top} found: the {k} nearest frames of each query frame hold few paths; "
-                 f"a larger k finds more (benchmarks/search.md)")
+        log.info(f"no match: no path through the k-NN graph of the {q.positions.shape[0]} query frames at "
+                 f"k={result.k} (tried {', '.join(map(str, result.k_tried))}); raise k_max (now {k_max})")
+    elif len(records) < top and result.k < database.num_frames:
+        log.info(f"{len(records)} of top={top} found: the {result.k} nearest frames of each query frame hold few "
+                 f"paths; a larger k finds more (benchmarks/search.md)")
+    if len(result.k_tried) > 1:
+        log.info(f"k grew {' → '.join(map(str, result.k_tried))} (grow={grow}, k_max={k_max}); k used {result.k}")
     log.info(f"{len(records)} match(es) written to {out}" + (f"; best: {records[0]['take']} "
                                                          f"{records[0]['start']}-{records[0]['end']} cost "
                                                          f"{records[0]['cost']:.4g}" if records else ""))
@@ -276,7 +298,8 @@ def search_from_config(cfg: DictConfig, command: str = "") -> dict[str, Any]:
     """:func:`search` with the keys of ``stylemotion/configs/search.yaml`` (:class:`SearchSettings`)."""
     data, settings = settings_from_config(cfg, SearchSettings, "search")
     return search(
-        data, settings.query, settings.out, features=settings.features, k=settings.k, top=settings.top,
+        data, settings.query, settings.out, features=settings.features, k=settings.k, k_max=settings.k_max,
+        grow=settings.grow, steps=settings.steps, skip_cost=settings.skip_cost, top=settings.top,
         eps=settings.eps, radius=settings.radius, engine=settings.engine, normalize=settings.normalize,
         exclude_query_take=settings.exclude_query_take, retarget_query=settings.retarget_query,
         conversion=conversion_keys(vars(settings)), export_bvh=settings.export.bvh, export_gif=settings.export.gif,

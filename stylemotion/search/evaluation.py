@@ -22,7 +22,7 @@ from scipy.stats import rankdata
 
 from stylemotion.search.dtw import best_subsequence_match
 from stylemotion.search.index import FrameIndex
-from stylemotion.search.lng import TakeBounds, lng_match
+from stylemotion.search.lng import THESIS_STEPS, Match, TakeBounds, lng_match
 
 #: A query whose mean joint speed (all 21 joints, world frame) is below this is a "still pose" query, m/s.
 #: Bandai's takes begin and end standing; standing sway stays below it, a waving hand alone lifts the mean
@@ -73,6 +73,57 @@ def random_segments(lengths: Sequence[int], frames: int, count: int, rng: np.ran
     return [(usable[p], int(rng.integers(0, lengths[usable[p]] - frames + 1))) for p in picks]
 
 
+class NeighbourCache:
+    """The k nearest database frames of one query's frames, queried once per larger ``k`` and sliced for a
+    smaller one (the first ``j`` columns of an exact k-NN answer are the ``j`` nearest), with each k's LNG
+    answer kept: every k-rule (a fixed k, :func:`~stylemotion.search.matching.grow_k` with any start and bound)
+    is then evaluated on the same neighbours without a second search.
+
+    ``features``: ``(m, d)`` the query's; ``eps``/``radius``: :meth:`FrameIndex.query`'s; ``steps``: the LNG's.
+    """
+
+    def __init__(self, index: FrameIndex, features: np.ndarray, takes: TakeBounds, *, eps: float = 0.0,
+                 radius: float | None = None, steps: tuple[tuple[int, int], ...] = THESIS_STEPS) -> None:
+        self.index, self.features, self.takes = index, features, takes
+        self.eps, self.radius, self.steps = eps, radius, steps
+        self._dist = np.zeros((len(features), 0))
+        self._ind = np.zeros((len(features), 0), dtype=np.int64)
+        self._found: dict[int, list[Match]] = {}
+
+    @property
+    def largest(self) -> int:
+        """The largest k queried so far."""
+        return int(self._ind.shape[1])
+
+    def __call__(self, k: int) -> tuple[np.ndarray, np.ndarray]:
+        """``(distances, indices)`` ``(m, k)``."""
+        if k > self.largest:
+            dist, ind = self.index.query(self.features, k, eps=self.eps, radius=self.radius)
+            self._dist, self._ind = np.atleast_2d(dist), np.atleast_2d(ind)
+        return self._dist[:, :k], self._ind[:, :k]
+
+    def match(self, ind: np.ndarray, dist: np.ndarray) -> list[Match]:
+        """The LNG's best match on these neighbours (kept per k)."""
+        k = int(ind.shape[1])
+        if k not in self._found:
+            self._found[k] = lng_match(ind, dist, self.takes, steps=self.steps, top=1, skip_cost=self.radius)
+        return self._found[k]
+
+    def best(self, k: int) -> tuple[int, int, float, int] | None:
+        """``(start, end, cost, take)`` of the LNG's best match at ``k``, None without a path."""
+        found = self.match(*self(k)[::-1])
+        return (found[0].start, found[0].end, found[0].cost, found[0].take) if found else None
+
+    def grown(self, k: int, k_max: int, grow: str) -> tuple[tuple[int, int, float, int] | None, int]:
+        """The best match of :func:`~stylemotion.search.matching.grow_k` from ``k`` up to ``k_max`` and the k
+        it used."""
+        from stylemotion.search.matching import grow_k
+
+        found, _, ind, _ = grow_k(self, self.match, k, min(k_max, self.index.size), grow)
+        best = (found[0].start, found[0].end, found[0].cost, found[0].take) if found else None
+        return best, int(ind.shape[1])
+
+
 @dataclass(frozen=True)
 class LNGvsDTW:
     """One query: the DTW best match (``dtw_*``, global frames, always found for queries no longer than a
@@ -82,12 +133,12 @@ class LNGvsDTW:
     dtw_end: int
     dtw_cost: float
     dtw_take: int
-    lng: dict[int, tuple[int, int, float, int] | None]
+    lng: dict[int | str, tuple[int, int, float, int] | None]
     takes_swept: int
 
-    def record(self, k: int) -> dict[str, Any]:
-        """The comparison at ``k``: ``no_path``, ``same_segment``, ``overlap``, ``cost_ratio`` (LNG / DTW,
-        ``None`` without a path), ``lng_cost``, ``dtw_cost``."""
+    def record(self, k: int | str) -> dict[str, Any]:
+        """The comparison at ``k`` (or a named variant of ``lng``): ``no_path``, ``same_segment``, ``overlap``,
+        ``cost_ratio`` (LNG / DTW, ``None`` without a path), ``lng_cost``, ``dtw_cost``."""
         found = self.lng[k]
         if found is None:
             return {"no_path": True, "same_segment": False, "overlap": False, "cost_ratio": None,
@@ -99,18 +150,22 @@ class LNGvsDTW:
                 "lng_cost": cost, "dtw_cost": self.dtw_cost}
 
 
-def compare_lng_dtw(features: np.ndarray, index: FrameIndex, takes: TakeBounds, ks: Sequence[int]) -> LNGvsDTW:
+def compare_lng_dtw(features: np.ndarray, index: FrameIndex, takes: TakeBounds, ks: Sequence[int],
+                    variants: dict[str, tuple[int, int, float, int] | None] | None = None,
+                    cache: NeighbourCache | None = None, bounding: Sequence[str] = ()) -> LNGvsDTW:
     """The LNG's best match of query ``features (m, d)`` at each of ``ks`` neighbours per frame (one k-NN
     query for the largest; the first ``k`` columns are the ``k`` nearest) against exact subsequence DTW over
-    every database frame with the same steps (:func:`~stylemotion.search.dtw.best_subsequence_match`)."""
+    every database frame with the thesis' steps (:func:`~stylemotion.search.dtw.best_subsequence_match`).
+    ``variants``: further named best matches ``(start, end, cost, take)`` or None (e.g. a growing k, another
+    step set) compared with the same DTW answer; ``bounding``: the variants found with the thesis' steps, whose
+    costs (like the fixed k's) bound DTW's from above and prune its sweep; ``cache``: the query's
+    :class:`NeighbourCache` (thesis steps) to reuse."""
     ks = sorted(set(int(k) for k in ks))
-    dist, ind = index.query(features, ks[-1])
-    dist, ind = np.atleast_2d(dist), np.atleast_2d(ind)
-    lng: dict[int, tuple[int, int, float, int] | None] = {}
-    for k in ks:
-        found = lng_match(ind[:, :k], dist[:, :k], takes, top=1)
-        lng[k] = (found[0].start, found[0].end, found[0].cost, found[0].take) if found else None
-    upper = min((v[2] for v in lng.values() if v is not None), default=None)
+    cache = cache if cache is not None else NeighbourCache(index, features, takes)
+    lng: dict[int | str, tuple[int, int, float, int] | None] = {k: cache.best(k) for k in ks}
+    lng.update(variants or {})
+    upper = min((v[2] for key, v in lng.items() if v is not None and (isinstance(key, int) or key in bounding)),
+                default=None)
     best, swept = best_subsequence_match(features, index.features, takes, upper_bound=upper)
     if best is None:
         raise ValueError("no DTW path: the query is longer than every take of the database")

@@ -61,6 +61,12 @@ THESIS_STEPS: tuple[Step, ...] = ((1, 1), (0, 1), (1, 0))
 #: one query frame (Müller's slope-bounded set [Mül07]); ``(2, 2)`` skips one query frame at unchanged
 #: speed, bridging a frame whose neighbours missed the path. Skipped query frames cost ``skip_cost``.
 ONLINE_STEPS: tuple[Step, ...] = ((1, 1), (1, 2), (2, 1), (2, 2))
+#: The gap-tolerant set: the thesis' steps (so a path may stay on one database frame, ``(1, 0)``, or linger on a
+#: query frame, ``(0, 1)``: still poses) and the online skips ``(1, 2)``, ``(2, 1)``, ``(2, 2)`` (so a path survives a
+#: query frame whose neighbours all missed it, at the penalty ``skip_cost``).
+GAP_STEPS: tuple[Step, ...] = (*THESIS_STEPS, (1, 2), (2, 1), (2, 2))
+#: Step sets by the name ``stylemotion-search``'s ``steps`` takes.
+STEP_SETS: dict[str, tuple[Step, ...]] = {"thesis": THESIS_STEPS, "online": ONLINE_STEPS, "gaps": GAP_STEPS}
 NORMALIZATIONS: tuple[str, ...] = ("none", "length", "query")
 
 #: Sort key of padding entries: above every database frame, far from int64 overflow under ``- dg``.

@@ -26,19 +26,23 @@ result is exactly the k-NN over the database without those takes.
 from __future__ import annotations
 
 import time
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
 from stylemotion.search.index import FrameIndex
-from stylemotion.search.lng import THESIS_STEPS, Match, Normalization, Step, lng_match
+from stylemotion.search.lng import THESIS_STEPS, Match, Normalization, Step, check_skip_cost, lng_match
 from stylemotion.search.settings import SearchSettings
 
 #: Neighbours per query frame by default: ``stylemotion-search``'s ``k`` (:class:`SearchSettings`, where it is
 #: set and why).
 DEFAULT_K: int = SearchSettings.k
+#: Largest neighbours per query frame a growing search reaches by default (:class:`SearchSettings`'s ``k_max``).
+DEFAULT_K_MAX: int = SearchSettings.k_max
+#: How the search grows ``k`` (:func:`grow_k`): not at all, until a path exists, until the best segment is stable.
+GROWTH: tuple[str, ...] = ("none", "path", "stable")
 #: Keys of a match's record in ``matches.json``, in order.
 MATCH_KEYS = ("take", "content", "style", "start", "end", "cost")
 
@@ -86,8 +90,10 @@ class SearchResult:
         matches: ranked, non-overlapping, best first.
         indices, distances: ``(m, k)`` each query frame's neighbours (global frames, ascending distance;
             ``-1``/``inf`` padding where a radius search found fewer) and their feature distances.
-        k: neighbours per query frame.  excluded_takes: names of takes left out of the search.
-        timings: seconds of ``features``, ``knn`` and ``lng``.
+        k: neighbours per query frame of the graph that gave the matches (the k used; ``indices`` has
+            ``k`` columns).  k_tried: every k whose graph was searched, in order (one entry without growth).
+        excluded_takes: names of takes left out of the search.
+        timings: seconds of ``features``, ``knn`` and ``lng`` (summed over the k tried).
     """
 
     matches: list[SegmentMatch]
@@ -96,6 +102,7 @@ class SearchResult:
     k: int = DEFAULT_K
     excluded_takes: tuple[str, ...] = ()
     timings: dict[str, float] = field(default_factory=dict)
+    k_tried: tuple[int, ...] = ()
 
     @property
     def query_frames(self) -> int:
@@ -151,30 +158,93 @@ def _segment(index: FrameIndex, match: Match, rank: int) -> SegmentMatch:
                         match.end + 1)
 
 
+def grow_k(neighbours: Callable[[int], tuple[np.ndarray, np.ndarray]],
+           match: Callable[[np.ndarray, np.ndarray], list[Match]], k: int, k_max: int,
+           grow: str = "stable") -> tuple[list[Match], np.ndarray, np.ndarray, tuple[int, ...]]:
+    """The LNG's matches with ``k`` doubled (capped at ``k_max``) until the answer holds.
+
+    ``neighbours(k)`` → ``(distances, indices)`` ``(m, k)``, ascending per row (the first ``j`` columns are the
+    ``j`` nearest, so one query serves every smaller k); ``match(indices, distances)`` → ranked matches.
+    ``grow``: ``"none"`` searches ``k`` only; ``"path"`` doubles until a path exists; ``"stable"`` doubles until
+    a path exists and the best segment (start and end frame) at ``2k`` is the one at ``k``, and returns the
+    ``2k`` answer (with every frame a neighbour the LNG is exact DTW, so the doubling converges to it).
+    Returns ``(matches at the k used, its distances, its indices, every k searched)``; the last k searched
+    is the k used. At ``k_max`` the answer stands as it is (possibly no path).
+    """
+    if grow not in GROWTH:
+        raise ValueError(f"grow must be one of {GROWTH}, got {grow!r}")
+    if k_max < k:
+        raise ValueError(f"k_max={k_max} is below k={k}: the growth bound must be at least the starting k")
+    if grow == "none" or k == k_max:
+        dist, ind = neighbours(k)
+        return match(ind, dist), dist, ind, (k,)
+    if grow == "path":
+        tried = []
+        while True:
+            dist, ind = neighbours(k)
+            found = match(ind, dist)
+            tried.append(k)
+            if found or k >= k_max:
+                return found, dist, ind, tuple(tried)
+            k = min(2 * k, k_max)
+    dist, ind = neighbours(min(2 * k, k_max))
+    found = match(ind[:, :k], dist[:, :k])
+    tried = [k]
+    while k < k_max:
+        nxt = min(2 * k, k_max)
+        if dist.shape[1] < nxt:
+            dist, ind = neighbours(nxt)
+        better = match(ind[:, :nxt], dist[:, :nxt])
+        tried.append(nxt)
+        same = found and better and (found[0].start, found[0].end) == (better[0].start, better[0].end)
+        found, k = better, nxt
+        if same:
+            break
+    return found, dist[:, :k], ind[:, :k], tuple(tried)
+
+
 def search_features(features: np.ndarray, index: FrameIndex, k: int = DEFAULT_K, top: int = 10, *,
                     exclude_takes: Iterable[str] = (), eps: float = 0.0, radius: float | None = None,
-                    steps: tuple[Step, ...] = THESIS_STEPS, normalize: Normalization = "none") -> SearchResult:
+                    steps: tuple[Step, ...] = THESIS_STEPS, normalize: Normalization = "none",
+                    k_max: int | None = None, grow: str = "none", skip_cost: float | None = None) -> SearchResult:
     """Ranked database segments matching query features ``(m, d)`` (the index's feature set) as a whole.
 
-    ``k``: neighbours per query frame (1 ≤ k ≤ database frames outside ``exclude_takes``); ``top``: at most this
-    many matches; ``exclude_takes``: take names left out; ``eps``/``radius``: the k-NN search's approximation and
-    fixed radius (:meth:`FrameIndex.query`); ``steps``/``normalize``: the LNG's (:func:`lng_match`).
+    ``k``: neighbours per query frame (1 ≤ k ≤ database frames outside ``exclude_takes``), the first k a
+    growing search tries; ``k_max``, ``grow``: :func:`grow_k` (``k_max`` None: no growth; capped at the
+    frames outside ``exclude_takes``); ``top``: at most this many matches; ``exclude_takes``: take names left
+    out; ``eps``/``radius``: the k-NN search's approximation and fixed radius (:meth:`FrameIndex.query`);
+    ``steps``/``normalize``/``skip_cost``: the LNG's (:func:`lng_match`; ``skip_cost`` None: the radius when one
+    is given, else each frame's k-th distance).
 
     Raises:
-        ValueError: bad ``k``/``top``/features, an unknown take name (KeyError).
+        ValueError: bad ``k``/``k_max``/``top``/``grow``/features, an unknown take name (KeyError).
     """
-    for value, key in ((k, "k"), (top, "top")):
+    for value, key in ((k, "k"), (top, "top"), (k if k_max is None else k_max, "k_max")):
         if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
             raise ValueError(f"{key} must be a whole number ≥ 1, got {value!r}")
+    skip_cost = radius if skip_cost is None else check_skip_cost(skip_cost)
     names, ids = _excluded_frames(index, exclude_takes)
-    t0 = time.perf_counter()
-    distances, indices = nearest_outside(index, features, int(k), ids, eps=eps, radius=radius)
-    t1 = time.perf_counter()
-    found = lng_match(indices, distances, index.database.take_bounds, steps=steps, normalize=normalize, top=int(top),
-                      skip_cost=radius)
-    t2 = time.perf_counter()
+    database = index.database
+    available = database.num_frames - int(sum(database.take_start[i + 1] - database.take_start[i] for i in ids))
+    bound = int(k) if k_max is None else min(int(k_max), max(available, int(k)))
+    spent = {"knn": 0.0, "lng": 0.0}
+
+    def neighbours(j: int) -> tuple[np.ndarray, np.ndarray]:
+        t0 = time.perf_counter()
+        out = nearest_outside(index, features, j, ids, eps=eps, radius=radius)
+        spent["knn"] += time.perf_counter() - t0
+        return out
+
+    def match(ind: np.ndarray, dist: np.ndarray) -> list[Match]:
+        t0 = time.perf_counter()
+        out = lng_match(ind, dist, database.take_bounds, steps=steps, normalize=normalize, top=int(top),
+                        skip_cost=skip_cost)
+        spent["lng"] += time.perf_counter() - t0
+        return out
+
+    found, distances, indices, tried = grow_k(neighbours, match, int(k), bound, grow)
     matches = [_segment(index, m, rank) for rank, m in enumerate(found, start=1)]
-    return SearchResult(matches, indices, distances, int(k), names, {"knn": t1 - t0, "lng": t2 - t1})
+    return SearchResult(matches, indices, distances, tried[-1], names, spent, tried)
 
 
 def search_motion(positions: np.ndarray, index: FrameIndex, k: int = DEFAULT_K, top: int = 10,

@@ -46,6 +46,16 @@ class SearchSettings(MotionFileKeys):
     often finds no path. Chosen among 64, 256 and 1024 on 1 s queries cut from Bandai's validation takes against
     its train takes (the smallest k for which the LNG returns exact DTW's best segment for 95 % of the queries;
     else the highest share) by ``python scripts/benchmarks.py run search``; test figures in benchmarks/search.md.
+    ``k_max``, ``grow``: a search that finds no path, or whose answer still changes, doubles ``k`` up to ``k_max``
+    (:func:`stylemotion.search.matching.grow_k`): ``grow=stable`` until the best segment at 2k is the one at k,
+    ``path`` until a path exists, ``none`` never; ``search.json`` reports the k used and every k tried. Chosen
+    (with ``k``'s role as the first k tried) on 1, 3 and 5 s queries cut from Bandai's validation takes against
+    its train takes by ``python scripts/benchmarks.py run search`` (block ``growth`` of benchmarks/search.md).
+    ``steps``: the LNG's step set: thesis (diagonal, vertical, horizontal: a path may stay on one database
+    frame) | online (the OLNG's (1,1), (1,2), (2,1), (2,2)) | gaps (thesis + online skips: a path may skip a query
+    frame whose neighbours missed it, paying ``skip_cost``); not tuned: the thesis' set, as §2.4.1.
+    ``skip_cost``: penalty per skipped query frame (feature units); None: the frame's k-th distance (a radius
+    search: the radius).
     ``top``: most matches reported (non-overlapping, best first).
     ``eps``: approximate k-NN: each distance within ``(1 + eps)`` of the true one; 0 = exact.
     ``radius``: fixed-radius k-NN (feature units): only neighbours within it; None = the k nearest.
@@ -62,6 +72,10 @@ class SearchSettings(MotionFileKeys):
     query: str = MISSING
     features: str = "E15"
     k: int = 1024
+    k_max: int = 16384
+    grow: str = "stable"
+    steps: str = "thesis"
+    skip_cost: float | None = None
     top: int = 10
     eps: float = 0.0
     radius: float | None = None

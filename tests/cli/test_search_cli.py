@@ -95,6 +95,10 @@ def test_the_query_take_is_excluded_by_default_and_gifs_are_written(tmp_path: Pa
     ({"query": "nowhere.bvh"}, "query=nowhere.bvh: no such file, and 'nowhere.bvh' is no take of dataset"),
     ({"eps": -1}, "eps=-1 must be a finite number ≥ 0"),
     ({"engine": "annoy"}, "engine=annoy is no search engine"),
+    ({"k_max": 512}, "k_max=512 is below k=1024: the growth bound must be at least the first k"),
+    ({"grow": "always"}, "grow=always is none of ['none', 'path', 'stable']"),
+    ({"steps": "wide"}, "steps=wide is none of ['thesis', 'online', 'gaps']"),
+    ({"skip_cost": -1}, "skip_cost=-1 must be a finite number ≥ 0"),
 ])
 def test_bad_input_is_refused_naming_the_value(overrides: dict, message: str, tmp_path: Path) -> None:
     kwargs = {"data": SYNTHETIC, "query": f"{TAKE}:30-90", "out": tmp_path / "out", **overrides}
@@ -154,3 +158,16 @@ def test_fewer_matches_than_asked_for_says_that_a_larger_k_finds_more(tmp_path: 
     found = len(report["matches"])
     assert 0 < found < 500
     assert any(f"{found} of top=500 found" in line and "larger k" in line for line in caplog.messages)
+
+
+@pytest.mark.parametrize("steps", ["thesis", "gaps"])
+def test_k_grows_from_k_to_k_max_and_search_json_says_which_k_answered(steps: str, tmp_path: Path, caplog) -> None:
+    with caplog.at_level(logging.INFO, logger="stylemotion"):
+        report = search(SYNTHETIC, f"{TAKE}:30-90", tmp_path / "out", k=2, k_max=64, grow="stable", steps=steps, top=1)
+    tried = report["k_tried"]
+    assert report["matches"] and tried[0] == 2 and report["k_used"] == tried[-1] <= 64
+    assert all(b == 2 * a for a, b in zip(tried, tried[1:]))
+    assert (report["k"], report["k_max"], report["grow"], report["steps"]) == (2, 64, "stable", steps)
+    assert len(tried) == 1 or any("k grew 2 → " in line for line in caplog.messages)
+    fixed = search(SYNTHETIC, f"{TAKE}:30-90", tmp_path / "fixed", k=2, grow="none", top=1)
+    assert fixed["k_tried"] == [2] and fixed["k_used"] == 2

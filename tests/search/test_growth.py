@@ -1,0 +1,178 @@
+"""An LNG that answers (issue 28, item 2): the gap-tolerant step set and a k that grows until the answer holds,
+checked against references written here — a plain double-loop subsequence DTW over any step set (no code shared
+with stylemotion.search) and a brute-force k-NN by sorting every distance."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from scipy.spatial.distance import cdist
+
+from stylemotion.search.lng import GAP_STEPS, ONLINE_STEPS, STEP_SETS, THESIS_STEPS, TakeBounds, lng_match
+from stylemotion.search.matching import GROWTH, grow_k
+
+
+def brute_dtw(cost: np.ndarray, lengths: list[int], steps: tuple[tuple[int, int], ...],
+              skip: float) -> tuple[float, int, int]:
+    """Best subsequence DTW path over ``steps`` inside one take by a double loop over the cells; a step of ``dq``
+    query frames pays ``skip`` for each of the ``dq - 1`` it skips; inf cells are no nodes. ``(cost, start, end)``
+    in global frames, ``(inf, -1, -1)`` without a path; ties: lowest cost, then lowest end frame."""
+    m, n = cost.shape
+    take = np.repeat(np.arange(len(lengths)), lengths)
+    acc = [[math.inf] * n for _ in range(m)]
+    start = [[-1] * n for _ in range(m)]
+    for i in range(m):
+        for g in range(n):
+            c = float(cost[i, g])
+            if not math.isfinite(c):
+                continue
+            options = [(0.0, g)] if i == 0 else []
+            for dq, dg in steps:
+                pi, pg = i - dq, g - dg
+                if pi < 0 or pg < 0 or take[pg] != take[g] or not math.isfinite(acc[pi][pg]):
+                    continue
+                penalty = 0.0
+                for _ in range(dq - 1):
+                    penalty += skip
+                options.append((acc[pi][pg] + penalty, start[pi][pg]))
+            if options:
+                best = min(o[0] for o in options)
+                acc[i][g] = c + best
+                start[i][g] = next(s for a, s in options if a == best)
+    ends = [(acc[m - 1][g], g) for g in range(n) if math.isfinite(acc[m - 1][g])]
+    if not ends:
+        return math.inf, -1, -1
+    total, end = min(ends)
+    return total, start[m - 1][end], end
+
+
+def _random_case(seed: int) -> tuple[np.ndarray, np.ndarray, list[int]]:
+    """A query ``(m, 3)`` cut from a random walk with noise, the walk ``(n, 3)`` and its take lengths."""
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(20, 45))
+    cuts = np.sort(rng.choice(np.arange(1, n), size=int(rng.integers(0, 4)), replace=False))
+    lengths = np.diff(np.concatenate([[0], cuts, [n]])).tolist()
+    walk = np.cumsum(rng.normal(size=(n, 3)), axis=0)
+    m = int(rng.integers(3, 8))
+    begin = int(rng.integers(0, n - m + 1))
+    return walk[begin:begin + m] + rng.normal(scale=0.5, size=(m, 3)), walk, lengths
+
+
+def _knn(query: np.ndarray, database: np.ndarray, k: int) -> tuple[np.ndarray, np.ndarray]:
+    """Brute-force ``(distances, indices)`` ``(m, k)``, ascending."""
+    d = cdist(query, database)
+    order = np.argsort(d, axis=1, kind="stable")[:, :k]
+    return np.take_along_axis(d, order, axis=1), order
+
+
+@pytest.mark.parametrize("seed", range(8))
+@pytest.mark.parametrize("name", ["gaps", "online"])
+def test_the_gap_tolerant_lng_equals_brute_force_dtw_under_the_same_steps(seed: int, name: str) -> None:
+    query, walk, lengths = _random_case(seed)
+    steps, skip = STEP_SETS[name], 0.7
+    takes = TakeBounds.from_lengths(lengths)
+    n = walk.shape[0]
+    for k in (n, 6):  # every frame a neighbour, then only 6: the brute force sees the same nodes
+        dist, ind = _knn(query, walk, k)
+        cost = np.full((len(query), n), np.inf)
+        np.put_along_axis(cost, ind, dist, axis=1)
+        want = brute_dtw(cost, lengths, steps, skip)
+        got = lng_match(ind, dist, takes, steps=steps, skip_cost=skip)
+        if not math.isfinite(want[0]):
+            assert got == [], (k, want)
+            continue
+        assert got, (k, want)
+        assert got[0].cost == pytest.approx(want[0], rel=1e-12, abs=1e-12)
+        assert (got[0].start, got[0].end) == (want[1], want[2])
+
+
+def test_the_gap_set_holds_the_thesis_steps_and_the_online_skips() -> None:
+    assert set(GAP_STEPS) == set(THESIS_STEPS) | set(ONLINE_STEPS)
+
+
+def _still_database(rng: np.random.Generator, takes: int, still_frames: int) -> tuple[np.ndarray, list[int]]:
+    """``takes`` takes of 40 frames, each a random walk that stands still (one pose plus sway) for
+    ``still_frames`` frames in the middle: Bandai's takes begin and end standing."""
+    parts = []
+    pose = np.array([0.0, 1.0, 0.0])
+    for _ in range(takes):
+        walk = np.cumsum(rng.normal(size=(40, 3)), axis=0) + 5
+        walk[10:10 + still_frames] = pose + rng.normal(scale=0.01, size=(still_frames, 3))
+        parts.append(walk)
+    return np.concatenate(parts), [40] * takes
+
+
+def test_a_still_pose_query_answers_by_growing_k_and_stays_on_few_database_frames() -> None:
+    rng = np.random.default_rng(3)
+    walk, lengths = _still_database(rng, takes=30, still_frames=3)
+    takes = TakeBounds.from_lengths(lengths)
+    query = np.array([0.0, 1.0, 0.0]) + rng.normal(scale=0.01, size=(25, 3))  # 25 still frames
+    assert lng_match(*_knn(query, walk, 4)[::-1], takes) == []  # 90 standing frames in 30 takes: 4 share no take
+
+    def neighbours(k: int) -> tuple[np.ndarray, np.ndarray]:
+        return _knn(query, walk, k)
+
+    def match(ind: np.ndarray, dist: np.ndarray) -> list:
+        return lng_match(ind, dist, takes)
+
+    for grow in ("path", "stable"):
+        found, dist, ind, tried = grow_k(neighbours, match, 4, walk.shape[0], grow)
+        assert found and tried[0] == 4 and tried[-1] == ind.shape[1] == dist.shape[1] > 4
+        assert all(b == min(2 * a, walk.shape[0]) for a, b in zip(tried, tried[1:]))
+        best = found[0]
+        assert best.end - best.start + 1 <= 3 < len(query)  # the path repeats database frames (horizontal steps)
+        cost = cdist(query, walk)
+        want = brute_dtw(cost, lengths, THESIS_STEPS, 0.0)
+        assert best.cost >= want[0] - 1e-12  # never below exact DTW
+        assert walk[best.start:best.end + 1, 1].min() > 0.9  # on a standing pose
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_growth_to_every_frame_is_exact_dtw(seed: int) -> None:
+    query, walk, lengths = _random_case(seed)
+    takes = TakeBounds.from_lengths(lengths)
+    n = walk.shape[0]
+    want = brute_dtw(cdist(query, walk), lengths, THESIS_STEPS, 0.0)
+    calls = []
+
+    def neighbours(k: int) -> tuple[np.ndarray, np.ndarray]:
+        calls.append(k)
+        return _knn(query, walk, k)
+
+    found, _, ind, tried = grow_k(neighbours, lambda i, d: lng_match(i, d, takes), 1, n, "path")
+    assert found and ind.shape[1] == tried[-1]  # a path exists at some k ≤ n: thesis steps always answer at n
+    assert found[0].cost >= want[0] - 1e-12
+    # the stable rule from k = n / 2 ends at n, where the LNG is exact DTW
+    found, _, ind, tried = grow_k(neighbours, lambda i, d: lng_match(i, d, takes), n, n, "stable")
+    assert tried == (n,) and found[0].cost == pytest.approx(want[0], rel=1e-12)
+    assert (found[0].start, found[0].end) == (want[1], want[2])
+
+
+def test_growth_rules_and_their_refusals() -> None:
+    query, walk, lengths = _random_case(0)
+    takes = TakeBounds.from_lengths(lengths)
+    calls = []
+
+    def neighbours(k: int) -> tuple[np.ndarray, np.ndarray]:
+        calls.append(k)
+        return _knn(query, walk, k)
+
+    def match(i: np.ndarray, d: np.ndarray) -> list:
+        return lng_match(i, d, takes)
+
+    found, dist, _, tried = grow_k(neighbours, match, 5, 40, "none")
+    assert tried == (5,) and calls == [5] and dist.shape[1] == 5
+    assert GROWTH == ("none", "path", "stable")
+    calls.clear()
+    found, _, ind, tried = grow_k(neighbours, match, 2, 9, "stable")
+    # stable: one k-NN query per k tried past the first (the first is sliced from the second's), capped at 9
+    assert calls[0] == 4 and set(tried) <= {2, 4, 8, 9} and ind.shape[1] == tried[-1]
+    if tried[-1] < 9:  # stopped early: the answer at the last k is the one at the k before
+        prev = match(*neighbours(tried[-2])[::-1])
+        assert (prev[0].start, prev[0].end) == (found[0].start, found[0].end)
+    with pytest.raises(ValueError, match="grow must be one of"):
+        grow_k(neighbours, match, 2, 9, "forever")
+    with pytest.raises(ValueError, match="k_max=3 is below k=4"):
+        grow_k(neighbours, match, 4, 3, "path")
