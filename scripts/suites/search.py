@@ -106,8 +106,8 @@ def _choose_growth(per: dict[Any, list], used: dict[Any, list], seeds: list[int]
                    candidates: list[tuple[str, int]], start_k: int) -> dict[str, Any]:
     """The growth rule (grow, k_max) chosen on every val query (all lengths): among those that answer every
     query and return DTW's best segment for the aim's share (mean over seeds), the one of least mean k used;
-    else the highest share (then least mean k). Remaining ties (a bound no val query reached costs nothing
-    more on val) go to the larger k_max: headroom for queries unlike validation's."""
+    else the highest share (then fewest unanswered, then least mean k). Remaining ties (a bound no val query
+    reached costs nothing more on val) go to the larger k_max: headroom for queries unlike validation's."""
     scores = {}
     for grow, km in candidates:
         name = _growth_name(grow, km)
@@ -125,7 +125,8 @@ def _choose_growth(per: dict[Any, list], used: dict[Any, list], seeds: list[int]
         why = (f"least mean k used among the rules answering every val query with DTW's best segment for "
                f"≥ {SAME_SEGMENT_AIM:.0%} of them (ties: the larger k_max)")
     else:
-        name = max(scores, key=lambda n: (mean[n], -scores[n]["mean_k_used"], scores[n]["k_max"]))
+        name = max(scores, key=lambda n: (mean[n], -scores[n]["no_path"], -scores[n]["mean_k_used"],
+                                          scores[n]["k_max"]))
         why = f"no rule reached {SAME_SEGMENT_AIM:.0%} with every val query answered: the highest share"
     return {"candidates": scores, "start_k": start_k, "rule": why, "aim": SAME_SEGMENT_AIM, "chosen_name": name,
             "chosen": [scores[name]["grow"], scores[name]["k_max"]],

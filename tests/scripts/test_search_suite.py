@@ -1,0 +1,55 @@
+"""Suite ``search`` (scripts/suites/search.py): the growth rule (grow, k_max) is chosen from planted validation
+records by the rule the suite states — answer every query, reach the aim's share of DTW's best segment, then the
+least mean k used, ties to the larger bound; else the highest share — and test records never enter the choice."""
+
+from __future__ import annotations
+
+import sys
+from collections import defaultdict
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(ROOT / "scripts"))
+
+from suites import search  # noqa: E402
+
+SEEDS = [0, 1, 2]
+LENGTHS = [1.0, 3.0]
+
+
+def planted(rules: dict[tuple[str, int], tuple[float, int, list[int]]]) -> tuple[dict, dict]:
+    """Per rule ``(share of same segment, queries without a path, k used per query)``: val records of 10 queries
+    per seed and length; test records that would win every rule, to show they are not read."""
+    per: dict = defaultdict(list)
+    used: dict = defaultdict(list)
+    for (grow, km), (share, no_path, ks) in rules.items():
+        name = search._growth_name(grow, km)
+        for seed in SEEDS:
+            for sec in LENGTHS:
+                hits = round(share * 10)
+                per[("val", seed, sec, name)] = [
+                    {"same_segment": q < hits, "no_path": q >= 10 - no_path // (len(SEEDS) * len(LENGTHS))}
+                    for q in range(10)]
+                used[("val", seed, sec, name)] = list(ks)
+                per[("test", seed, sec, name)] = [{"same_segment": True, "no_path": False}] * 10
+    return per, used
+
+
+def test_the_cheapest_rule_reaching_the_aim_is_chosen_and_ties_go_to_the_larger_bound() -> None:
+    rules = {("path", 4096): (0.8, 0, [1024] * 10), ("stable", 4096): (1.0, 0, [2048] * 10),
+             ("stable", 16384): (1.0, 0, [2048] * 10), ("stable", 65536): (1.0, 0, [4096] * 10)}
+    per, used = planted(rules)
+    choice = search._choose_growth(per, used, SEEDS, LENGTHS, list(rules), 1024)
+    assert choice["chosen"] == ["stable", 16384]  # 4096 and 16384 cost the same on val: the larger bound
+    assert choice["candidates"]["grow path to 4096"]["same_segment"] == [0.8, 0.8, 0.8]
+    assert "least mean k used" in choice["rule"] and choice["start_k"] == 1024
+
+
+def test_a_rule_with_unanswered_val_queries_never_reaches_the_aim() -> None:
+    rules = {("path", 4096): (0.9, 6, [1024] * 10), ("stable", 16384): (0.9, 0, [4096] * 10),
+             ("stable", 4096): (0.8, 0, [2048] * 10)}
+    per, used = planted(rules)
+    choice = search._choose_growth(per, used, SEEDS, LENGTHS, list(rules), 1024)
+    assert choice["candidates"]["grow path to 4096"]["no_path"] == 6
+    # none reached the aim: the highest share; of two equal shares the one answering every query, though dearer
+    assert choice["chosen"] == ["stable", 16384] and choice["rule"].startswith("no rule reached")
