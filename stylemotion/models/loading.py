@@ -39,6 +39,9 @@ def load_generative(path: str | os.PathLike, autoencoder: MotionAutoencoder | No
     """A trained :class:`~stylemotion.models.vae.PrimitiveVAE`, :class:`~stylemotion.models.cvae.StyleCVAE`
     or :class:`~stylemotion.models.zero_shot.ZeroShotStyleVAE` (class from its hyperparameters), eval mode, CPU.
 
+    ``stylemotion.load(path)`` (:mod:`stylemotion.loading`) reads this and every other model the commands write
+    (run folders, Morphable Graph files) behind one ``sample``/``describe``; it loads checkpoints through here.
+
     Args:
         path: its checkpoint (``~`` expanded).
         autoencoder: an already loaded autoencoder to attach (must be the model's own: same

@@ -315,7 +315,8 @@ class MorphableModel:
 
     @classmethod
     def load(cls, path: str | Path) -> MorphableModel:
-        """A model saved by :meth:`save` (a file, or a run folder holding ``model.npz``)."""
+        """A model saved by :meth:`save` (a file, or a run folder holding ``model.npz``). ``stylemotion.load(path)``
+        reads it through here, with the sampling interface and ``describe()`` of every other model."""
         path = Path(path).expanduser()
         if path.is_dir():
             path = path / "model.npz"
