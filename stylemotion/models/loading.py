@@ -131,7 +131,8 @@ def load_model(path: str | Path, neutral_style: str = "normal", autoencoder=None
     model = load_generative(path, autoencoder)
     if isinstance(model, ZeroShotStyleVAE):
         raise IncompatibleModelError(f"{path} is a zero-shot style network: it samples only given a style example "
-                                     "(bind one with model.bind_example(...), or evaluate it with "
+                                     "(in Python: stylemotion.load(path).sample(n, example='walk.bvh'); "
+                                     "model.bind_example(...); its leave-one-style-out evaluation: "
                                      "python scripts/benchmarks.py run zero_shot)")
     spec = model.spec
     styled = isinstance(model, StyleCVAE)
