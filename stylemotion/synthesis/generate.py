@@ -134,16 +134,10 @@ def write_outputs(motion: SynthesizedMotion, folder: Path, outputs: Mapping[str,
     return figures
 
 
-def generate(cfg: DictConfig | Mapping[str, Any], command: str = "") -> dict[str, Any]:
-    """Synthesize and write one walk (see the module doc); returns the summary."""
-    cfg = OmegaConf.to_container(cfg, resolve=True) if isinstance(cfg, DictConfig) else dict(cfg)
-    force = bool(cfg.get("force", False))
-    out = check_new_output(cfg["out"], force)
-    started = time.perf_counter()
-    path = path_from_config(cfg.get("path") or {})
-    settings = FollowSettings(**(cfg.get("follow") or {}))  # bad follow.* values are refused before loading
-    kind = str((cfg.get("model") or {}).get("family", "?"))  # model=morphable; none: the VAEs
-    kind = "vae" if not cfg.get("model") else kind
+def walk_graph(cfg: Mapping[str, Any]) -> Any:
+    """The graph of stance models a walk of ``cfg`` (a resolved generate config) takes its steps from: the VAEs of
+    ``run``/``models`` in ``style``, or the Morphable Graph with ``model=morphable``."""
+    kind = "vae" if not cfg.get("model") else str((cfg.get("model") or {}).get("family", "?"))
     if kind == "morphable":
         from stylemotion.synthesis.morphable_graph import MapSettings, load_morphable_graph
 
@@ -151,14 +145,26 @@ def generate(cfg: DictConfig | Mapping[str, Any], command: str = "") -> dict[str
             map_settings = MapSettings(**(cfg.get("morphable") or {}))
         except (TypeError, ValueError) as err:  # an unknown or out-of-range morphable.* key
             raise ConfigError(f"morphable.*: {err}") from err
-        graph = load_morphable_graph(cfg.get("models") or {}, action=str(cfg.get("action", "walk")),
-                                     settings=map_settings)
-    elif kind == "vae":
-        graph = load_graph(str(cfg["style"]), run=cfg.get("run"), models=cfg.get("models"),
-                           action=str(cfg.get("action", "walk")), neutral_style=str(cfg.get("neutral_style", "normal")))
-    else:
-        raise ConfigError("stylemotion-generate takes model=morphable (the Morphable Graph) or no model= (the VAEs); "
-                          f"the chosen model config has family {kind!r}")
+        return load_morphable_graph(cfg.get("models") or {}, action=str(cfg.get("action", "walk")),
+                                    settings=map_settings)
+    if kind == "vae":
+        return load_graph(str(cfg["style"]), run=cfg.get("run"), models=cfg.get("models"),
+                          action=str(cfg.get("action", "walk")), neutral_style=str(cfg.get("neutral_style", "normal")))
+    raise ConfigError("stylemotion-generate takes model=morphable (the Morphable Graph) or no model= (the VAEs); "
+                      f"the chosen model config has family {kind!r}")
+
+
+def generate(cfg: DictConfig | Mapping[str, Any], command: str = "", graph: Any = None) -> dict[str, Any]:
+    """Synthesize and write one walk (see the module doc); returns the summary. ``graph``: the models of
+    :func:`walk_graph` for this ``cfg``, loaded once for many walks (default: loaded here)."""
+    cfg = OmegaConf.to_container(cfg, resolve=True) if isinstance(cfg, DictConfig) else dict(cfg)
+    force = bool(cfg.get("force", False))
+    out = check_new_output(cfg["out"], force)
+    started = time.perf_counter()
+    path = path_from_config(cfg.get("path") or {})
+    settings = FollowSettings(**(cfg.get("follow") or {}))  # bad follow.* values are refused before loading
+    kind = "vae" if not cfg.get("model") else str((cfg.get("model") or {}).get("family", "?"))
+    graph = graph if graph is not None else walk_graph(cfg)
     motion = follow_path(graph, path, seed=int(cfg.get("seed", 0)), settings=settings)
     rigid = None
     if cfg.get("rigid_bones", True):
