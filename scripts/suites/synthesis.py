@@ -55,7 +55,7 @@ PATHS = {
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--runs", type=Path, default=ROOT / "runs" / "benchmarks" / "style" / "bandai" / "full",
                         help="folder of suite style_bandai's both-stance runs, seed<k> per model seed")
-    parser.add_argument("--out", type=Path, default=ROOT / "runs" / "benchmarks" / "synthesis",
+    parser.add_argument("--walks", type=Path, default=ROOT / "runs" / "benchmarks" / "synthesis",
                         help="walk folders (reused when finished)")
     parser.add_argument("--validation-styles", type=int, default=2, metavar="K",
                         help="styles besides neutral walked on the validation paths (a seeded choice, default_rng(2))")
@@ -158,7 +158,7 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
             for follow in candidates:
                 name = candidate_name(follow)
                 for i, path in enumerate(val_paths):
-                    folder = args.out / "validation" / f"seed{seeds[0]}" / style / f"path{i}" / name
+                    folder = args.walks / "validation" / f"seed{seeds[0]}" / style / f"path{i}" / name
                     val_rows.setdefault(name, []).append(walk(first, style, path, 0, follow, folder, graphs, False))
                 print(f"[validation] {style} {name}: mean dev "
                       f"{np.mean([r['mean_m'] for r in val_rows[name][-len(val_paths):]]):.3f} m", flush=True)
@@ -170,7 +170,7 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
     for seed in seeds:
         for style in styles:
             for label, path in PATHS.items():
-                folder = args.out / "test" / chosen / f"seed{seed}" / style / label.split(" ")[0].replace("-", "_")
+                folder = args.walks / "test" / chosen / f"seed{seed}" / style / label.split(" ")[0].replace("-", "_")
                 test.setdefault(style, {}).setdefault(label, {})[str(seed)] = walk(
                     runs[seed], style, path, seed, follow, folder, graphs, True)
             print(f"[test seed {seed}] {style}: " + ", ".join(
