@@ -31,15 +31,17 @@ except PackageNotFoundError:  # run from a source tree that was never installed
 
 def lazy_exports(package: str, where: dict[str, str]):
     """``(__getattr__, __dir__)`` for the init of ``package`` whose exported names load from their submodules on
-    first use (PEP 562): ``where`` maps each name to its submodule (``"graph"`` → ``<package>.graph``). A light
-    submodule of the package then loads without the heavy ones its init names."""
+    first use (PEP 562): ``where`` maps each name to its submodule (``"graph"`` → ``<package>.graph``) or, for a
+    name re-exported from elsewhere, to a full module name (``"stylemotion.models.loading"``). A light submodule of
+    the package then loads without the heavy ones its init names."""
     import sys
     from importlib import import_module
 
     def __getattr__(name: str):
         if name not in where:
             raise AttributeError(f"module {package!r} has no attribute {name!r}")
-        value = getattr(import_module(f"{package}.{where[name]}"), name)
+        module = where[name] if where[name].startswith("stylemotion.") else f"{package}.{where[name]}"
+        value = getattr(import_module(module), name)
         setattr(sys.modules[package], name, value)
         return value
 

@@ -27,7 +27,6 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 import numpy as np
-from scipy.ndimage import gaussian_filter1d
 
 from stylemotion.geometry import direction_yaw, rotate_yaw, rotate_yaw_torch, rotate_yaw_xz_torch, wrap_angle
 from stylemotion.skeleton import JOINT_INDEX, NUM_JOINTS
@@ -68,6 +67,8 @@ def facing_yaw(positions: np.ndarray, fps: float, smooth_seconds: float = 0.15) 
     forward = np.stack([-across[..., 2], across[..., 0]], axis=-1)
     sigma = smooth_seconds * fps
     if sigma > 0 and forward.shape[-2] > 1:
+        from scipy.ndimage import gaussian_filter1d  # here: scipy.ndimage costs ~0.5 s of start-up
+
         forward = gaussian_filter1d(forward, sigma, axis=-2, mode="nearest")
     return direction_yaw(forward)
 

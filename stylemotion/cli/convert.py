@@ -12,8 +12,6 @@ import sys
 from collections.abc import Sequence
 
 from stylemotion.cli.skeleton import argparse_command
-from stylemotion.datasets.convert import check_arguments, convert_file
-from stylemotion.datasets.loading import ConversionSettings
 
 
 def _unit(value: str) -> float | str:
@@ -35,6 +33,9 @@ def convert(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--up-axis", choices=["y", "z"], default="y")
     parser.add_argument("--force", action="store_true", help="replace an existing DST")
     args = parser.parse_args(argv)
+    from stylemotion.datasets.convert import check_arguments, convert_file  # after parsing: --help loads no scipy
+    from stylemotion.datasets.loading import ConversionSettings
+
     check_arguments(args.dst, args.fps)
     settings = ConversionSettings(args.fps, args.joint_map, args.unit_scale, args.up_axis)
     positions = convert_file(args.src, args.dst, settings, args.force)

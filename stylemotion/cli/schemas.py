@@ -3,7 +3,7 @@
 Settings defaults live once, in the dataclasses that use them: ``segment`` =
 :class:`~stylemotion.primitives.segmentation.SegmentSettings`, ``evaluation`` =
 :class:`~stylemotion.evaluation.settings.EvalSettings`, ``follow`` =
-:class:`~stylemotion.synthesis.controller.FollowSettings`, and the whole of a command's own keys for
+:class:`~stylemotion.synthesis.settings.FollowSettings`, and the whole of a command's own keys for
 ``search``, ``annotate``, ``reconstruct``, ``texture``, ``keyframes`` and ``style`` (each wing's
 ``settings.py``). The YAML files take them in their defaults lists (``- schema@segment: segment``; the
 command's own keys at the top level: ``- schema@_here_: search``) instead of repeating their values; keys
@@ -26,7 +26,7 @@ from functools import partial
 SCHEMA_CLASSES: dict[str, str] = {
     "segment": "stylemotion.primitives.segmentation:SegmentSettings",
     "evaluation": "stylemotion.evaluation.settings:EvalSettings",
-    "follow": "stylemotion.synthesis.controller:FollowSettings",
+    "follow": "stylemotion.synthesis.settings:FollowSettings",
     "search": "stylemotion.search.settings:SearchSettings",
     "annotate": "stylemotion.annotate.settings:AnnotateSettings",
     "reconstruct": "stylemotion.reconstruct.settings:ReconstructSettings",

@@ -141,6 +141,55 @@ def hydra_errors_in_one_line(started: Callable[[], bool] = lambda: True) -> Iter
         utils.run_and_report = original
 
 
+def template_names(template: str) -> set[str]:
+    """The ``$NAME`` / ``${NAME}`` placeholders of a :class:`string.Template` text (``$$`` is no placeholder)."""
+    import string
+
+    pattern = string.Template.pattern
+    return {m["named"] or m["braced"] for m in pattern.finditer(template) if m["named"] or m["braced"]}
+
+
+@contextmanager
+def help_computes_only_what_it_shows() -> Iterator[None]:
+    """Within the block, Hydra's ``--help`` (and ``--hydra-help``) fills only the placeholders its template names.
+
+    Hydra computes all four (``$FLAGS_HELP``, ``$HYDRA_CONFIG_GROUPS``, ``$APP_CONFIG_GROUPS``, ``$CONFIG``) before
+    it fills the template; listing the config groups reads every group option of the package (most of a second,
+    over a second on two busy cores), though the commands' help templates (``configs/hydra/help/``) name none of
+    them. A placeholder the template names is computed exactly as Hydra does, so the text is the same. (Hydra has
+    no hook for this: its ``Hydra.get_help`` is replaced for the block.)"""
+    import string
+
+    from hydra._internal.hydra import Hydra
+    from omegaconf import OmegaConf
+
+    original = Hydra.get_help
+
+    def get_help(self: Any, help_cfg: Any, cfg: Any, args_parser: Any, resolve: bool) -> str:
+        template = help_cfg.template
+        names = template_names(template)
+
+        def is_hydra_group(x: str) -> bool:
+            return x.startswith("hydra/") or x == "hydra"
+
+        values: dict[str, str] = {}
+        if "FLAGS_HELP" in names:
+            values["FLAGS_HELP"] = self.format_args_help(args_parser)
+        if "HYDRA_CONFIG_GROUPS" in names:
+            values["HYDRA_CONFIG_GROUPS"] = self.format_config_groups(is_hydra_group)
+        if "APP_CONFIG_GROUPS" in names:
+            values["APP_CONFIG_GROUPS"] = self.format_config_groups(lambda x: not is_hydra_group(x))
+        if "CONFIG" in names:
+            values["CONFIG"] = OmegaConf.to_yaml(cfg, resolve=resolve)
+        return string.Template(template).substitute(values)
+
+    Hydra.get_help = get_help
+    try:
+        yield
+    finally:
+        Hydra.get_help = original
+
+
 def check_not_a_link(value: Any, key: str) -> None:
     """Refuse an output folder ``key=value`` that is a link (every command writes its outputs into ``out``):
     nothing is written through a link, wherever it points.
@@ -287,7 +336,7 @@ def hydra_command(command: str, config_name: str, work: Callable[[Any, str], Any
             check_run_dir(sys.argv[1:])
             typed[:] = sys.argv[1:]
             sys.argv[1:] = [*typed, *finished_run_overrides(typed, finished)]
-            with hydra_errors_in_one_line(lambda: bool(started)):
+            with hydra_errors_in_one_line(lambda: bool(started)), help_computes_only_what_it_shows():
                 hydra.main(config_path=CONFIG_PACKAGE, config_name=config_name, version_base="1.3")(task)()
 
     main.__doc__ = f"Console script ``{command}``."

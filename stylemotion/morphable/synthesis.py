@@ -18,7 +18,7 @@ search over keyframe boxes for constraints at the primitive's first or last fram
 target (end position and heading from the median step length, the previous clip's last pose and speed
 as the transition keyframe), calls :meth:`MorphablePrimitive.search_step`, decodes, stitches and cleans
 up exactly as for the VAEs. The step residuals are the controller's cost terms (position, heading, pose,
-speed, each over its scale in :class:`~stylemotion.synthesis.controller.FollowSettings`) and the prior.
+speed, each over its scale in :class:`~stylemotion.synthesis.settings.FollowSettings`) and the prior.
 
 **Walks that vary (§4.6.3).** A step's start is drawn at random, as the thesis does: ``random_starts`` codes
 drawn from the primitive's mixture (the prior itself, by the walk's seeded generator), the cheapest under the

@@ -23,7 +23,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.ndimage import label, median_filter
 
 from stylemotion.skeleton import FOOT_POINTS, JOINT_INDEX, NUM_JOINTS
 
@@ -177,6 +176,8 @@ def foot_contacts(
 
 def contacts_from_signals(sig: FootSignals, fps: float, settings: ContactSettings | None = None) -> np.ndarray:
     """The contact decision of :func:`foot_contacts` from precomputed :class:`FootSignals`."""
+    from scipy import ndimage  # here: scipy.ndimage costs ~0.5 s of start-up (the settings load without it)
+
     settings = settings or ContactSettings()
     scale = sig.leg_length[..., None, None, None]
     strict = ((sig.heights < settings.height_on * scale) & (sig.speeds < settings.speed_on * scale)).any(-1)
@@ -191,13 +192,15 @@ def contacts_from_signals(sig: FootSignals, fps: float, settings: ContactSetting
     out = np.empty_like(strict2)
     for i in range(strict2.shape[0]):
         grown = _grow(strict2[i], loose2[i])
-        filtered = median_filter(grown.astype(np.uint8), size=width, mode="nearest").astype(bool)
+        filtered = ndimage.median_filter(grown.astype(np.uint8), size=width, mode="nearest").astype(bool)
         out[i] = _fill_low_gaps(filtered, low2[i], max_gap)
     return np.moveaxis(out.reshape(lead + (2, frames)), -1, -2)
 
 
 def _grow(strict: np.ndarray, loose: np.ndarray) -> np.ndarray:
     """Runs of ``loose`` that contain a ``strict`` frame (``(frames,)`` bool each)."""
+    from scipy.ndimage import label
+
     labels, count = label(loose | strict)
     if count == 0:
         return np.zeros_like(strict)

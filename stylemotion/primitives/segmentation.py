@@ -16,13 +16,15 @@ from collections import Counter
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field, fields
 from functools import cached_property
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from stylemotion.datasets.base import Take
 from stylemotion.primitives.contacts import ContactSettings, foot_contacts, leg_length, planted_point_speed
 from stylemotion.representation import FRAME_DIM, ROOT_JOINT, VELOCITY_DIMS, frames_to_positions
+
+if TYPE_CHECKING:  # the data-set package loads scipy: not needed to read the settings (command start-up)
+    from stylemotion.datasets.base import Take
 
 #: The six primitives of each locomotion action (DFKI walk graph naming).
 PRIMITIVES: tuple[str, ...] = (

@@ -11,16 +11,17 @@ from typing import TYPE_CHECKING
 from stylemotion import lazy_exports
 
 if TYPE_CHECKING:
-    from stylemotion.synthesis.controller import FollowSettings, SharpTurnWarning, SynthesizedMotion, follow_path
+    from stylemotion.synthesis.controller import SharpTurnWarning, SynthesizedMotion, follow_path
     from stylemotion.synthesis.graph import MotionGraph, UnknownStyleError, load_graph
     from stylemotion.synthesis.path import GroundPath, PathError, s_curve
+    from stylemotion.synthesis.settings import FollowSettings
 
 
 __all__ = ["FollowSettings", "GroundPath", "MotionGraph", "PathError", "SharpTurnWarning", "SynthesizedMotion",
            "UnknownStyleError", "follow_path", "load_graph", "s_curve"]
 
 __getattr__, __dir__ = lazy_exports(__name__, {
-    "FollowSettings": "controller",
+    "FollowSettings": "settings",
     "SharpTurnWarning": "controller",
     "SynthesizedMotion": "controller",
     "follow_path": "controller",

@@ -42,12 +42,12 @@ from dataclasses import dataclass, field
 import numpy as np
 import torch
 
-from stylemotion.config import ConfigError
 from stylemotion.geometry import wrap_angle_torch
 from stylemotion.representation import JOINT_DIMS, VELOCITY_DIMS, frames_to_positions, integrate_root
 from stylemotion.skeleton import NUM_JOINTS
 from stylemotion.synthesis.graph import MotionGraph
 from stylemotion.synthesis.path import GroundPath, PathError
+from stylemotion.synthesis.settings import FollowSettings
 from stylemotion.synthesis.stitching import append_clip
 
 log = logging.getLogger(__name__)
@@ -58,49 +58,6 @@ LOOKAHEAD_TARGETS = 4
 
 class SharpTurnWarning(UserWarning):
     """The path turns more sharply than any trained step can; the walk follows it as closely as it can."""
-
-
-@dataclass
-class FollowSettings:
-    """Settings of :func:`follow_path` (see the module doc for the cost).
-
-    Attributes:
-        candidates: ``K``, prior samples per step.
-        iterations: Adam steps on the best candidate's ``z`` (0: best of K only).
-        lr: Adam learning rate (latent units).
-        position_scale_m: ``σ_p``, metres.
-        heading_scale_rad: ``σ_θ``, radians.
-        prior_weight: ``λ_prior``. At 1 the codes are pulled towards the prior's mode ‖z‖ = 0, far
-            inside its typical shell ‖z‖ ≈ √latent_dim, and the stylized models (whose codes vary
-            less in step length and turning than the neutral one) miss the path by 0.15–0.26 m; 0.3
-            keeps ‖z‖ at 2–4 and the deviation at 0.05–0.11 m (Bandai, chosen on the reported S-curve,
-            one seed: a validation re-choice is pending; benchmarks/synthesis.md).
-        pose_scale_m: ``σ_pose``, metres.
-        speed_scale_mps: ``σ_v``, m/s.
-        blend_frames: frames over which each transition is blended (:mod:`.stitching`).
-        first_foot: planted foot of the first step, ``left`` or ``right``.
-        max_steps: safety limit on the number of steps.
-    """
-
-    candidates: int = 128
-    iterations: int = 40
-    lr: float = 0.05
-    position_scale_m: float = 0.05
-    heading_scale_rad: float = 0.15
-    prior_weight: float = 0.3
-    pose_scale_m: float = 0.03
-    speed_scale_mps: float = 0.1
-    blend_frames: int = 6
-    first_foot: str = "left"
-    max_steps: int = 500
-
-    def __post_init__(self) -> None:
-        for name, least in (("candidates", 1), ("iterations", 0), ("max_steps", 1), ("blend_frames", 0)):
-            if not getattr(self, name) >= least:
-                raise ConfigError(f"follow.{name} must be at least {least}, got {getattr(self, name)}")
-        for name in ("position_scale_m", "heading_scale_rad", "pose_scale_m", "speed_scale_mps"):
-            if not getattr(self, name) > 0:
-                raise ConfigError(f"follow.{name} must be positive, got {getattr(self, name)}")
 
 
 @dataclass
