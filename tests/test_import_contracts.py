@@ -19,12 +19,16 @@ package ``__init__``). Contracts:
 
 Plus, in fresh interpreters: importing the package (``import stylemotion``: its public API loads on first use), the
 commands that read a user's motion, and ``stylemotion.config``, loads no Lightning, and no torch or scikit-learn
-(the numpy side).
+(the numpy side); and every console script of pyproject.toml answers ``--help`` and a bad argument without loading
+torch, Lightning, scikit-learn, matplotlib or scipy (issue 29: start-up within a second or two; the timings are
+the benchmark suite ``startup``'s, never a test's).
 """
 
 from __future__ import annotations
 
 import ast
+import json
+import re
 import subprocess
 import sys
 from functools import cache
@@ -283,3 +287,71 @@ def test_the_public_api_resolves_and_explains_itself():
     explained = {r[0] for r in rows if r[2] == "True"}
     assert {"load", "sample", "evaluate", "walk", "search_motion", "reconstruct_motion", "annotate_motion",
             "view"} <= explained
+
+
+def console_scripts() -> dict[str, str]:
+    """``[project.scripts]`` of pyproject.toml: command → ``module:function`` (read without tomllib: Python 3.10)."""
+    text = (PACKAGE.parent / "pyproject.toml").read_text()
+    block = text.split("[project.scripts]", 1)[1].split("\n[", 1)[0]
+    return dict(re.findall(r'^([\w-]+)\s*=\s*"([\w.]+:\w+)"', block, re.M))
+
+
+#: What no command may load before it prints its help or refuses a bad argument (seconds of start-up each).
+HEAVY = ("torch", "lightning", "sklearn", "matplotlib", "scipy")
+#: A bad argument per argparse command (an unknown flag after the required arguments); Hydra commands get a key
+#: that does not exist.
+BAD_ARGUMENTS = {"stylemotion-convert": ["walk.bvh", "walk.npz", "--nosuchflag"],
+                 "stylemotion-view": ["walk.bvh", "--out", "viewer", "--nosuchflag"]}
+
+#: Runs an entry point as its console script does, once per argument list (``sys.argv`` = the list, JSON), and
+#: prints after each the exit status and which of :data:`HEAVY` were loaded by then.
+STARTUP_PROBE = """
+import importlib, json, sys
+module, function, heavy, *cases = sys.argv[1:]
+for argv in map(json.loads, cases):
+    sys.argv = [function, *argv]
+    try:
+        code = getattr(importlib.import_module(module), function)()
+    except SystemExit as exc:
+        code = exc.code
+    sys.stdout.flush()
+    print("\\nPROBE " + json.dumps({"exit": code, "heavy": [m for m in heavy.split(",") if m in sys.modules]}))
+"""
+
+
+def startup_probe(entry: str, cases: list[list[str]], cwd: Path) -> list[dict]:
+    """``{"exit": status, "heavy": [...]}`` after each argument list of ``cases``, run in turn by one interpreter
+    through the entry point ``module:function`` (what a case loads stays loaded for the next)."""
+    module, _, function = entry.partition(":")
+    done = subprocess.run([sys.executable, "-c", STARTUP_PROBE, module, function, ",".join(HEAVY),
+                           *map(json.dumps, cases)], capture_output=True, text=True, timeout=300, cwd=cwd)
+    found = [json.loads(ln[len("PROBE "):]) for ln in done.stdout.splitlines() if ln.startswith("PROBE ")]
+    assert len(found) == len(cases), f"{entry} {cases}: {len(found)} probe lines; stderr: {done.stderr[-2000:]}"
+    return found
+
+
+def test_every_console_script_is_probed():
+    scripts = console_scripts()
+    assert len(scripts) >= 14 and all(c.startswith("stylemotion-") for c in scripts), scripts
+    assert set(BAD_ARGUMENTS) <= set(scripts)
+
+
+@pytest.mark.parametrize("command", sorted(console_scripts()))
+def test_help_and_a_bad_argument_load_no_torch_lightning_sklearn_matplotlib_or_scipy(command, tmp_path):
+    """Issue 29: ``--help`` and a refused argument answer within a second or two because no command loads the
+    heavy libraries first: the settings dataclasses Hydra's schemas need live in light modules, package inits load
+    their names on first use, the argparse commands import their work after parsing, and Hydra's help computes
+    only what its template shows (:func:`stylemotion.cli.skeleton.help_computes_only_what_it_shows`)."""
+    entry = console_scripts()[command]
+    shown, refused = startup_probe(entry, [["--help"], BAD_ARGUMENTS.get(command, ["nosuchkey=1"])], tmp_path)
+    assert shown == {"exit": 0, "heavy": []}, f"{command} --help: {shown}"
+    assert refused == {"exit": 2, "heavy": []}, f"{command} --help, then a bad argument: {refused}"
+    assert list(tmp_path.iterdir()) == [], f"{command} wrote {sorted(tmp_path.iterdir())}"
+
+
+def test_the_startup_probe_sees_a_heavy_import(tmp_path):
+    """The probe counts what the call imports, not only the entry module (timeit imports scipy.ndimage in ``-s``)."""
+    once = ["-n", "1", "-r", "1"]
+    quiet, loaded = startup_probe("timeit:main", [[*once, "pass"], [*once, "-s", "import scipy.ndimage", "pass"]],
+                                  tmp_path)
+    assert quiet["heavy"] == [] and loaded["heavy"] == ["scipy"], (quiet, loaded)
