@@ -5,7 +5,7 @@ one reproduction per model seed; run ``python scripts/benchmarks.py run style_ba
 
 * **choice** — the path follower's λ_prior (``follow.prior_weight``), K (``follow.candidates``) and Adam steps
   (``follow.iterations``) chosen on **validation paths**: seeded random splines (:func:`validation_path`), never a
-  reported path, walked by the neutral model and two seeded styles of model seed ``seeds[0]``, walk seed 0. Rule
+  reported path, walked by the neutral model and one seeded style of model seed ``seeds[0]``, walk seed 0. Rule
   (:func:`choose`): the lowest mean over walks of log(mean deviation ÷ the best candidate's) + log(raw foot skating ÷
   the best candidate's): the path accuracy and the naturalness of the decoded steps (codes pushed away from the prior
   slide their feet before the clean-up), weighed alike. No candidate costs more than the earlier default (K = 128,
@@ -55,7 +55,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="folder of suite style_bandai's both-stance runs, seed<k> per model seed")
     parser.add_argument("--walks", type=Path, default=ROOT / "runs" / "benchmarks" / "synthesis",
                         help="walk folders (reused when finished)")
-    parser.add_argument("--validation-styles", type=int, default=2, metavar="K",
+    parser.add_argument("--validation-styles", type=int, default=1, metavar="K",
                         help="styles besides neutral walked on the validation paths (a seeded choice, default_rng(2))")
 
 
