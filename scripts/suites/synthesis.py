@@ -55,6 +55,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="folder of suite style_bandai's both-stance runs, seed<k> per model seed")
     parser.add_argument("--walks", type=Path, default=ROOT / "runs" / "benchmarks" / "synthesis",
                         help="walk folders (reused when finished)")
+    parser.add_argument("--validation-seed", type=int, default=None, metavar="SEED",
+                        help="model seed whose models walk the validation paths (default: the first of --seeds)")
     parser.add_argument("--validation-styles", type=int, default=1, metavar="K",
                         help="styles besides neutral walked on the validation paths (a seeded choice, default_rng(2))")
 
@@ -139,7 +141,10 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
         if not (folder / "report" / "report.json").is_file():
             raise SystemExit(f"{folder}: no finished reproduction; run `python scripts/benchmarks.py run style_bandai "
                              f"--workers 2` first (or pass --runs)")
-    first = runs[seeds[0]]
+    val_seed = seeds[0] if args.validation_seed is None else args.validation_seed
+    first = args.runs / f"seed{val_seed}"
+    if not (first / "report" / "report.json").is_file():
+        raise SystemExit(f"{first}: no finished reproduction for --validation-seed {val_seed}")
     styles = sorted({e["name"] for e in available_models(str(first))}, key=lambda s: (s != "neutral", s))
     rng = np.random.default_rng(2)
     val_styles = ["neutral", *sorted(rng.choice(styles[1:], min(args.validation_styles, len(styles) - 1),
@@ -156,7 +161,7 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
             for follow in candidates:
                 name = candidate_name(follow)
                 for i, path in enumerate(val_paths):
-                    folder = args.walks / "validation" / f"seed{seeds[0]}" / style / f"path{i}" / name
+                    folder = args.walks / "validation" / f"seed{val_seed}" / style / f"path{i}" / name
                     val_rows.setdefault(name, []).append(walk(first, style, path, 0, follow, folder, graphs, False))
                 print(f"[validation] {style} {name}: mean dev "
                       f"{np.mean([r['mean_m'] for r in val_rows[name][-len(val_paths):]]):.3f} m", flush=True)
@@ -185,7 +190,7 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
     return {"runs": {str(s): str(f.relative_to(ROOT) if f.is_relative_to(ROOT) else f) for s, f in runs.items()},
             "splits": {"models": f"suite style_bandai's reproductions (data split by take: {split}); the model seed "
                                  "varies training; the walk seed equals the model seed on test paths",
-                       "validation": {"paths": val_paths, "styles": val_styles, "model_seed": seeds[0],
+                       "validation": {"paths": val_paths, "styles": val_styles, "model_seed": val_seed,
                                       "walk_seed": 0, "how": "seeded random splines (validation_path), not a "
                                       "reported path"},
                        "test": {"paths": PATHS}},
