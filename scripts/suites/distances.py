@@ -9,7 +9,9 @@ query's own take — the same pairs for all. Reported:
    the row's measure, ρ between their distances under the row's and the column's measure, mean over queries, then
    mean ± sd over seeds; and a heatmap of it;
 2. Fig. 2.7's form: ρ of ``E15``'s neighbours with every other measure against the number of neighbours;
-3. precision@10 by content label per measure (the 10 nearest frames of other takes sharing the query's content).
+3. precision@10 by content label per measure (the 10 nearest frames of other takes sharing the query's content);
+4. Fig. 2.4's form: clips (the middle 2 s of 8 random test takes per content), DTW distances between every two
+   under every measure, ρ over each clip's 8 nearest clips, and precision@8 by content.
 
 No setting is tuned: the point-cloud windows (1 and 11 frames at 30 fps), the Lee et al. weights and the Wang &
 Bodenheimer joints and ``k`` are the thesis'; the PCAs (``pca*``, ``F_pva20``) are fitted on the ``train`` takes.
@@ -38,6 +40,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--ks", type=int, nargs="+", default=[8, 32, 128, 512, 2048, 8192],
                         help="numbers of neighbours of the Fig. 2.7 curves (E15's neighbours)")
     parser.add_argument("--chunk", type=int, default=8, help="queries per block of distances (memory)")
+    parser.add_argument("--clips-per-content", type=int, default=8,
+                        help="test takes per content whose clips the DTW comparison (Fig. 2.4) uses (thesis: ≥ 8)")
+    parser.add_argument("--clip-s", type=float, default=2.0, help="clip length, s (the middle of each take)")
+    parser.add_argument("--clip-k", type=int, default=8, help="nearest clips per clip (thesis: 8)")
+    parser.add_argument("--clip-stride", type=int, default=3,
+                        help="align every n-th frame of a clip (3: 10 fps; the measures see every frame)")
     parser.add_argument("--figure", type=Path, default=FIGURE, help="heatmap PNG, relative to the repository")
 
 
@@ -96,7 +104,9 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
                     curve[k][b].extend(e15[k][b].tolist())
             for n in names:
                 prec[n].extend(precision_at(dist[n], excluded, contents, contents[rows]).tolist())
-        per_seed.append({"rho": {a: {b: float(np.nanmean(v)) for b, v in r.items()} for a, r in rho.items()},
+        clips = _clip_comparison(test, bandai.fps, seed, args, fitted)
+        per_seed.append({"clips": clips,
+                         "rho": {a: {b: float(np.nanmean(v)) for b, v in r.items()} for a, r in rho.items()},
                          "curve": {k: {b: float(np.nanmean(v)) for b, v in c.items()} for k, c in curve.items()},
                          "precision": {n: float(np.mean(v)) for n, v in prec.items()},
                          "nan_rho": int(sum(np.isnan(np.asarray(v)).sum() for r in rho.values() for v in r.values()))})
@@ -123,10 +133,42 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
         "curve": {str(k): {b: spread(s["curve"][k][b] for s in per_seed) for b in names} for k in ks},
         "precision_at_10": {n: spread(s["precision"][n] for s in per_seed) for n in names},
         "nan_rho_per_seed": [s["nan_rho"] for s in per_seed],
+        "clips": {"per_content": args.clips_per_content, "seconds": args.clip_s, "k": args.clip_k,
+                  "stride": args.clip_stride,
+                  "count_per_seed": [s["clips"]["count"] for s in per_seed],
+                  "rho": {a: {b: spread(s["clips"]["rho"][a][b] for s in per_seed) for b in names} for a in names},
+                  "precision": {n: spread(s["clips"]["precision"][n] for s in per_seed) for n in names}},
     }
     result["figure"] = str(args.figure)
     _plot(result, REPO / args.figure)
     return result
+
+
+def _clip_comparison(test: list[Any], fps: float, seed: int, args: argparse.Namespace,
+                     fitted: dict[str, Any]) -> dict[str, Any]:
+    """Fig. 2.4's form: the middle ``clip_s`` of ``clips_per_content`` random test takes per content (takes at least
+    that long); DTW distances between every two clips under every measure; per clip its ``clip_k`` nearest other
+    clips under the row's measure and ρ with the column's; precision@k by content."""
+    from stylemotion.search.distances import FrameMeasures, clip_distances, neighbour_correlations, precision_at
+
+    frames = int(round(args.clip_s * fps))
+    rng = np.random.default_rng([seed, 2, 4])
+    chosen = []
+    for content in sorted({t.content for t in test}):
+        usable = [t for t in test if t.content == content and t.num_frames >= frames]
+        picks = rng.choice(len(usable), size=min(args.clips_per_content, len(usable)), replace=False)
+        chosen += [usable[i] for i in sorted(picks)]
+    clips = [np.asarray(t.positions[(t.num_frames - frames) // 2:][:frames]) for t in chosen]
+    measures = FrameMeasures(clips, fps, FEATURE_SETS, fitted)
+    dist = clip_distances(measures, frames, args.clip_stride)
+    contents = np.array([t.content for t in chosen])
+    own = np.eye(len(clips), dtype=bool)
+    corr = neighbour_correlations(dist, own, [args.clip_k])
+    names = measures.names
+    return {"count": len(clips),
+            "rho": {a: {b: float(np.nanmean(corr[a][args.clip_k][b])) for b in names} for a in names},
+            "precision": {n: float(np.mean(precision_at(dist[n], own, contents, contents, args.clip_k)))
+                          for n in names}}
 
 
 def _joint_names() -> tuple[str, ...]:
@@ -135,13 +177,7 @@ def _joint_names() -> tuple[str, ...]:
     return rotation_joint_names()
 
 
-def _plot(result: dict[str, Any], path: Path) -> None:
-    from matplotlib.figure import Figure
-
-    names = result["measures"]
-    matrix = np.array([[result["rho"][a][b].get("mean", np.nan) for b in names] for a in names])
-    fig = Figure(figsize=(15, 6.8))
-    ax, ax2 = fig.subplots(1, 2, gridspec_kw={"width_ratios": [1.35, 1]})
+def _heatmap(ax: Any, fig: Any, matrix: np.ndarray, names: list[str], title: str) -> None:
     image = ax.imshow(matrix, vmin=-0.2, vmax=1.0, cmap="viridis")
     for i in range(len(names)):
         for j in range(len(names)):
@@ -150,24 +186,40 @@ def _plot(result: dict[str, Any], path: Path) -> None:
     ax.set_xticks(range(len(names)), names, rotation=90, fontsize=7)
     ax.set_yticks(range(len(names)), names, fontsize=7)
     ax.set_xlabel("distance measure (ranks compared)", fontsize=8)
-    ax.set_ylabel("measure choosing the k nearest frames", fontsize=8)
-    ax.set_title(f"Spearman ρ over the {result['k']} nearest frames (Bandai test takes, mean of seeds)", fontsize=9)
+    ax.set_ylabel("measure choosing the nearest", fontsize=8)
+    ax.set_title(title, fontsize=9)
     fig.colorbar(image, ax=ax, fraction=0.04, pad=0.02)
+
+
+def _plot(result: dict[str, Any], path: Path) -> None:
+    """Three panels: the frame matrix (Fig. 2.3), the clip matrix (Fig. 2.4), ρ with E15 against k (Fig. 2.7)."""
+    from matplotlib import colormaps
+    from matplotlib.figure import Figure
+
+    names = result["measures"]
+    fig = Figure(figsize=(22, 7))
+    ax, ax_clips, ax2 = fig.subplots(1, 3, gridspec_kw={"width_ratios": [1.2, 1.2, 1]})
+    for axis, rho, title in (
+            (ax, result["rho"], f"frames: ρ over the {result['k']} nearest (Bandai test takes, mean of seeds)"),
+            (ax_clips, result["clips"]["rho"], f"clips (DTW): ρ over the {result['clips']['k']} nearest")):
+        matrix = np.array([[rho[a][b].get("mean", np.nan) for b in names] for a in names])
+        _heatmap(axis, fig, matrix, names, title)
     ks = [int(k) for k in result["curve"]]
-    for b in names:
-        if b == "E15":
-            continue
-        ax2.plot(ks, [result["curve"][str(k)][b].get("mean", np.nan) for k in ks], marker="o", ms=3, label=b)
+    colours = colormaps["tab20"].colors
+    for i, b in enumerate(n for n in names if n != "E15"):
+        ax2.plot(ks, [result["curve"][str(k)][b].get("mean", np.nan) for k in ks], marker="o", ms=3, label=b,
+                 color=colours[i % len(colours)], ls="-" if b.startswith(("D_", "F_")) else "--")
     ax2.set_xscale("log", base=2)
     ax2.set_xlabel("nearest frames under E15", fontsize=8)
     ax2.set_ylabel("Spearman ρ with E15", fontsize=8)
-    ax2.set_title("Fig. 2.7's form: ρ against the number of neighbours", fontsize=9)
+    ax2.set_title("Fig. 2.7's form: ρ against the number of neighbours\n(solid: §2.3.1 measures, dashed: feature sets)",
+                  fontsize=9)
     ax2.legend(fontsize=6, ncol=2)
     ax2.grid(alpha=0.3)
     fig.tight_layout()
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_name(f".{path.stem}.tmp{path.suffix}")
-    fig.savefig(tmp, dpi=100, metadata={"Software": None})
+    fig.savefig(tmp, dpi=90, metadata={"Software": None})
     tmp.replace(path)
 
 
@@ -190,6 +242,20 @@ def render(record: dict[str, Any]) -> dict[str, str]:
     precision = (md_table(["measure", "precision@10 by content"], prec_rows)
                  + f"\n\nShare of a query frame's 10 nearest frames of other test takes with the query's content "
                    f"label (10 contents), mean ± sd over seeds. {prov}")
+    c = r["clips"]
+    clip_rows = [[a, *(fmt(c["rho"][a][b].get("mean"), 2) for b in names)] for a in names]
+    clip_block = (md_table(["A \\ B", *names], clip_rows)
+                  + f"\n\nMean Spearman ρ over seeds (Fig. 2.4's form): the middle {c['seconds']:g} s of "
+                    f"{c['per_content']} random test takes per content ({', '.join(map(str, c['count_per_seed']))} "
+                    f"clips per seed), every {c['stride']}th frame aligned; DTW (steps (1, 0), (0, 1), (1, 1), "
+                    f"accumulated frame distances) between every "
+                    f"two clips under each measure; per clip its {c['k']} nearest other clips under A (row) and ρ "
+                    f"between their DTW distances under A and under B (column). Largest sd over seeds: "
+                    f"{max(c['rho'][a][b].get('sd', 0.0) for a in names for b in names):.3f}. {prov}")
+    clip_prec = (md_table(["measure", f"clips: precision@{c['k']} by content"],
+                          [[n, fmt_spread(c["precision"][n])] for n in names])
+                 + f"\n\nShare of a clip's {c['k']} nearest other clips (DTW under the measure) with its content, "
+                   f"mean ± sd over seeds. {prov}")
     pc = r["rho"]["D_pc11"]
     headline = (f"Frame distance measures (Krüger §2.3.1) on Bandai test takes: over the {r['k']} nearest frames, "
                 f"E15 ranks like the point-cloud distance D_pc11 with ρ {fmt_spread(r['rho']['E15']['D_pc11'])} "
@@ -209,4 +275,5 @@ def render(record: dict[str, Any]) -> dict[str, str]:
         ["rotations", settings["rotations"], "—"],
         ["PCAs", "pca8/16/25, F_pva20", r["splits"]["choose"]],
     ]) + f"\n\n{prov}")
-    return {"matrix": matrix, "curve": curve, "precision": precision, "headline": headline, "settings": params}
+    return {"matrix": matrix, "curve": curve, "precision": precision, "headline": headline, "settings": params,
+            "clips": clip_block, "clip_precision": clip_prec}

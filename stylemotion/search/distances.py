@@ -269,29 +269,32 @@ class FrameMeasures:
     def num_frames(self) -> int:
         return int(self.take_id.shape[0])
 
-    def distances(self, name: str, rows: np.ndarray) -> np.ndarray:
-        """``(len(rows), num_frames)`` distances of measure ``name`` from the frames ``rows`` to every frame
-        (radians for the rotation measures, m² for the point clouds, feature units for the sets)."""
+    def distances(self, name: str, rows: np.ndarray, columns: np.ndarray | None = None) -> np.ndarray:
+        """``(len(rows), len(columns))`` distances of measure ``name`` from the frames ``rows`` to the frames
+        ``columns`` (default every frame): radians for the rotation measures, m² for the point clouds, feature
+        units for the sets."""
+        cols = np.arange(self.num_frames) if columns is None else np.asarray(columns)
         if name in ("D_quat", "D_lee", "D_wb"):
-            theta2 = self._squared_angles(rows)
+            theta2 = self._squared_angles(rows, cols)
             return np.sqrt(theta2.sum(-1) if name == "D_quat" else theta2 @ BODY_PART_WEIGHTS[name[2:].lower()])
         if name == "D_euler":
-            return euler_distance(self.euler[rows][:, None], self.euler[None])
+            return euler_distance(self.euler[rows][:, None], self.euler[cols][None])
         if name in self.clouds:
             cloud = self.clouds[name]
-            return aligned_distance(tuple(part[rows] for part in cloud), cloud)
+            return aligned_distance(tuple(part[rows] for part in cloud), tuple(part[cols] for part in cloud))
         v = self.vectors[name]
-        sq = self.sq_norms[name][rows][:, None] + self.sq_norms[name][None] - 2.0 * (v[rows] @ v.T)
+        sq = self.sq_norms[name][rows][:, None] + self.sq_norms[name][cols][None] - 2.0 * (v[rows] @ v[cols].T)
         return np.sqrt(np.maximum(sq, 0.0))
 
 
-    def _squared_angles(self, rows: np.ndarray) -> np.ndarray:
-        """``(len(rows), num_frames, 21)`` squared quaternion angles, kept for the last ``rows`` (the three
-        rotation measures share them)."""
-        key = np.asarray(rows).tobytes()
+    def _squared_angles(self, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
+        """``(len(rows), len(cols), 21)`` squared quaternion angles, kept for the last ``rows`` and ``cols`` (the
+        three rotation measures share them)."""
+        key = np.asarray(rows).tobytes() + b"|" + np.asarray(cols).tobytes()
         if self._angles is None or self._angles[0] != key:
-            dot = np.abs(np.einsum("qjc,fjc->qfj", self.quats[rows], self.quats))
-            self._angles = (key, (2.0 * np.arccos(np.clip(dot, 0.0, 1.0))) ** 2)
+            a, b = self.quats[rows], self.quats[cols]
+            dot = np.stack([a[:, j] @ b[:, j].T for j in range(a.shape[1])], axis=-1)
+            self._angles = (key, (2.0 * np.arccos(np.clip(np.abs(dot), 0.0, 1.0))) ** 2)
         return self._angles[1]
 
 
@@ -345,3 +348,56 @@ def precision_at(dist: np.ndarray, excluded: np.ndarray, labels: np.ndarray, que
     masked = np.where(excluded, np.inf, dist)
     near = np.argpartition(masked, n, axis=1)[:, :n]
     return np.mean(labels[near] == query_labels[:, None], axis=1)
+
+
+# ---------------------------------------------------------------------------------------------
+# Motion segments: DTW-induced distances (the thesis' Fig. 2.4)
+
+
+def dtw_costs(cost: np.ndarray) -> np.ndarray:
+    """Global DTW of many pairs of sequences at once: ``cost`` ``(pairs, m, n)`` frame distances → ``(pairs,)``
+    accumulated costs of the cheapest path from ``(0, 0)`` to ``(m−1, n−1)`` with steps (1, 0), (0, 1), (1, 1)
+    (the thesis' "accumulated pose distances along the warping path")."""
+    cost = np.asarray(cost, dtype=np.float64)
+    if cost.ndim != 3 or 0 in cost.shape[1:]:
+        raise ValueError(f"cost must be (pairs, m, n) with m, n ≥ 1, got {cost.shape}")
+    cells = np.ascontiguousarray(cost.transpose(1, 2, 0))  # (m, n, pairs): each cell's pairs side by side
+    row = np.cumsum(cells[0], axis=0)
+    for i in range(1, cells.shape[0]):
+        new = np.empty_like(row)
+        new[0] = row[0] + cells[i, 0]
+        best_prev = np.minimum(row[1:], row[:-1])  # from (i−1, j) and (i−1, j−1)
+        for j in range(1, cells.shape[1]):
+            new[j] = cells[i, j] + np.minimum(best_prev[j - 1], new[j - 1])
+        row = new
+    return row[-1]
+
+
+def clip_distances(measures: FrameMeasures, clip_frames: int, stride: int = 1,
+                   chunk: int = 100) -> dict[str, np.ndarray]:
+    """DTW distances between the clips of ``measures`` under every measure.
+
+    Args:
+        measures: built over clips of ``clip_frames`` frames each (every "take" one clip).
+        clip_frames: frames per clip.
+        stride: align every ``stride``-th frame of each clip (the measures themselves see every frame: windows
+            and velocities keep their full-rate meaning).
+        chunk: rows of frame distances computed at once (memory).
+
+    Returns:
+        ``{measure: (clips, clips)}`` accumulated DTW costs in the measure's units.
+    """
+    n = measures.num_frames
+    if n % clip_frames or np.any(np.bincount(measures.take_id) != clip_frames):
+        raise ValueError(f"every clip must hold {clip_frames} frames")
+    clips = n // clip_frames
+    kept = np.arange(0, clip_frames, stride)
+    frames = (np.arange(clips)[:, None] * clip_frames + kept[None, :]).ravel()
+    m = len(kept)
+    out = {}
+    for name in measures.names:
+        frame = np.concatenate([measures.distances(name, frames[lo:lo + chunk], frames)
+                                for lo in range(0, len(frames), chunk)])
+        blocks = frame.reshape(clips, m, clips, m).transpose(0, 2, 1, 3)
+        out[name] = dtw_costs(blocks.reshape(clips * clips, m, m)).reshape(clips, clips)
+    return out

@@ -24,6 +24,9 @@ def test_render_writes_every_block_from_the_record() -> None:
                "candidate_frames": 1000, "test_takes": 10,
                "curve": {"8": {b: _s(0.3) for b in NAMES}, "512": {b: _s(0.4) for b in NAMES}},
                "precision_at_10": {b: _s(0.7) for b in NAMES},
+               "clips": {"per_content": 8, "seconds": 2.0, "k": 8, "stride": 3, "count_per_seed": [80, 80, 80],
+                         "rho": rho,
+                         "precision": {b: _s(0.9) for b in NAMES}},
                "splits": {"choose": "nothing tuned", "parameters": {
                    "point_cloud_windows_frames": {"D_pc1": 1, "D_pc11": 11}, "wb_weights": "equal",
                    "body_part_weights": {"lee": ["Hips"], "wb": ["UpperLeg_L"]}, "k": 512, "k_source": "thesis",
@@ -31,7 +34,9 @@ def test_render_writes_every_block_from_the_record() -> None:
     record = {"results": results, "command": "python scripts/benchmarks.py run distances", "commit": "abc",
               "started": "2026-12-03T19:00:00", "seeds": [0, 1, 2], "seconds": 1.0}
     blocks = distances.render(record)
-    assert set(blocks) == {"matrix", "curve", "precision", "headline", "settings"}
+    assert set(blocks) == {"matrix", "curve", "precision", "headline", "settings", "clips",
+                           "clip_precision"}
     assert "| E15 | 0.50 | 0.60 | 1.00 | 0.80 |" in blocks["matrix"]
     assert "0.40 ± 0.01" in blocks["curve"] and "0.70 ± 0.01" in blocks["precision"]
     assert "ρ 0.60 ± 0.01" in blocks["headline"]  # E15 against D_pc11
+    assert "| E15 | 0.50 | 0.60 | 1.00 | 0.80 |" in blocks["clips"] and "0.90 ± 0.01" in blocks["clip_precision"]

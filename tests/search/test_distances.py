@@ -11,6 +11,8 @@ from stylemotion.geometry import rotation_y
 from stylemotion.search.distances import (
     BODY_PART_WEIGHTS,
     FrameMeasures,
+    clip_distances,
+    dtw_costs,
     euler_distance,
     fit_pva,
     joint_rotations,
@@ -162,3 +164,34 @@ def test_precision_at_counts_labels_of_the_nearest_frames() -> None:
     labels = np.array(["x", "x", "y", "x", "y"])
     excluded = np.array([[True, False, False, False, False]])
     assert precision_at(dist, excluded, labels, np.array(["x"]), n=2)[0] == pytest.approx(0.5)
+
+
+def _all_paths_min(cost: np.ndarray, i: int = 0, j: int = 0) -> float:
+    """Cheapest monotone path from (i, j) to the last cell by enumerating every path (tiny matrices only)."""
+    m, n = cost.shape
+    here = cost[i, j]
+    if (i, j) == (m - 1, n - 1):
+        return float(here)
+    nexts = [(i + di, j + dj) for di, dj in ((1, 0), (0, 1), (1, 1)) if i + di < m and j + dj < n]
+    return float(here + min(_all_paths_min(cost, a, b) for a, b in nexts))
+
+
+def test_dtw_costs_equal_the_cheapest_of_all_paths() -> None:
+    rng = np.random.default_rng(5)
+    cost = rng.random(size=(6, 5, 4))
+    cost[0] = 1.0  # every path of a constant matrix: the diagonal-heavy one with the fewest cells, 5
+    expected = [_all_paths_min(c) for c in cost]
+    np.testing.assert_allclose(dtw_costs(cost), expected)
+    assert dtw_costs(cost)[0] == pytest.approx(5.0)
+    assert dtw_costs(cost[:, :1, :1])[3] == pytest.approx(cost[3, 0, 0])
+
+
+def test_clip_distances_of_a_clip_with_itself_are_zero(takes: list[np.ndarray]) -> None:
+    clips = [takes[0][:20], takes[1][:20], takes[0][:20] + np.array([2.0, 0.0, 1.0])]
+    fitted = {"F_pva20": fit_pva(clips, FPS)}
+    measures = FrameMeasures(clips, FPS, ["E15"], fitted)
+    dist = clip_distances(measures, 20, stride=2, chunk=7)
+    for name, d in dist.items():
+        assert d.shape == (3, 3)
+        assert d[0, 1] > 1e-3, name
+        assert d[0, 2] < 1e-4 * d[0, 1], name  # a shifted copy: every measure is blind to the shift
