@@ -22,9 +22,10 @@ class FollowSettings:
         heading_scale_rad: ``σ_θ``, radians.
         prior_weight: ``λ_prior``. At 1 the codes are pulled towards the prior's mode ‖z‖ = 0, far
             inside its typical shell ‖z‖ ≈ √latent_dim, and the stylized models (whose codes vary
-            less in step length and turning than the neutral one) miss the path by 0.15–0.26 m; 0.3
-            keeps ‖z‖ at 2–4 and the deviation at 0.05–0.11 m (Bandai, chosen on the reported S-curve,
-            one seed: a validation re-choice is pending; benchmarks/synthesis.md).
+            less in step length and turning than the neutral one) miss the path. 0.1 was chosen among
+            0.1, 0.3 and 1 (K and the Adam steps likewise kept) on seeded random **validation paths**
+            with Bandai models by suite ``synthesis`` (rule and figures: benchmarks/synthesis.md); it is
+            the smallest candidate, so the grid did not bracket the optimum.
         pose_scale_m: ``σ_pose``, metres.
         speed_scale_mps: ``σ_v``, m/s.
         blend_frames: frames over which each transition is blended (:mod:`.stitching`).
@@ -37,7 +38,7 @@ class FollowSettings:
     lr: float = 0.05
     position_scale_m: float = 0.05
     heading_scale_rad: float = 0.15
-    prior_weight: float = 0.3
+    prior_weight: float = 0.1
     pose_scale_m: float = 0.03
     speed_scale_mps: float = 0.1
     blend_frames: int = 6
