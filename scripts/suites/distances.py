@@ -31,6 +31,8 @@ DESCRIPTION = ("frame distance measures (quaternion, Euler, body-part, point clo
 DEFAULT_SEEDS = (0, 1, 2)
 REPO = Path(__file__).resolve().parents[2]
 FIGURE = Path("benchmarks") / "figures" / "distances.png"
+#: The thesis' ρ of E15 with D_pc1 over 512 nearest neighbours (§2.3.3, "Root normalizations": 3D normalization).
+THESIS_E15_PC1 = "0.55"
 FEATURE_SETS = ("E15", "E30", "E39", "E15x3", "E15x5", "E30x3", "E39x3", "pca8", "pca16", "pca25", "EP17", "EP19")
 
 
@@ -256,14 +258,18 @@ def render(record: dict[str, Any]) -> dict[str, str]:
                           [[n, fmt_spread(c["precision"][n])] for n in names])
                  + f"\n\nShare of a clip's {c['k']} nearest other clips (DTW under the measure) with its content, "
                    f"mean ± sd over seeds. {prov}")
-    pc = r["rho"]["D_pc11"]
-    headline = (f"Frame distance measures (Krüger §2.3.1) on Bandai test takes: over the {r['k']} nearest frames, "
-                f"E15 ranks like the point-cloud distance D_pc11 with ρ {fmt_spread(r['rho']['E15']['D_pc11'])} "
-                f"and like D_quat with ρ {fmt_spread(r['rho']['E15']['D_quat'])}; D_pc11 ranks like E15x3 with "
-                f"ρ {fmt_spread(pc['E15x3'])}. precision@10 by content: E15 "
-                f"{fmt_spread(r['precision_at_10']['E15'])}, D_pc11 {fmt_spread(r['precision_at_10']['D_pc11'])}, "
-                f"D_quat {fmt_spread(r['precision_at_10']['D_quat'])} ([benchmarks/distances.md]"
-                f"(benchmarks/distances.md)). {prov}")
+    e15 = r["rho"]["E15"]
+    clip_e15 = r["clips"]["rho"]["E15"]
+    headline = (f"Frame distance measures (Krüger §2.3.1) against the feature sets on Bandai test takes "
+                f"({r['queries_per_seed']} query frames × {len(record.get('seeds', []))} seeds): over E15's "
+                f"{r['k']} nearest frames, Spearman ρ "
+                f"with the point-cloud distance D_pc1 is {fmt_spread(e15['D_pc1'])} (the thesis: {THESIS_E15_PC1} "
+                f"on HDM05), with D_pc11 {fmt_spread(e15['D_pc11'])}, with D_quat {fmt_spread(e15['D_quat'])}, with "
+                f"E15x3 {fmt_spread(e15['E15x3'])}; compared as DTW distances of 2 s clips, E15 ranks like E15x3 with "
+                f"ρ {fmt_spread(clip_e15['E15x3'])} and like D_pc11 with {fmt_spread(clip_e15['D_pc11'])}. "
+                f"precision@10 by content: E15 {fmt_spread(r['precision_at_10']['E15'])}, D_pc11 "
+                f"{fmt_spread(r['precision_at_10']['D_pc11'])}, D_quat {fmt_spread(r['precision_at_10']['D_quat'])} "
+                f"([benchmarks/distances.md](benchmarks/distances.md)). {prov}")
     settings = r["splits"]["parameters"]
     params = (md_table(["setting", "value", "source"], [
         ["point-cloud windows",

@@ -11,7 +11,7 @@ sys.path.insert(0, str(ROOT / "scripts"))
 
 from suites import distances  # noqa: E402
 
-NAMES = ["D_quat", "D_pc11", "E15", "E15x3"]
+NAMES = ["D_quat", "D_pc1", "D_pc11", "E15", "E15x3"]
 
 
 def _s(mean: float) -> dict:
@@ -36,7 +36,7 @@ def test_render_writes_every_block_from_the_record() -> None:
     blocks = distances.render(record)
     assert set(blocks) == {"matrix", "curve", "precision", "headline", "settings", "clips",
                            "clip_precision"}
-    assert "| E15 | 0.50 | 0.60 | 1.00 | 0.80 |" in blocks["matrix"]
+    assert "| E15 | 0.50 | 0.60 | 0.70 | 1.00 | 0.90 |" in blocks["matrix"]
     assert "0.40 ± 0.01" in blocks["curve"] and "0.70 ± 0.01" in blocks["precision"]
-    assert "ρ 0.60 ± 0.01" in blocks["headline"]  # E15 against D_pc11
-    assert "| E15 | 0.50 | 0.60 | 1.00 | 0.80 |" in blocks["clips"] and "0.90 ± 0.01" in blocks["clip_precision"]
+    assert "D_pc1 is 0.60 ± 0.01" in blocks["headline"] and "× 3 seeds" in blocks["headline"]
+    assert "| E15 | 0.50 | 0.60 | 0.70 | 1.00 | 0.90 |" in blocks["clips"] and "0.90 ± 0.01" in blocks["clip_precision"]
