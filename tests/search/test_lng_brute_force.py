@@ -1,5 +1,6 @@
-"""The LNG and the benchmark's helpers against independent references written here: a plain-Python subsequence
-DTW (a double loop over cells, no code shared with stylemotion.search), scipy's Spearman ρ, and counting."""
+"""The LNG and the benchmark's helpers against independent references: a plain-Python subsequence DTW
+(tests/dtw_reference.py: a double loop over cells, no code shared with stylemotion.search), scipy's Spearman ρ,
+and counting."""
 
 from __future__ import annotations
 
@@ -7,43 +8,12 @@ import math
 
 import numpy as np
 import pytest
+from dtw_reference import brute_dtw
 from scipy.stats import spearmanr
 
 from stylemotion.search.dtw import best_subsequence_match, feature_distances, subsequence_dtw
 from stylemotion.search.evaluation import precision_at, spearman_with_misses, summarize_lng
 from stylemotion.search.lng import TakeBounds, lng_match
-
-
-def brute_dtw(cost: np.ndarray, lengths: list[int]) -> tuple[float, int, int]:
-    """Best subsequence DTW path with the steps (1,1), (0,1), (1,0) inside one take, by a double loop over the
-    cells: ``(cost, start, end)`` in global frames, ``(inf, -1, -1)`` without a path. ``cost`` may hold inf
-    (a cell that is not a node). Ties: lowest cost, then lowest end frame."""
-    m, n = cost.shape
-    take = np.repeat(np.arange(len(lengths)), lengths)
-    acc = [[math.inf] * n for _ in range(m)]
-    start = [[-1] * n for _ in range(m)]
-    for i in range(m):
-        for g in range(n):
-            c = float(cost[i, g])
-            if not math.isfinite(c):
-                continue
-            options = [(0.0, g)] if i == 0 else []
-            if i > 0 and g > 0 and take[g - 1] == take[g]:
-                options.append((acc[i - 1][g - 1], start[i - 1][g - 1]))
-            if g > 0 and take[g - 1] == take[g]:
-                options.append((acc[i][g - 1], start[i][g - 1]))
-            if i > 0:
-                options.append((acc[i - 1][g], start[i - 1][g]))
-            options = [o for o in options if math.isfinite(o[0])]
-            if options:
-                best = min(o[0] for o in options)
-                acc[i][g] = c + best
-                start[i][g] = next(s for a, s in options if a == best)
-    ends = [(acc[m - 1][g], g) for g in range(n) if math.isfinite(acc[m - 1][g])]
-    if not ends:
-        return math.inf, -1, -1
-    total, end = min(ends)
-    return total, start[m - 1][end], end
 
 
 def _case(seed: int) -> tuple[np.ndarray, list[int], np.random.Generator]:
