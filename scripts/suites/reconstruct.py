@@ -299,15 +299,8 @@ def _pct(r: dict, path: list[str]) -> str:
     return fmt_spread({**s, **{k: s[k] * 100 for k in ("mean", "sd") if k in s}}, 1) + " %"
 
 
-def _conditions(r: dict | None = None) -> list[tuple[str, str, str]]:
-    """The database conditions of the marker tables (``retargeted`` only when the results hold it)."""
-    found = _all_conditions()
-    if r is not None and "retargeted/ours" not in r["per_seed"][0]["markers"]["test"]:
-        found = [c for c in found if c[0] != "retargeted"]
-    return found
-
-
-def _all_conditions() -> list[tuple[str, str, str]]:
+def _conditions() -> list[tuple[str, str, str]]:
+    """The database conditions of the marker tables: (key, what the database holds, how it compares)."""
     return [("same", "Bandai train takes (the query's content, style and skeleton in it)", "easier: same actors, "
              "content and style in the database"),
             ("without", "Bandai train takes without the query's content (CMU⁻ analogue)", "like the thesis' CMU⁻"),
@@ -337,7 +330,7 @@ def render(record: dict[str, Any]) -> dict[str, str]:
 
     # headline
     rows = []
-    for key, what, note in _conditions(r):
+    for key, what, note in _conditions():
         rows.append([f"6 markers → 21 joints: {what}", note,
                      f"{_cm(r, ['markers', 'test', f'{key}/ours', 'mean_cm'])} cm",
                      f"{_cm(r, ['markers', 'test', f'{key}/ours', 'p95_cm'])} / "
@@ -365,7 +358,7 @@ def render(record: dict[str, Any]) -> dict[str, str]:
 
     # markers: per database, per content
     mrows = []
-    for key, what, note in _conditions(r):
+    for key, what, note in _conditions():
         for name, label in (("ours", "ours (local linear model)"), ("nn", "nearest neighbour")):
             base = ["markers", "test", f"{key}/{name}"]
             first = [what, note] if name == "ours" else ["", ""]
