@@ -478,8 +478,7 @@ def _growth_blocks(r: dict[str, Any], seeds: int, prov: str) -> dict[str, str]:
     rows = []
     for seconds in lengths:
         for v in variants:
-            p = next((x for x in r["lng_pooled"] if x["split"] == "test" and x["query_s"] == seconds
-                      and x["k"] == v), None)
+            p = _pooled(r, "test", seconds, v, missing_ok=True)
             if p is None:
                 continue
             ratio = r["time_ratio"].get(f"{seconds:g}|{v}", {})
@@ -509,8 +508,7 @@ def _growth_blocks(r: dict[str, Any], seeds: int, prov: str) -> dict[str, str]:
     arows = []
     for seconds in approx["lengths_s"]:
         for v in [name, *(f"eps {e:g}" for e in approx["eps"]), *(f"radius {x:g}" for x in approx["radii"])]:
-            p = next((x for x in r["lng_pooled"] if x["split"] == "test" and x["query_s"] == seconds
-                      and x["k"] == v), None)
+            p = _pooled(r, "test", seconds, v, missing_ok=True)
             if p is None:
                 continue
             ratio = r["time_ratio"].get(f"{seconds:g}|{v}", {})
@@ -539,8 +537,11 @@ def _seed_spread(r: dict[str, Any], split: str, seconds: float, k: int, key: str
     return spread(s[key] for s in r["lng_per_seed"] if s["split"] == split and s["query_s"] == seconds and s["k"] == k)
 
 
-def _pooled(r: dict[str, Any], split: str, seconds: float, k: int) -> dict[str, Any]:
-    return next(p for p in r["lng_pooled"] if p["split"] == split and p["query_s"] == seconds and p["k"] == k)
+def _pooled(r: dict[str, Any], split: str, seconds: float, k: Any, missing_ok: bool = False) -> dict[str, Any] | None:
+    """The pooled LNG figures of one split, query length and search (``k`` or a variant's name); None for a
+    combination the run did not measure when ``missing_ok``."""
+    found = (p for p in r["lng_pooled"] if p["split"] == split and p["query_s"] == seconds and p["k"] == k)
+    return next(found, None) if missing_ok else next(found)
 
 
 def render(record: dict[str, Any]) -> dict[str, str]:

@@ -134,10 +134,15 @@ def write_outputs(motion: SynthesizedMotion, folder: Path, outputs: Mapping[str,
     return figures
 
 
+def model_kind(cfg: Mapping[str, Any]) -> str:
+    """``vae`` (no ``model=``: the VAEs of ``run``/``models``) or the chosen model config's ``family``."""
+    return "vae" if not cfg.get("model") else str((cfg.get("model") or {}).get("family", "?"))
+
+
 def walk_graph(cfg: Mapping[str, Any]) -> Any:
     """The graph of stance models a walk of ``cfg`` (a resolved generate config) takes its steps from: the VAEs of
     ``run``/``models`` in ``style``, or the Morphable Graph with ``model=morphable``."""
-    kind = "vae" if not cfg.get("model") else str((cfg.get("model") or {}).get("family", "?"))
+    kind = model_kind(cfg)
     if kind == "morphable":
         from stylemotion.synthesis.morphable_graph import MapSettings, load_morphable_graph
 
@@ -163,7 +168,7 @@ def generate(cfg: DictConfig | Mapping[str, Any], command: str = "", graph: Any 
     started = time.perf_counter()
     path = path_from_config(cfg.get("path") or {})
     settings = FollowSettings(**(cfg.get("follow") or {}))  # bad follow.* values are refused before loading
-    kind = "vae" if not cfg.get("model") else str((cfg.get("model") or {}).get("family", "?"))
+    kind = model_kind(cfg)
     graph = graph if graph is not None else walk_graph(cfg)
     motion = follow_path(graph, path, seed=int(cfg.get("seed", 0)), settings=settings)
     rigid = None
