@@ -69,8 +69,8 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
         POINT_CLOUD_WINDOWS_30FPS,
         FrameMeasures,
         fit_pva,
+        nearest_label_precision,
         neighbour_correlations,
-        precision_at,
     )
     from stylemotion.search.features import fit_features
 
@@ -105,7 +105,7 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
                 for b in names:
                     curve[k][b].extend(e15[k][b].tolist())
             for n in names:
-                prec[n].extend(precision_at(dist[n], excluded, contents, contents[rows]).tolist())
+                prec[n].extend(nearest_label_precision(dist[n], excluded, contents, contents[rows]).tolist())
         clips = _clip_comparison(test, bandai.fps, seed, args, fitted)
         per_seed.append({"clips": clips,
                          "rho": {a: {b: float(np.nanmean(v)) for b, v in r.items()} for a, r in rho.items()},
@@ -151,7 +151,12 @@ def _clip_comparison(test: list[Any], fps: float, seed: int, args: argparse.Name
     """Fig. 2.4's form: the middle ``clip_s`` of ``clips_per_content`` random test takes per content (takes at least
     that long); DTW distances between every two clips under every measure; per clip its ``clip_k`` nearest other
     clips under the row's measure and ρ with the column's; precision@k by content."""
-    from stylemotion.search.distances import FrameMeasures, clip_distances, neighbour_correlations, precision_at
+    from stylemotion.search.distances import (
+        FrameMeasures,
+        clip_distances,
+        nearest_label_precision,
+        neighbour_correlations,
+    )
 
     frames = int(round(args.clip_s * fps))
     rng = np.random.default_rng([seed, 2, 4])
@@ -169,7 +174,7 @@ def _clip_comparison(test: list[Any], fps: float, seed: int, args: argparse.Name
     names = measures.names
     return {"count": len(clips),
             "rho": {a: {b: float(np.nanmean(corr[a][args.clip_k][b])) for b in names} for a in names},
-            "precision": {n: float(np.mean(precision_at(dist[n], own, contents, contents, args.clip_k)))
+            "precision": {n: float(np.mean(nearest_label_precision(dist[n], own, contents, contents, args.clip_k)))
                           for n in names}}
 
 

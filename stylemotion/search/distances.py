@@ -341,13 +341,15 @@ def neighbour_correlations(dist: dict[str, np.ndarray], excluded: np.ndarray, ks
     return out
 
 
-def precision_at(dist: np.ndarray, excluded: np.ndarray, labels: np.ndarray, query_labels: np.ndarray,
-                 n: int = 10) -> np.ndarray:
+def nearest_label_precision(dist: np.ndarray, excluded: np.ndarray, labels: np.ndarray, query_labels: np.ndarray,
+                            n: int = 10) -> np.ndarray:
     """Share of each query's ``n`` nearest frames (``dist`` ``(queries, frames)``, ``excluded`` frames left out)
-    whose label equals the query's: ``(queries,)``."""
+    whose label equals the query's (:func:`stylemotion.search.evaluation.precision_at` per query): ``(queries,)``."""
+    from stylemotion.search.evaluation import precision_at
+
     masked = np.where(excluded, np.inf, dist)
     near = np.argpartition(masked, n, axis=1)[:, :n]
-    return np.mean(labels[near] == query_labels[:, None], axis=1)
+    return np.array([precision_at(labels[row], wanted, n) for row, wanted in zip(near, query_labels, strict=True)])
 
 
 # ---------------------------------------------------------------------------------------------

@@ -16,11 +16,11 @@ from stylemotion.search.distances import (
     euler_distance,
     fit_pva,
     joint_rotations,
+    nearest_label_precision,
     neighbour_correlations,
     point_cloud_distance,
     point_cloud_window,
     point_clouds,
-    precision_at,
     quaternion_distance,
     spearman_rows,
 )
@@ -159,11 +159,11 @@ def test_neighbour_correlations_on_a_planted_case() -> None:
     assert abs(corr[50]["far_agrees"].mean()) < 0.35 and corr[1000]["far_agrees"].mean() > 0.95
 
 
-def test_precision_at_counts_labels_of_the_nearest_frames() -> None:
+def test_nearest_label_precision_counts_labels_of_the_nearest_frames() -> None:
     dist = np.array([[0.0, 1.0, 2.0, 3.0, 4.0]])
     labels = np.array(["x", "x", "y", "x", "y"])
     excluded = np.array([[True, False, False, False, False]])
-    assert precision_at(dist, excluded, labels, np.array(["x"]), n=2)[0] == pytest.approx(0.5)
+    assert nearest_label_precision(dist, excluded, labels, np.array(["x"]), n=2)[0] == pytest.approx(0.5)
 
 
 def _all_paths_min(cost: np.ndarray, i: int = 0, j: int = 0) -> float:
