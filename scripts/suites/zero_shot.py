@@ -25,7 +25,7 @@ from pathlib import Path
 from typing import Any
 
 from suites.common import fmt, fmt_range, fmt_spread, md_table, progress_printed, provenance_line, spread
-from suites.style import DATA, reproduce_seed, setup_tag
+from suites.style import DATA, reproduce_seed, sample_styles, setup_tag
 
 DESCRIPTION = ("zero-shot style network, leave one style out without leakage (an autoencoder and a network per "
                "left-out style that never saw it, judged by a reproduction's autoencoder and classifier), over seeds")
@@ -54,6 +54,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--styles", nargs="+", default=None,
                         help="left-out styles (default: every CVAE style of the judge run; the judge the suite runs "
                              "trains CVAEs of these only)")
+    parser.add_argument("--sample-styles", type=int, default=None, metavar="K",
+                        help="leave out K styles only, a seeded choice (numpy default_rng(0), as suite style's "
+                             "--sample-styles) instead of naming them with --styles")
     parser.add_argument("--primitives", nargs="+", default=None, help="stance primitives (default: the judge run's)")
     parser.add_argument("--epochs", type=int, default=None,
                         help="epochs of each zero-shot network (default: the zero_shot experiment's 100, early "
@@ -105,6 +108,10 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
     from stylemotion.evaluation.zero_shot import leave_one_style_out, read_run
 
     torch.set_num_threads(1)
+    how = "narrowed on the command line"
+    if getattr(args, "sample_styles", None) is not None and args.styles is None:
+        args.styles = sample_styles(args.data, args.sample_styles)
+        how = f"{args.sample_styles} left-out styles, a seeded choice (numpy default_rng(0))"
     judge = judge_run(args)
     source = read_run(judge)
     check_data(judge, args.data, source.data_cfg)
@@ -152,7 +159,7 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
                                          "autoencoder": relative(source.autoencoder_ckpt),
                                          "cvae_styles": {p: source.styles(p) for p in source.primitives}},
             "subsample": {"primitives": args.primitives, "styles": args.styles,
-                          "how": None if not (args.primitives or args.styles) else "narrowed on the command line"},
+                          "how": None if not (args.primitives or args.styles) else how},
             "kinds": kinds,
             "epochs": args.epochs, "samples": args.samples, "left_out": [f"{p}/{s}" for p, s in left_out],
             "splits": {**splits, "seed_varies": "the autoencoders and networks without each style (initialization, "
