@@ -124,17 +124,27 @@ def _checkpoint_run(path: Path) -> Path:
 # -- one model
 
 
-def _motion_file_example(text: str | os.PathLike, primitive: str, fps: float) -> list:
-    """The clips of ``primitive`` (else of its action) cut from a motion file ``file.bvh[:start-end]`` at ``fps``,
-    as ``stylemotion-style`` cuts an example (default segmentation settings)."""
-    from stylemotion.datasets.loading import ConversionSettings
-    from stylemotion.datasets.user_motion import convert_example, parse_example
-    from stylemotion.primitives.segmentation import parse_primitive
-    from stylemotion.style_example.example import cut_example
+def _is_motion_file(example: Any) -> bool:
+    """``example`` names motion file(s): a path, or a non-empty list or tuple of paths."""
+    if isinstance(example, (str, os.PathLike)):
+        return True
+    return (isinstance(example, (list, tuple)) and bool(example)
+            and all(isinstance(e, (str, os.PathLike)) for e in example))
 
-    example = convert_example(parse_example(str(text)), ConversionSettings(fps=fps))
+
+def _motion_file_example(value: str | os.PathLike | Sequence[str | os.PathLike], primitive: str, fps: float) -> list:
+    """The clips of ``primitive`` (else of its action) cut from motion file(s) ``file.bvh[:start-end]`` (one, or a
+    list: the clips of all, pooled as ``stylemotion-style example=[…]`` pools them,
+    :func:`stylemotion.style_example.example.cut_examples`) at ``fps`` (default segmentation settings)."""
+    from stylemotion.datasets.loading import ConversionSettings
+    from stylemotion.datasets.user_motion import convert_example
+    from stylemotion.primitives.segmentation import parse_primitive
+    from stylemotion.style_example.example import cut_examples, parse_examples
+
+    value = os.fspath(value) if isinstance(value, os.PathLike) else value
+    examples = [convert_example(spec, ConversionSettings(fps=fps)) for spec in parse_examples(value)]
     action = parse_primitive(primitive)[0]
-    return cut_example(example, "example", action, [primitive], None).used[primitive]
+    return cut_examples(examples, "example", action, [primitive], None).used[primitive]
 
 
 class Model:
@@ -175,8 +185,10 @@ class Model:
             n: how many.
             seed: the same seed gives the same motions (None: a fresh draw).
             example: only for a zero-shot network that was not bound to one: the style to produce, as a motion file
-                (``walk.bvh`` or ``walk.bvh:120-480``, cut into this primitive's steps), clip(s) with ``frames``
-                ``(frames, 66)``, or autoencoder features ``(C, T')``.
+                (``walk.bvh`` or ``walk.bvh:120-480``, cut into this primitive's steps) or a list of them (several
+                examples: the network is conditioned on the clips of all, their mean embedding, as
+                ``stylemotion-style example=[…]``), clip(s) with ``frames`` ``(frames, 66)``, or autoencoder
+                features ``(C, T')``.
 
         Raises:
             LoadError: the model does not sample (an autoencoder), or ``example`` is missing or not wanted.
@@ -190,7 +202,7 @@ class Model:
             if example is None:
                 raise LoadError(f"{self.path} is a zero-shot style network: it samples the style of an example; "
                                 "pass example='walk.bvh:120-480' (or clips or features)")
-            if isinstance(example, (str, os.PathLike)):
+            if _is_motion_file(example):
                 example = _motion_file_example(example, self.primitive, self.fps)
             return self.model.sample(n, seed=seed, example=example)
         if example is not None:
@@ -389,6 +401,7 @@ def load(path: str | os.PathLike) -> Model | ModelSet:
         vae = stylemotion.load("runs/reproduce/synthetic/vae/walk_leftStance")   # one model
         network = stylemotion.load("runs/style/mine/network/walk_leftStance")    # a zero-shot network:
         tired = network.sample(10, seed=0, example="my_walk.bvh:120-480")        #   the example's style
+        tired = network.sample(10, seed=0, example=["a.bvh", "b.bvh:0-900"])     #   several examples' style
     """
     from stylemotion.synthesis.graph import style_folder_meta
 

@@ -90,3 +90,13 @@ def validate(model: pl.LightningModule, dm: pl.LightningDataModule) -> dict[str,
     trainer = pl.Trainer(accelerator="cpu", logger=False, enable_checkpointing=False, enable_progress_bar=False,
                          enable_model_summary=False)
     return {k: float(v) for k, v in trainer.validate(model, datamodule=dm, verbose=False)[0].items()}
+
+
+def user_examples(count: int, style: str = "exhausted") -> list:
+    """``count`` examples as ``stylemotion-style`` converts them: synthetic walks of a style the tiny data lacks."""
+    from stylemotion.datasets.synthetic import generate_take
+    from stylemotion.datasets.user_motion import ConvertedExample, ExampleSpec
+
+    takes = [generate_take("walk", style, i, seed=11, fps=30.0, duration_s=3.0 + i) for i in range(count)]
+    return [ConvertedExample(ExampleSpec(f"take{i}.bvh"), f"{i:064x}", 30.0, len(t.positions), 0, len(t.positions),
+                             t.positions, 30.0) for i, t in enumerate(takes)]

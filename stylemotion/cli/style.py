@@ -2,10 +2,11 @@
 
     stylemotion-style example=my_walk.bvh run=runs/reproduce/synthetic name=mine
     stylemotion-style example=walk_120fps.bvh:240-960 run=runs/reproduce/bandai name=limp
+    stylemotion-style 'example=[take1.bvh,take2.bvh:0-900]' run=runs/reproduce/bandai name=limp
 
 The work is :func:`stylemotion.style_example.add_style`; progress and the summary go to the log (console
-and ``style.log`` in the Hydra run folder). A bad example, frame range, run, name, method or an existing
-``out`` ends in one line naming it.
+and ``style.log`` in the Hydra run folder). A bad example (of a list: naming the item), frame range, run, name,
+method or an existing ``out`` ends in one line naming it.
 """
 
 from __future__ import annotations

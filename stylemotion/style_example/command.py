@@ -2,13 +2,15 @@
 
     stylemotion-style example=my_walk.bvh run=runs/reproduce/synthetic name=mine
     stylemotion-style example=walk_120fps.bvh:240-960 run=runs/reproduce/bandai name=limp out=runs/style/limp
+    stylemotion-style 'example=[take1.bvh,take2.bvh:0-900]' name=limp     # several examples of the style
     stylemotion-generate run=runs/style/mine style=mine      # a walk in the new style (neutral and the run's too)
 
 Stages (one progress line each, ``[k/N]``, as ``stylemotion-reproduce`` prints them):
 
-1. check the run (a finished reproduce run, :mod:`.base_run`), the name and the example, and convert
-   the example (:func:`.example.convert_example`);
-2. cut it into the run's primitives with the run's segmentation (:func:`.example.cut_example`);
+1. check the run (a finished reproduce run, :mod:`.base_run`), the name and the example(s), and convert
+   each (:func:`.example.convert_example`);
+2. cut them into the run's primitives with the run's segmentation and pool their clips
+   (:func:`.example.cut_examples`: each model is conditioned on the clips of every example);
 3. one model per primitive of the example's action, by ``method`` (:data:`METHODS`; ``cvae``: the run's
    StyleCVAE training, :func:`train_cvae`; ``zero_shot``: a zero-shot network per primitive bound to the
    example, :mod:`.zero_shot`);
@@ -20,7 +22,8 @@ before any work. The folder holds ``cvae/<primitive>_<name>/`` (each model's tra
 run's stages have them: checkpoints, ``config_resolved.yaml``, ``run.json``, ``metrics.json``; their
 records name the temporary folder they were trained in; ``method=zero_shot``: ``network/<primitive>/``
 when the networks are trained here), ``example/example.npz`` (the converted
-example: ``positions`` (frames, 21, 3) metres, ``fps``, ``joint_names``), ``report.md`` and
+example: ``positions`` (frames, 21, 3) metres, ``fps``, ``joint_names``; further examples in
+``example/example_<i>.npz``, :func:`.example.example_file`), ``report.md`` and
 ``report.json`` (layout in ``docs/style.md``). Paths in ``report.json`` inside ``out`` are relative to it.
 """
 
@@ -54,13 +57,13 @@ from stylemotion.skeleton import CANONICAL_JOINTS
 from stylemotion.style_example.base_run import STYLE_KIND, SourceRun, check_name, load_run, run_action, train_config
 from stylemotion.style_example.evaluate import evaluate_primitive, markdown, pooled_foot_skating
 from stylemotion.style_example.example import (
-    EXAMPLE_FILE,
     ConvertedExample,
     CutExample,
     convert_example,
-    cut_example,
+    cut_examples,
+    example_file,
     on_run_skeleton,
-    parse_example,
+    parse_examples,
 )
 from stylemotion.style_example.methods import Method, recorded_path
 from stylemotion.style_example.settings import StyleSettings
@@ -98,10 +101,11 @@ def hydra_configs() -> Iterator[None]:
 # -- methods: how a style's primitive models come about
 
 
-def train_cvae(run: SourceRun, name: str, example: ConvertedExample, cut: CutExample, folder: Path,
-               progress: Progress, threads: Any = None) -> dict[str, Path]:
+def train_cvae(run: SourceRun, name: str, cut: CutExample, folder: Path, progress: Progress,
+               threads: Any = None) -> dict[str, Path]:
     """A :class:`~stylemotion.models.cvae.StyleCVAE` per primitive, trained as the run's CVAE stage of that
-    primitive (:func:`.base_run.train_config`) on the example's clips; returns primitive → checkpoint."""
+    primitive (:func:`.base_run.train_config`) on the clips of every example (the Gram target: their mean Gram
+    matrix, :func:`stylemotion.models.style.mean_gram`); returns primitive → checkpoint."""
     from stylemotion.training.fit import run as train_run
 
     checkpoints = {}
@@ -111,8 +115,7 @@ def train_cvae(run: SourceRun, name: str, example: ConvertedExample, cut: CutExa
         progress(f"cvae {primitive}/{name}: training ({cfg.trainer.max_epochs} epochs, style_weight "
                  f"{cfg.model.style_weight}) on {len(clips)} example clip(s)")
         t0 = time.perf_counter()
-        result = train_run(cfg, datamodule_args={"example_clips": clips,
-                                                 "example_records": [example.record(c) for c in clips]})
+        result = train_run(cfg, datamodule_args={"example_clips": clips, "example_records": cut.records[primitive]})
         metrics = result["metrics"]
         last = model_folder / "checkpoints" / "last.ckpt"
         checkpoints[primitive] = Path(metrics.get("best_checkpoint") or last)
@@ -125,9 +128,9 @@ def train_cvae(run: SourceRun, name: str, example: ConvertedExample, cut: CutExa
 class CVAEMethod(Method):
     """``method=cvae``: :func:`train_cvae`; the evaluation loads each StyleCVAE as the run's own."""
 
-    def make(self, run: SourceRun, name: str, example: ConvertedExample, cut: CutExample, folder: Path,
+    def make(self, run: SourceRun, name: str, examples: Sequence[ConvertedExample], cut: CutExample, folder: Path,
              progress: Progress, threads: Any, options: Mapping[str, Any]) -> dict[str, Path]:
-        return train_cvae(run, name, example, cut, folder, progress, threads)
+        return train_cvae(run, name, cut, folder, progress, threads)
 
     def load(self, checkpoint: Path, primitive: str, clips: Sequence[Clip], records: Sequence[Mapping[str, Any]],
              name: str, neutral_style: str, autoencoder) -> EvalModel:
@@ -158,7 +161,8 @@ def method_options(method: str, options: Mapping[str, Any] | None) -> dict[str, 
 # -- the command
 
 
-def add_style(example: str, run: str | os.PathLike, name: str, out: str | os.PathLike, method: str = _D.method,
+def add_style(example: str | Sequence[str], run: str | os.PathLike, name: str, out: str | os.PathLike,
+              method: str = _D.method,
               action: str | None = _D.action, samples: int = _D.samples, seed: int | None = _D.seed,
               threads: Any = _D.threads, conversion: Mapping[str, Any] | None = None,
               command: str = "", network: Any = _D.network,
@@ -166,7 +170,8 @@ def add_style(example: str, run: str | os.PathLike, name: str, out: str | os.Pat
     """Make the models of a new style ``name`` from ``example`` and evaluate them (see the module doc).
 
     Args:
-        example: ``<BVH>[:start-end]`` (frames of the file's own frame rate, 0-based, end exclusive).
+        example: ``<BVH>[:start-end]`` (frames of the file's own frame rate, 0-based, end exclusive), or a list of
+            them (at most :data:`.example.MAX_EXAMPLES`): the models are conditioned on the clips of all.
         run: a finished ``stylemotion-reproduce`` folder.
         name: the new style's name (not a style or model name of the run).
         out: the new folder.
@@ -187,9 +192,9 @@ def add_style(example: str, run: str | os.PathLike, name: str, out: str | os.Pat
         OutputExistsError: ``out`` exists (before any work).
         ConfigError: a bad ``method``, ``samples``, ``seed``, ``threads`` or ``network_epochs``, or a key of
             another method.
-        StyleExampleError: a bad example, frame range, run or name (:class:`.base_run.NameTakenError`), an
-            example without a complete step, or a ``network`` that is not the run's (primitive, autoencoder,
-            timeline); nothing is written then.
+        StyleExampleError: a bad example (of a list: naming the item), frame range, run or name
+            (:class:`.base_run.NameTakenError`), an example without a complete step, or a ``network`` that is not
+            the run's (primitive, autoencoder, timeline); nothing is written then.
     """
     started = time.perf_counter()
     out = check_new_output(Path(out).expanduser())
@@ -201,7 +206,7 @@ def add_style(example: str, run: str | os.PathLike, name: str, out: str | os.Pat
         raise ConfigError(f"samples must be at least 2 (a spread needs two), got {samples}")
     if seed is not None and (isinstance(seed, bool) or not isinstance(seed, int) or seed < 0):
         raise ConfigError(f"seed must be a whole number ≥ 0 or null (the run's seed), got {seed!r}")
-    spec = parse_example(example)
+    specs = parse_examples(example)
     source = load_run(run)
     name = check_name(name, source)
     action = run_action(source, action)
@@ -209,18 +214,20 @@ def add_style(example: str, run: str | os.PathLike, name: str, out: str | os.Pat
     ours = [p for p in source.primitives if parse_primitive(p)[0] == action]
     options = METHODS[method].prepare(source, ours, options)
     progress = Progress(3 + METHODS[method].steps(ours, options))
-    converted = convert_example(spec, settings)
     takeset = build_dataset(source.data_cfg)
-    converted = on_run_skeleton(converted, takeset, source.settings.neutral_style)
-    progress(f"example {converted.name}: {converted.end - converted.start} of {converted.file_frames} frames at "
-             f"{converted.file_fps:g} fps → {len(converted.positions)} frames at {converted.fps:g} fps"
-             + f" on the run's skeleton (bones of {converted.retarget.get('style') or 'all takes'})"
+    converted = [on_run_skeleton(convert_example(spec, settings), takeset, source.settings.neutral_style)
+                 for spec in specs]
+    progress("; ".join((f"{c.spec.key}={c.spec}" if len(specs) > 1 else f"example {c.name}")
+                       + f": {c.end - c.start} of {c.file_frames} frames at {c.file_fps:g} fps → {len(c.positions)} "
+                       f"frames at {c.fps:g} fps" for c in converted)
+             + f" on the run's skeleton (bones of {converted[0].retarget.get('style') or 'all takes'})"
              + f"; run {source.folder} (data {takeset.name}, primitives {source.primitives})")
     with hydra_configs():
         node = train_config(source, ours[0], name, out, threads).datamodule.get("segment")
         segment = OmegaConf.to_container(node, resolve=True) if node is not None else {}
-    cut = cut_example(converted, name, action, source.primitives, segment)
-    progress(f"{converted.name} cut with the run's segmentation: "
+    cut = cut_examples(converted, name, action, source.primitives, segment)
+    what = converted[0].name if len(converted) == 1 else f"{len(converted)} examples"
+    progress(f"{what} cut with the run's segmentation: "
              + ", ".join(f"{p} {len(c)}" for p, c in cut.clips.items())
              + (f"; {cut.borrowed} take the example's other steps" if cut.borrowed else "")
              + (f"; no model of {cut.skipped} (another action)" if cut.skipped else ""))
@@ -232,7 +239,8 @@ def add_style(example: str, run: str | os.PathLike, name: str, out: str | os.Pat
                            options)
         results["meta"].update(provenance(command or None), seconds=time.perf_counter() - started,
                                run_relative=os.path.relpath(source.folder.resolve(), out.resolve()))
-        write_example(converted, tmp / EXAMPLE_FILE)
+        for i, one in enumerate(converted):
+            write_example(one, tmp / example_file(i))
         results = plain(results)
         write_json(tmp / "report.json", results)
         (tmp / "report.md").write_text(markdown(results))
@@ -252,11 +260,14 @@ def conversion_settings(run: SourceRun, conversion: Mapping[str, Any] | None) ->
     return ConversionSettings(fps=float(fps), **{k: v for k, v in values.items() if v is not None})
 
 
-def evaluate(run: SourceRun, takeset: TakeSet, name: str, method: str, example: ConvertedExample, cut: CutExample,
+def evaluate(run: SourceRun, takeset: TakeSet, name: str, method: str, examples: Sequence[ConvertedExample],
+             cut: CutExample,
              checkpoints: Mapping[str, Path], folder: Path, samples: int, seed: int | None,
              options: Mapping[str, Any] | None = None) -> dict[str, Any]:
     """The report of the new models against ``run`` and its data ``takeset`` (``report.json`` layout without
-    provenance); paths inside ``folder`` relative to it; ``options``: the method's keys (see :meth:`Method.prepare`)."""
+    provenance); paths inside ``folder`` relative to it; ``options``: the method's keys (see :meth:`Method.prepare`).
+    ``examples``: every example, in order (``report.json``'s ``examples``; ``example`` is the one example's record
+    when there is one, else what they make together)."""
     impl = METHODS[method]
     settings = run.settings
     seed = run.seed if seed is None else int(seed)
@@ -270,7 +281,7 @@ def evaluate(run: SourceRun, takeset: TakeSet, name: str, method: str, example: 
         if action not in segmentations:
             segmentations[action] = segment_action(takeset.takes, action, settings.segment)
         clips = cut.used[primitive]
-        new = loaded[primitive] = impl.load(ckpt, primitive, clips, [example.record(c) for c in clips], name,
+        new = loaded[primitive] = impl.load(ckpt, primitive, clips, cut.records[primitive], name,
                                             settings.neutral_style, autoencoder)
         per[primitive] = evaluate_primitive(primitive, run.models(primitive, autoencoder), new, cut.used[primitive],
                                             takeset, autoencoder, settings, run.data_cfg.get("split"), samples, seed,
@@ -282,15 +293,15 @@ def evaluate(run: SourceRun, takeset: TakeSet, name: str, method: str, example: 
     entries = [{"path": m["checkpoint"], "primitive": p, "name": name, "style": name,
                 **({"path_relative": os.path.relpath(m["checkpoint"], folder.resolve())}
                    if Path(m["checkpoint"]).is_absolute() else {}),
-                **impl.entry(p, cut.used[p])} for p, m in models.items()]
+                **impl.entry(p, cut.used[p], cut.origin[p], len(examples))} for p, m in models.items()]
+    records = [example_record(e, i, cut) for i, e in enumerate(examples)]
     return {
         "name": name, "method": method,
-        "example": {"file": example.name, "sha256": example.sha256, "file_fps": example.file_fps,
-                    "file_frames": example.file_frames, "file_range": [example.start, example.end],
-                    "frames": int(len(example.positions)), "fps": example.fps,
-                    "retarget": example.retarget, "clips": {p: len(c) for p, c in cut.clips.items()},
-                    "rejected_steps": [{"reason": r.reason, "kind": r.kind, "start": r.start, "stop": r.stop}
-                                       for r in cut.segmentation.rejections]},
+        "example": records[0] if len(records) == 1 else {
+            "count": len(records), "files": [r["file"] for r in records], "frames": sum(r["frames"] for r in records),
+            "fps": records[0]["fps"], "retarget": records[0]["retarget"],
+            "clips": {p: len(c) for p, c in cut.clips.items()}},
+        "examples": records,
         "models": models, "skipped": cut.skipped, "samples": samples,
         "table_5_1_row": {p: r["table_5_1_row"] for p, r in per.items()},
         "table_5_1_columns": {p: r["columns"] for p, r in per.items()},
@@ -307,6 +318,20 @@ def evaluate(run: SourceRun, takeset: TakeSet, name: str, method: str, example: 
                  "paths_relative_to": ".", "settings": asdict(settings)},
         **impl.report(loaded, folder, options or {}),
     }
+
+
+def example_record(example: ConvertedExample, index: int, cut: CutExample) -> dict[str, Any]:
+    """What ``report.json`` records of example ``index`` (0-based): its file, sha256, frames used, conversion, the
+    clips cut from it per primitive, its rejected steps and where the style folder keeps it (``saved``)."""
+    segmentation = (cut.segmentations or [cut.segmentation])[index]
+    return {"file": example.name, "spec": str(example.spec), "sha256": example.sha256, "file_fps": example.file_fps,
+            "file_frames": example.file_frames, "file_range": [example.start, example.end],
+            "frames": int(len(example.positions)), "fps": example.fps, "retarget": example.retarget,
+            "clips": {p: sum(1 for c in segmentation.clips if f"{c.action}_{c.primitive}" == p) for p in cut.clips},
+            "used_clips": {p: sum(1 for i in origin if i == index) for p, origin in cut.origin.items()},
+            "rejected_steps": [{"reason": r.reason, "kind": r.kind, "start": r.start, "stop": r.stop}
+                               for r in segmentation.rejections],
+            "saved": example_file(index)}
 
 
 def write_example(example: ConvertedExample, path: Path) -> None:
@@ -348,7 +373,7 @@ def add_style_from_config(cfg: DictConfig | Mapping[str, Any], command: str = ""
             if OmegaConf.is_missing(cfg, key):
                 raise ConfigError(f"{key} is missing: give {form}")
     _, s = settings_from_config(cfg, StyleSettings, "style")
-    return add_style(str(s.example), s.run, s.name, s.out, method=s.method, action=s.action, samples=s.samples,
+    return add_style(s.example, s.run, s.name, s.out, method=s.method, action=s.action, samples=s.samples,
                      seed=s.seed, threads=s.threads, conversion=conversion_keys(vars(s)), command=command,
                      network=s.network, network_epochs=s.network_epochs)
 

@@ -113,8 +113,10 @@ def evaluate_primitive(primitive: str, run_models: Sequence[EvalModel], new: Eva
 
 
 def _clips(model: dict[str, Any]) -> str:
-    """A model's example clips as frames of the user's file."""
-    return ("; ".join(f"{c['primitive']} {c['file_frames'][0]}–{c['file_frames'][1]}" for c in model["examples"])
+    """A model's example clips as frames of the user's file (files, when they come from several)."""
+    several = len({(c.get("file"), tuple(c.get("file_range") or ())) for c in model["examples"]}) > 1
+    return ("; ".join((f"{c['file']} " if several else "") + f"{c['primitive']} {c['file_frames'][0]}–"
+                      f"{c['file_frames'][1]}" for c in model["examples"])
             + (" (none of this primitive: the example's other steps)" if model["borrowed"] else ""))
 
 
@@ -158,12 +160,18 @@ def pooled_foot_skating(per_primitive: dict[str, dict[str, Any]], kind: str) -> 
 
 def markdown(results: dict[str, Any]) -> str:
     """``report.md`` of a new style (``results``: the ``report.json`` layout, see ``docs/style.md``)."""
-    meta, example, name = results["meta"], results["example"], results["name"]
-    out = [f"# New style `{name}` from an example", ""]
-    rng = (f", frames {example['file_range'][0]}–{example['file_range'][1]} of {example['file_frames']} at "
-           f"{example['file_fps']:g} fps")
-    out += [f"Example `{example['file']}`{rng} (sha256 `{example['sha256'][:16]}…`), converted to "
-            f"{example['frames']} frames at {example['fps']:g} fps; method `{results['method']}`. It extends the "
+    meta, name = results["meta"], results["name"]
+    examples = results.get("examples") or [results["example"]]
+    out = [f"# New style `{name}` from {'an example' if len(examples) == 1 else f'{len(examples)} examples'}", ""]
+
+    def described(example: dict[str, Any]) -> str:
+        return (f"`{example['file']}`, frames {example['file_range'][0]}–{example['file_range'][1]} of "
+                f"{example['file_frames']} at {example['file_fps']:g} fps (sha256 `{example['sha256'][:16]}…`), "
+                f"converted to {example['frames']} frames at {example['fps']:g} fps")
+
+    what = (f"Example {described(examples[0])}" if len(examples) == 1 else
+            f"Examples (every model takes the clips of all): {'; '.join(described(e) for e in examples)}")
+    out += [f"{what}; method `{results['method']}`. It extends the "
             f"reproduce run `{meta['run']}` (data `{meta['data_name']}`, seed {meta['train_seed']}); "
             f"{fmt(results['samples'])} samples per model (seed {meta['seed']}). Git commit "
             f"`{meta.get('git_commit', '?')}`; {fmt(meta.get('seconds'), 3)} s.", ""]

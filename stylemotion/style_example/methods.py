@@ -44,23 +44,26 @@ class Method:
         """Progress lines :meth:`make` prints for ``primitives``."""
         return len(primitives)
 
-    def make(self, run, name: str, example, cut, folder: Path, progress: ProgressLine, threads: Any,
+    def make(self, run, name: str, examples, cut, folder: Path, progress: ProgressLine, threads: Any,
              options: Mapping[str, Any]) -> dict[str, Path]:
-        """The style's checkpoints, primitive → file (made in ``folder``, or taken from elsewhere)."""
+        """The style's checkpoints, primitive → file (made in ``folder``, or taken from elsewhere); ``examples``: the
+        converted examples, ``cut``: their pooled clips (:func:`.example.cut_examples`)."""
         raise NotImplementedError
 
     def load(self, checkpoint: Path, primitive: str, clips: Sequence[Clip], records: Sequence[Mapping[str, Any]],
              name: str, neutral_style: str, autoencoder) -> EvalModel:
-        """The model of ``primitive`` the report evaluates, from its ``checkpoint`` and the example ``clips``
-        (``records``: plain values of each clip in the user's file)."""
+        """The model of ``primitive`` the report evaluates, from its ``checkpoint`` and the example ``clips`` (of
+        every example; ``records``: plain values of each clip in the user's file)."""
         raise NotImplementedError
 
     def report(self, models: Mapping[str, EvalModel], folder: Path, options: Mapping[str, Any]) -> dict[str, Any]:
         """Further ``report.json`` values of the method (none by default)."""
         return {}
 
-    def entry(self, primitive: str, clips: Sequence[Clip]) -> dict[str, Any]:
-        """Further values of ``primitive``'s entry in ``meta.checkpoints`` (none by default)."""
+    def entry(self, primitive: str, clips: Sequence[Clip], origin: Sequence[int] = (), examples: int = 1
+              ) -> dict[str, Any]:
+        """Further values of ``primitive``'s entry in ``meta.checkpoints`` (none by default); ``origin``: the example
+        (0-based) of each clip, of ``examples`` in all."""
         return {}
 
 

@@ -17,7 +17,8 @@ trained on the run's autoencoder (weight fingerprint) and on the run's canonical
 
 The style folder records, in each ``meta.checkpoints`` entry, the network's checkpoint, the example's
 file (``example/example.npz``) and the clips' frames in it (``clips``: ``[start, stop)`` at the run's frame
-rate): ``stylemotion-generate`` binds the same clips again
+rate); with several examples, ``example`` lists their files and each clip is ``[start, stop, example]``
+(0-based place in that list): ``stylemotion-generate`` binds the same clips again
 (:func:`stylemotion.synthesis.graph.load_bound_style`).
 """
 
@@ -42,7 +43,7 @@ from stylemotion.models.loading import EvalModel, load_generative
 from stylemotion.models.zero_shot import ZeroShotStyleVAE
 from stylemotion.primitives.segmentation import Clip
 from stylemotion.style_example.base_run import SourceRun, train_config
-from stylemotion.style_example.example import EXAMPLE_FILE, StyleExampleError
+from stylemotion.style_example.example import EXAMPLE_FILE, StyleExampleError, example_file
 from stylemotion.style_example.methods import Method, ProgressLine, recorded_path
 
 log = logging.getLogger(__name__)
@@ -234,5 +235,10 @@ class ZeroShotMethod(Method):
             "trained_styles": {p: n.styles for p, n in networks.items()},
             "excluded_styles": {p: n.excluded_styles for p, n in networks.items()}}}
 
-    def entry(self, primitive: str, clips: Sequence[Clip]) -> dict[str, Any]:
-        return {"method": "zero_shot", "example": EXAMPLE_FILE, "clips": [[int(c.start), int(c.stop)] for c in clips]}
+    def entry(self, primitive: str, clips: Sequence[Clip], origin: Sequence[int] = (), examples: int = 1
+              ) -> dict[str, Any]:
+        if examples == 1:
+            return {"method": "zero_shot", "example": EXAMPLE_FILE,
+                    "clips": [[int(c.start), int(c.stop)] for c in clips]}
+        return {"method": "zero_shot", "example": [example_file(i) for i in range(examples)],
+                "clips": [[int(c.start), int(c.stop), int(i)] for c, i in zip(clips, origin)]}

@@ -231,16 +231,19 @@ def _style_entry(entry: Mapping[str, Any], folder: Path) -> dict[str, Any]:
     if not path.is_file() and entry.get("path_relative"):
         path = Path(os.path.normpath(folder / entry["path_relative"]))
     out["path"] = str(path)
-    if entry.get("example"):
-        out["example"] = os.path.normpath(folder / entry["example"])
-        out["clips"] = [[int(a), int(b)] for a, b in entry["clips"]]
+    if entry.get("example"):  # one file, or several (``stylemotion-style example=[…]``: clips [start, stop, file])
+        files = entry["example"]
+        out["example"] = (os.path.normpath(folder / files) if isinstance(files, str)
+                          else [os.path.normpath(folder / f) for f in files])
+        out["clips"] = [[int(v) for v in clip] for clip in entry["clips"]]
     return out
 
 
 def load_bound_style(entry: Mapping[str, Any], autoencoder=None) -> BoundExample:
     """The zero-shot network of a style folder's entry (:func:`available_models`) bound again to the clips
-    the style was made from: ``entry["example"]`` (``positions`` (frames, 21, 3) metres, ``fps``) cut at
-    ``entry["clips"]``, as ``stylemotion-style method=zero_shot`` bound them.
+    the style was made from: ``entry["example"]`` (``positions`` (frames, 21, 3) metres, ``fps``; or a list of such
+    files) cut at ``entry["clips"]`` (``[start, stop]``, or ``[start, stop, file index]``), as ``stylemotion-style
+    method=zero_shot`` bound them.
 
     Raises:
         FileNotFoundError: the checkpoint or the example file is gone.
@@ -250,13 +253,15 @@ def load_bound_style(entry: Mapping[str, Any], autoencoder=None) -> BoundExample
     if not isinstance(network, ZeroShotStyleVAE):
         raise IncompatibleModelError(f"{entry['path']} is a {type(network).__name__}, not the zero-shot network the "
                                      f"style {entry['name']} records")
-    example = Path(entry["example"])
-    if not example.is_file():
-        raise RunFolderError(f"style {entry['name']}: its example {example} is gone; the zero-shot network "
-                                "samples the style only with it")
-    with np.load(example) as npz:
-        frames = positions_to_frames(npz["positions"], float(npz["fps"]))[0]
-    clips = [_Frames(frames[start:stop]) for start, stop in entry["clips"]]
+    files = [entry["example"]] if isinstance(entry["example"], (str, os.PathLike)) else list(entry["example"])
+    frames = []
+    for example in map(Path, files):
+        if not example.is_file():
+            raise RunFolderError(f"style {entry['name']}: its example {example} is gone; the zero-shot network "
+                                 "samples the style only with it")
+        with np.load(example) as npz:
+            frames.append(positions_to_frames(npz["positions"], float(npz["fps"]))[0])
+    clips = [_Frames(frames[clip[2] if len(clip) > 2 else 0][clip[0]:clip[1]]) for clip in entry["clips"]]
     return network.bind_example(clips, entry["name"])
 
 

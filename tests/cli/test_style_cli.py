@@ -91,3 +91,14 @@ def test_the_config_names_a_missing_key(tmp_path: Path, missing: str, message: s
         add_style_from_config(cfg)
     assert cfg.method == "cvae" and cfg.samples == 1000 and not (tmp_path / "out").exists()
     assert cfg.network is None and cfg.network_epochs is None
+
+
+def test_a_bad_item_of_an_example_list_is_one_line_naming_it(run: Path, tmp_path: Path, capsys, monkeypatch) -> None:
+    good = example_bvh(tmp_path)
+    gone = tmp_path / "gone.bvh"
+    for bad, message in ((f"{good}:9-3", f"stylemotion-style: example[2]={good}:9-3: the frame range 9-3 is empty"),
+                         (str(gone), f"stylemotion-style: example[2]={gone}: ")):
+        done = run_command("style", f"example=[{good},{bad}]", f"run={run}", "name=mine", f"out={tmp_path / 'out'}",
+                           f"hydra.run.dir={tmp_path / 'hydra'}", cwd=tmp_path, capsys=capsys, monkeypatch=monkeypatch)
+        assert one_line_error(done, "stylemotion-style").startswith(message)
+        assert not (tmp_path / "out").exists()

@@ -5,9 +5,10 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
 import pytest
 import torch
-from vae_fixtures import TINY_HIDDEN, feature_module, fit, tiny_autoencoder_ckpt
+from vae_fixtures import TINY_HIDDEN, feature_module, fit, tiny_autoencoder_ckpt, user_examples
 
 from stylemotion.datamodules.clips import NoClipsError
 from stylemotion.datamodules.features import ReceptiveFieldError, encode_examples
@@ -159,3 +160,40 @@ def test_checkpoints_from_before_the_margin_term_still_load(elderly, tmp_path) -
     loaded = StyleCVAE.load_from_checkpoint(tmp_path / "old.ckpt")
     assert loaded.hparams.style_term == "distance" and torch.isnan(loaded.content_spread)
     assert torch.allclose(loaded.style_gram, cvae.style_gram)
+
+
+def test_the_gram_target_of_k_examples_is_the_mean_gram_of_all_their_clips(ae_ckpt) -> None:
+    """stylemotion-style example=[…]: the CVAE's target is the mean Gram over the clips of every example, checked
+    against the Grams computed here in float64 from each clip resampled and encoded; one example alone is the
+    single-example path exactly."""
+    from stylemotion.primitives.segmentation import time_normalize
+    from stylemotion.style_example.example import cut_example, cut_examples
+
+    primitive = "walk_leftStance"
+    examples = user_examples(3)
+    cut = cut_examples(examples, "tired", "walk", [primitive], None)
+    clips = cut.used[primitive]
+    assert sorted(set(cut.origin[primitive])) == [0, 1, 2] and len(clips) > 3  # several clips of every example
+    dm = feature_module(ae_ckpt, style="tired", example_clips=clips, example_records=cut.records[primitive])
+    model = StyleCVAE(spec=dm.model_spec())
+    model._install_stats(dm)
+    autoencoder = MotionAutoencoder.load_from_checkpoint(ae_ckpt, map_location="cpu").eval()
+    grams = []
+    for clip in clips:
+        frames = torch.from_numpy(time_normalize(clip.frames, dm.timeline_frames)).float()[None]
+        with torch.no_grad():
+            f = autoencoder.encode(frames)[0].double().numpy()
+        grams.append(f @ f.T / f.shape[1])
+    expected = np.mean(grams, axis=0)
+    np.testing.assert_allclose(model.style_gram.double().numpy(), expected, rtol=1e-5,
+                               atol=1e-6 * np.abs(expected).max())
+    assert [e["file"] for e in model.style_examples] == [examples[i].name for i in cut.origin[primitive]]
+    # a list of one example: the target of that example's clips alone, as cut_example gives them
+    alone = cut_example(examples[1], "tired", "walk", [primitive], None).used[primitive]
+    one = feature_module(ae_ckpt, style="tired", example_clips=cut_examples([examples[1]], "tired", "walk",
+                                                                             [primitive], None).used[primitive])
+    single = feature_module(ae_ckpt, style="tired", example_clips=alone)
+    assert torch.equal(mean_gram(one.style_features), mean_gram(single.style_features))
+    first = [g for g, i in zip(grams, cut.origin[primitive]) if i == 1]
+    np.testing.assert_allclose(mean_gram(single.style_features).double().numpy(), np.mean(first, axis=0),
+                               rtol=1e-5, atol=1e-6 * np.abs(expected).max())

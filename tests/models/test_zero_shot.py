@@ -8,10 +8,19 @@ from __future__ import annotations
 from dataclasses import asdict
 from pathlib import Path
 
+import numpy as np
 import pytest
 import torch
 from recognition_reference import hand_share
-from vae_fixtures import TINY_DATA, feature_module, fit, tiny_autoencoder_ckpt, tiny_takeset, validate
+from vae_fixtures import (
+    TINY_DATA,
+    feature_module,
+    fit,
+    tiny_autoencoder_ckpt,
+    tiny_takeset,
+    user_examples,
+    validate,
+)
 
 from stylemotion.datamodules.multistyle import MultiStyleDataModule
 from stylemotion.evaluation.pipeline import evaluate_models
@@ -160,3 +169,48 @@ def test_bad_hyperparameters_are_refused(kwargs, message) -> None:
 def test_an_embedding_wider_than_the_data_is_refused(data) -> None:
     with pytest.raises(ValueError, match="model.embedding_dim=500 needs at least 501 training clips"):
         fit(ZeroShotStyleVAE(**{**TINY_NET, "embedding_dim": 500}), data, steps=1)
+
+
+def test_the_condition_of_k_examples_is_the_mean_embedding_and_anchor_of_all_their_clips(trained, tmp_path) -> None:
+    """stylemotion-style example=[…] and stylemotion.load(…).sample(example=[…]): the network's condition is the
+    mean over the clips of every example, checked against the embedding and anchor computed here in float64
+    from each clip resampled and encoded; the loader pools a list of motion files the same way, and a list of
+    one file is that file."""
+    from stylemotion.datasets.loading import ConversionSettings
+    from stylemotion.datasets.user_motion import convert_example, parse_example
+    from stylemotion.io.export import write_motion_bvh
+    from stylemotion.loading import Description, Model
+    from stylemotion.primitives.segmentation import time_normalize
+    from stylemotion.style_example.example import cut_examples
+
+    model = trained[True].eval()
+    examples = user_examples(3)
+    cut = cut_examples(examples, "tired", "walk", [model.primitive], None)
+    clips = cut.used[model.primitive]
+    assert sorted(set(cut.origin[model.primitive])) == [0, 1, 2]
+    embeddings, anchors = [], []
+    mean, axes = model.style_mean.double().numpy(), model.style_axes.double().numpy()
+    fmean, fstd = model.feature_mean.double().numpy(), model.feature_std.double().numpy()
+    for clip in clips:
+        frames = torch.from_numpy(time_normalize(clip.frames, model.timeline_frames)).float()[None]
+        with torch.no_grad():
+            f = model.autoencoder.encode(frames)[0].double().numpy()
+        descriptor = np.concatenate([f.mean(1), f.std(1)])
+        embeddings.append((descriptor - mean) @ axes.T / float(model.style_scale))
+        anchors.append(np.append(((f - fmean[:, None]) / fstd[:, None]).ravel(), 0.0))
+    condition = model.condition(clips)
+    np.testing.assert_allclose(condition.embedding.double().numpy(), np.mean(embeddings, 0), rtol=1e-4, atol=1e-4)
+    np.testing.assert_allclose(condition.anchor.double().numpy(), np.mean(anchors, 0), rtol=1e-4, atol=1e-4)
+    # the loader (stylemotion.load(…).sample): a list of motion files pooled as the command pools them
+    files = []
+    for i, example in enumerate(examples):
+        files.append(tmp_path / f"take{i}.bvh")
+        write_motion_bvh(example.positions, files[-1], 30.0)
+    network = Model("zero_shot", tmp_path, model, Description("zero_shot", str(tmp_path), primitive=model.primitive))
+    converted = [convert_example(parse_example(str(f)), ConversionSettings(fps=model.fps)) for f in files]
+    pooled = cut_examples(converted, "example", "walk", [model.primitive], None).used[model.primitive]
+    assert len(pooled) == len(clips)
+    assert torch.equal(network.sample(6, seed=2, example=[str(f) for f in files]).positions,
+                       model.sample(6, seed=2, example=pooled).positions)
+    assert torch.equal(network.sample(6, seed=2, example=[files[0]]).positions,
+                       network.sample(6, seed=2, example=str(files[0])).positions)

@@ -19,12 +19,15 @@ from stylemotion.datasets.registry import load_synthetic
 from stylemotion.datasets.retarget import retarget_takeset
 from stylemotion.io.sources import FileSource
 from stylemotion.style_example.example import (
+    MAX_EXAMPLES,
     ExampleSpec,
     StyleExampleError,
     convert_example,
     cut_example,
+    cut_examples,
     on_run_skeleton,
     parse_example,
+    parse_examples,
 )
 
 PRIMITIVES = ["walk_leftStance", "walk_rightStance"]
@@ -166,3 +169,63 @@ def test_the_shared_walks_of_other_skeletons_are_cut_into_the_runs_primitives(ot
     for p in PRIMITIVES:
         assert [later.record(c)["file_frames"] for c in cut_later.clips[p]] == \
             [example.record(c)["file_frames"] for c in result.clips[p]]
+
+
+# -- several examples (issue 27): example=[…]
+
+
+def test_a_single_value_or_a_list_of_one_is_exactly_the_single_example_path(tmp_path: Path) -> None:
+    text = f"{example_bvh(tmp_path, fps=60.0)}:0-200"
+    assert parse_examples(text) == [parse_example(text)] == parse_examples([text])
+    assert parse_examples([text])[0].key == "example[1]" and parse_examples(text)[0].key == "example"
+    example = convert_example(parse_example(text), ConversionSettings())
+    one, pooled = cut_example(example, "tired", "walk", PRIMITIVES, {}), cut_examples([example], "tired", "walk",
+                                                                                        PRIMITIVES, {})
+    assert pooled.used.keys() == one.used.keys()
+    for p in PRIMITIVES:
+        assert [(c.take, c.primitive, c.start, c.stop) for c in pooled.used[p]] == \
+            [(c.take, c.primitive, c.start, c.stop) for c in one.used[p]]
+        assert all(np.array_equal(a.frames, b.frames) for a, b in zip(pooled.used[p], one.used[p], strict=True))
+    assert pooled.records == one.records and pooled.borrowed == one.borrowed
+    assert pooled.origin == {p: [0] * len(one.used[p]) for p in PRIMITIVES}
+
+
+def test_the_clips_of_several_examples_are_pooled_in_order_with_their_origin(tmp_path: Path) -> None:
+    first = convert_example(parse_example(str(example_bvh(tmp_path, fps=60.0))), ConversionSettings())
+    second = convert_example(parse_example(f"{example_bvh(tmp_path, 'elderly', fps=30.0)}:0-90"),
+                             ConversionSettings())
+    cuts = [cut_example(e, "tired", "walk", PRIMITIVES, {}) for e in (first, second)]
+    pooled = cut_examples([first, second], "tired", "walk", PRIMITIVES, {})
+    for p in PRIMITIVES:
+        own = [i for i, cut in enumerate(cuts) for _ in cut.clips[p]]
+        if own:  # each example's own clips of p, in order, recorded against its own file
+            assert [(c.start, c.stop) for c in pooled.used[p]] == [(c.start, c.stop) for cut in cuts
+                                                                 for c in cut.clips[p]]
+            assert pooled.origin[p] == own
+            assert pooled.records[p] == [e.record(c) for e, cut in zip((first, second), cuts) for c in cut.clips[p]]
+    assert [s.rejections for s in pooled.segmentations] == [cut.segmentation.rejections for cut in cuts]
+    assert {r["file"] for p in PRIMITIVES for r in pooled.records[p]} == {first.name, second.name}
+
+
+@pytest.mark.parametrize("items, message", [
+    ([], r"example=\[\] is empty"),
+    (["a.bvh", "b.bvh:9-3"], r"^example\[2\]=b.bvh:9-3: the frame range 9-3 is empty"),
+    (["a.bvh", ""], r"^example\[2\]= is empty"),
+    (["a.bvh", 5], r"^example\[2\]=5: each example must be a BVH file"),
+    (["a.bvh:0-9", "a.bvh:0-9"], r"^example\[2\]=a.bvh:0-9 is example\[1\] again"),
+    ([f"w{i}.bvh" for i in range(MAX_EXAMPLES + 1)], f"lists {MAX_EXAMPLES + 1} examples; at most {MAX_EXAMPLES}"),
+])
+def test_a_bad_item_of_a_list_is_refused_in_one_line_naming_it(items, message: str) -> None:
+    with pytest.raises(StyleExampleError, match=message) as caught:
+        parse_examples(items)
+    assert "\n" not in str(caught.value)
+
+
+def test_an_item_whose_file_is_bad_is_named_by_its_place(tmp_path: Path) -> None:
+    good = str(example_bvh(tmp_path, fps=60.0))
+    [_, missing] = parse_examples([good, str(tmp_path / "nope.bvh")])
+    with pytest.raises(StyleExampleError, match=r"^example\[2\]=.*nope.bvh"):
+        convert_example(missing, ConversionSettings())
+    with pytest.raises(StyleExampleError, match=r"^example\[2\]=.*:0-20: no complete step"):
+        cut_examples([convert_example(s, ConversionSettings()) for s in parse_examples([good, f"{good}:0-20"])],
+                     "tired", "walk", PRIMITIVES, {})

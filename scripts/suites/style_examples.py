@@ -1,0 +1,316 @@
+"""Suite ``style_examples``: the zero-shot network conditioned on k = 1, 2, 4, 8 examples of a style it never saw.
+
+Issue 27, item 2: does a style keep more of its variation when the model sees several takes of it? No network is
+trained here: the suite reads the finished leave-one-style-out trainings of suite ``zero_shot``
+(``--loso runs/benchmarks/zero_shot/<data>/loso_<judge>[_e<epochs>]``, one ``seed<k>/`` per seed, each with its
+``zero_shot.json``). For each seed ``k``, each primitive ``p`` and left-out style ``s`` there:
+
+1. the network of ``p`` trained without ``s`` (and on an autoencoder that never saw ``s``:
+   :func:`stylemotion.evaluation.zero_shot.load_left_out`, decoding with its own autoencoder,
+   :func:`~stylemotion.evaluation.zero_shot.generator_autoencoder`);
+2. for each k of ``--ks``: k example clips drawn from the **train-split** clips of ``s`` of ``p`` (one seeded
+   permutation per seed, primitive and style, its first k: the draws are nested, k = 2 holds k = 1's clip),
+   bound to the network (their mean embedding and anchor, the pooling ``stylemotion-style example=[…]`` uses,
+   :meth:`~stylemotion.models.zero_shot.ZeroShotStyleVAE.condition`);
+3. ``--samples`` samples (seed ``k``), measured by the judge of suite ``zero_shot`` (the reproduction the trainings
+   were evaluated with, ``zero_shot.json``'s ``meta.run``: its autoencoder's Table 5.1 space and its style
+   classifier, :func:`stylemotion.evaluation.pipeline.real_side`): **recognition** (the share classified as
+   ``s``), the **Table 5.1 row** and whether ``s``'s own column (the example of the run's CVAE of ``s``) is its
+   minimum (:func:`stylemotion.evaluation.zero_shot._table_row`), and pose_SD, V_SD, step_SD, pose_across_SD
+   (:func:`stylemotion.evaluation.tables.variance_stats`) and diversity (mean pairwise distance in the classifier's
+   features, :func:`stylemotion.evaluation.metrics.diversity`), each also as a share of the same figure of the
+   style's **held-out** (val + test split) real clips.
+
+The aims of issue 27 at k = 4: V_SD and step_SD ≥ 80 % and diversity ≥ 70 % of the held-out real clips, recognition
+≥ 90 %, the own column the minimum; k = 1 is the single-example protocol of suite ``zero_shot`` (its example is one
+train clip drawn here, not the CVAE's example).
+
+``--data`` names the data the trainings are of (checked against the judge's); synthetic is a smoke test only.
+"""
+
+from __future__ import annotations
+
+import argparse
+import zlib
+from pathlib import Path
+from typing import Any
+
+from suites.common import fmt, fmt_range, fmt_spread, md_table, progress_printed, provenance_line, spread
+
+DESCRIPTION = ("zero-shot style network conditioned on k = 1, 2, 4, 8 train-split examples of a style it never saw "
+               "(suite zero_shot's leave-one-style-out trainings, no training per k): recognition, Table 5.1 row, "
+               "V_SD, step_SD, pose spread and diversity against the style's held-out real clips, over seeds")
+DEFAULT_SEEDS = (0, 1, 2)
+ROOT = Path(__file__).resolve().parents[2]
+#: Example counts of the curve.
+KS = (1, 2, 4, 8)
+#: Variation figures, measured on the samples and on the style's held-out real clips.
+VARIATION = ("pose_sd", "v_sd", "step_sd", "pose_across_sd", "diversity")
+#: Issue 27's aims at k = 4: a share of the held-out real clips' figure each style must reach.
+AIMS = {"v_sd": 0.8, "step_sd": 0.8, "diversity": 0.7}
+#: The aimed recognition at k = 4.
+AIM_RECOGNITION = 0.9
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--loso", type=Path, required=True,
+                        help="suite zero_shot's trainings: a folder with seed<k>/zero_shot.json per seed (e.g. "
+                             "runs/benchmarks/zero_shot/bandai/loso_<judge>_e<epochs>); read only")
+    parser.add_argument("--data", choices=("synthetic", "bandai"), default="synthetic",
+                        help="the data the trainings are of (checked against their judge run)")
+    parser.add_argument("--ks", type=int, nargs="+", default=list(KS), help="example counts of the curve")
+    parser.add_argument("--samples", type=int, default=1000, help="samples per network, k and seed")
+    parser.add_argument("--styles", nargs="+", default=None, help="left-out styles (default: every one trained)")
+    parser.add_argument("--primitives", nargs="+", default=None, help="primitives (default: every one trained)")
+
+
+def relative(path: Path | str) -> str:
+    path = Path(path)
+    return str(path.relative_to(ROOT)) if path.is_relative_to(ROOT) else str(path)
+
+
+def draw_examples(clips: list, ks: list[int], seed: int, primitive: str, style: str) -> dict[int, list]:
+    """k → the first k clips of one permutation of ``clips`` (sorted by take and frame first) seeded by ``seed``
+    and the primitive and style (nested draws); a k above the clip count is left out."""
+    import numpy as np
+
+    ordered = sorted(clips, key=lambda c: (c.take, c.start))
+    rng = np.random.default_rng([int(seed), zlib.crc32(f"{primitive}/{style}".encode())])
+    permuted = [ordered[i] for i in rng.permutation(len(ordered))]
+    return {k: permuted[:k] for k in ks if k <= len(permuted)}
+
+
+class Judge:
+    """The judge run of the trainings (``zero_shot.json``'s ``meta.run``): its autoencoder, data and, per primitive,
+    its real side and Table 5.1 columns, built once."""
+
+    def __init__(self, folder: str | Path):
+        from stylemotion.datasets import build_dataset
+        from stylemotion.evaluation.zero_shot import read_run
+        from stylemotion.models.checkpoints import load_autoencoder
+
+        self.source = read_run(folder)
+        self.autoencoder = load_autoencoder(self.source.autoencoder_ckpt)
+        self.takeset = build_dataset(self.source.data_cfg)
+        self._sides: dict[str, tuple[Any, list[str], Any]] = {}
+
+    def side(self, primitive: str) -> tuple[Any, list[str], Any]:
+        """``(real side, Table 5.1 column names, their Grams)`` of ``primitive``, as suite zero_shot's evaluation
+        has them: the neutral mean motion and the example of each of the run's CVAEs."""
+        if primitive not in self._sides:
+            import torch
+
+            from stylemotion.evaluation.pipeline import example_column_gram, real_side
+            from stylemotion.models.loading import NEUTRAL, EvalModel, load_model
+
+            source, settings = self.source, self.source.settings
+            cvaes = [load_model(source.cvaes[(q, s)], settings.neutral_style, self.autoencoder)
+                     for q, s in source.cvaes if q == primitive]
+            real = real_side(primitive, cvaes, self.takeset, settings, source.data_cfg.get("split"))
+            neutral = EvalModel(NEUTRAL, primitive, settings.neutral_style, source=None)
+            grams = torch.stack([example_column_gram(self.autoencoder, real, m) for m in [neutral, *real.models]])
+            self._sides[primitive] = (real, [NEUTRAL] + [m.name for m in real.models], grams)
+        return self._sides[primitive]
+
+
+def variation_figures(real, motions) -> dict[str, float]:
+    """pose_SD, V_SD, step_SD, pose_across_SD (:func:`~stylemotion.evaluation.tables.variance_stats`) and diversity
+    (classifier features) of ≥ 2 motions."""
+    from stylemotion.evaluation.metrics import diversity
+    from stylemotion.evaluation.tables import variance_stats
+
+    stats = variance_stats(motions.frames.numpy(), motions.positions.numpy(), motions.num_frames.numpy(),
+                           motions.normalized_frames.numpy())
+    return {**{k: float(stats[k]) for k in VARIATION[:-1]}, "diversity": diversity(real.features(motions))}
+
+
+def style_curve(judge: Judge, network, primitive: str, style: str, ks: list[int], samples: int,
+                seed: int) -> dict[str, Any]:
+    """The curve of one left-out network: per k its recognition, Table 5.1 row and variation (and shares of the
+    held-out real clips'), and the held-out real clips' figures."""
+    from stylemotion.datamodules.features import describe_clip
+    from stylemotion.evaluation.pipeline import recognition
+    from stylemotion.evaluation.sources import motions_from_clips
+    from stylemotion.evaluation.zero_shot import _table_row, generator_autoencoder
+    from stylemotion.models.loading import EvalModel
+
+    real, columns, grams = judge.side(primitive)
+    settings = judge.source.settings
+    generator_autoencoder(network)  # it decodes with the autoencoder it was trained on
+    heldout = motions_from_clips(real.data.heldout(style), real.length)
+    reference = variation_figures(real, heldout)
+    truth = real.features(real.truth[style])
+    train = real.data.split("train", style)
+    out: dict[str, Any] = {"train_clips": len(train), "heldout_clips": len(heldout.num_frames), "real": reference,
+                           "ks": {}}
+    for k, clips in draw_examples(train, ks, seed, primitive, style).items():
+        records = [describe_clip(c) for c in clips]
+        bound = network.bind_example(clips, style, records)
+        model = EvalModel(f"zero_shot:{style}", primitive, style, bound, records, dict(network.spec["autoencoder"]),
+                          network.checkpoint_file, network.timeline_frames, bound.target_gram,
+                          network.spec.get("dataset"), "canonical")
+        drawn = bound.sample(samples, seed=seed)
+        judged = recognition(real, model, real.features(drawn), truth)
+        row = _table_row(judge.autoencoder, drawn.normalized_frames, style, columns, grams, settings)
+        figures = variation_figures(real, drawn)
+        out["ks"][str(k)] = {
+            "recognition": judged.share, "own_column_is_minimum": bool(row["own_column_is_minimum"]),
+            "nearest_column": row["nearest_column"], "table_5_1_row": row["table_5_1_row"], **figures,
+            "vs_real": {m: figures[m] / reference[m] if reference[m] else None for m in VARIATION},
+            "examples": [{k_: r[k_] for k_ in ("take", "start", "stop")} for r in records]}
+    return out
+
+
+def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
+    import torch
+
+    from stylemotion.evaluation.zero_shot import ZeroShotRunError, load_left_out
+    from stylemotion.io.jsonfile import read_json_object
+
+    torch.set_num_threads(1)
+    ks = sorted({int(k) for k in args.ks})
+    if not ks or ks[0] < 1:
+        raise ZeroShotRunError(f"--ks must be whole numbers ≥ 1, got {args.ks}")
+    judges: dict[str, Judge] = {}
+    per_seed: dict[str, Any] = {}
+    for seed in seeds:
+        folder = args.loso.expanduser() / f"seed{seed}"
+        record = read_json_object(folder / "zero_shot.json", "suite zero_shot's results",
+                                  f"run suite zero_shot with --seeds {seed} first")
+        if record["meta"].get("leaky"):
+            raise ZeroShotRunError(f"{folder} holds the leaky protocol (networks on the judge's autoencoder); give "
+                                   "the leakage-free trainings")
+        judge_folder = str(record["meta"]["run"])
+        if judge_folder not in judges:
+            judges[judge_folder] = Judge(judge_folder)
+        judge = judges[judge_folder]
+        name = judge.source.data_cfg.get("name")
+        if (name == "synthetic") != (args.data == "synthetic"):
+            raise ZeroShotRunError(f"{folder}'s judge run holds {name!r} data, not --data {args.data}")
+        curves: dict[str, Any] = {}
+        for p, res in record["primitives"].items():
+            if args.primitives and p not in args.primitives:
+                continue
+            for s, row in res["styles"].items():
+                if args.styles and s not in args.styles:
+                    continue
+                network = load_left_out(Path(row["zero_shot"]["checkpoint"]), p, s,
+                                        row["generator_autoencoder"]["fingerprint"])
+                with progress_printed(f"[seed {seed} {p}/{s}]"):
+                    curves.setdefault(p, {})[s] = style_curve(judge, network, p, s, ks, args.samples, seed)
+        per_seed[str(seed)] = {"loso": relative(folder), "judge": relative(judge_folder), "curves": curves}
+    return summarize(per_seed, ks, args)
+
+
+def summarize(per_seed: dict[str, Any], ks: list[int], args: argparse.Namespace) -> dict[str, Any]:
+    """Spreads over seeds per style and k, the headline per k (means over styles), and the aims met at each k."""
+    first = next(iter(per_seed.values()))
+    left_out = [(p, s) for p, styles in first["curves"].items() for s in styles]
+    per_style: dict[str, Any] = {}
+    for p, s in left_out:
+        curves = [v["curves"][p][s] for v in per_seed.values() if s in v["curves"].get(p, {})]
+        per_style.setdefault(p, {})[s] = {
+            "seeds": len(curves), "train_clips": curves[0]["train_clips"], "heldout_clips": curves[0]["heldout_clips"],
+            "real": curves[0]["real"],
+            "ks": {str(k): {"recognition": spread(c["ks"][str(k)]["recognition"] for c in curves if str(k) in c["ks"]),
+                            "own_column_is_minimum": sum(bool(c["ks"][str(k)]["own_column_is_minimum"])
+                                                         for c in curves if str(k) in c["ks"]),
+                            "vs_real": {m: spread(c["ks"][str(k)]["vs_real"][m] for c in curves if str(k) in c["ks"])
+                                        for m in VARIATION}}
+                   for k in ks}}
+    headline: dict[str, Any] = {}
+    for k in ks:
+        by_seed = {}
+        for key, v in per_seed.items():
+            cells = [v["curves"][p][s]["ks"][str(k)] for p, s in left_out
+                     if str(k) in v["curves"].get(p, {}).get(s, {}).get("ks", {})]
+            if cells:
+                by_seed[key] = {
+                    "recognition": sum(c["recognition"] for c in cells) / len(cells),
+                    "own_column_is_minimum": sum(bool(c["own_column_is_minimum"]) for c in cells), "rows": len(cells),
+                    **{m: _mean(c["vs_real"][m] for c in cells) for m in VARIATION},
+                    "aims_met": sum(all((c["vs_real"][m] or 0) >= a for m, a in AIMS.items())
+                                    and c["recognition"] >= AIM_RECOGNITION for c in cells)}
+        headline[str(k)] = {**{key: spread(b[key] for b in by_seed.values())
+                               for key in ("recognition", "own_column_is_minimum", "aims_met", *VARIATION)},
+                            "rows_per_seed": max((b["rows"] for b in by_seed.values()), default=0)}
+    return {"data": args.data, "loso": relative(args.loso.expanduser()), "ks": ks, "samples": args.samples,
+            "judge": sorted({v["judge"] for v in per_seed.values()}),
+            "left_out": [f"{p}/{s}" for p, s in left_out],
+            "subsample": {"primitives": args.primitives, "styles": args.styles},
+            "aims": {"k": 4, **{f"{m}_vs_real": a for m, a in AIMS.items()}, "recognition": AIM_RECOGNITION},
+            "splits": {"examples": "k clips of the left-out style drawn from its train-split clips (nested: one seeded "
+                                   "permutation per seed, primitive and style)",
+                       "reference": "the left-out style's held-out (val + test split) real clips",
+                       "judge": "suite zero_shot's judge run: its autoencoder (Table 5.1) and style classifier "
+                                "(fitted on the train-split clips of every style, the left-out one included)",
+                       "networks": "suite zero_shot's leave-one-style-out trainings (autoencoder and network without "
+                                   "the style); nothing trained here",
+                       "seed_varies": "the trainings (a seed each), the example draws and the samples; the judge "
+                                      "is fixed"},
+            "headline": headline, "per_style": per_style,
+            "per_seed": {k: {"loso": v["loso"], "judge": v["judge"]} for k, v in per_seed.items()}}
+
+
+def _mean(values) -> float | None:
+    finite = [float(v) for v in values if v is not None]
+    return sum(finite) / len(finite) if finite else None
+
+
+def _label(r: dict[str, Any]) -> str:
+    label = ("**Synthetic data: a smoke test of the pipeline, not evidence that the method works.** "
+             if r["data"] == "synthetic" else "")
+    sub = r.get("subsample") or {}
+    if sub.get("styles") or sub.get("primitives"):
+        label += "**Narrowed** (not every trained style and primitive): " + ", ".join(r["left_out"]) + ". "
+    return label
+
+
+def render(record: dict[str, Any]) -> dict[str, str]:
+    r = record["results"]
+    seeds = len(record.get("seeds", []))
+    prov = provenance_line(record)
+    label = _label(r)
+    protocol = (f"Networks of suite zero_shot (`{r['loso']}`: per seed an autoencoder and a network that never saw "
+                f"the left-out style), each conditioned on k clips of the style drawn from its train split (nested "
+                f"draws; their mean embedding and anchor, as `stylemotion-style example=[…]` pools them); "
+                f"{r['samples']:,} samples per network, k and seed, judged by run(s) {', '.join(r['judge'])} (its "
+                f"autoencoder's Table 5.1 columns and its style classifier). Variation as a share of the style's "
+                f"held-out (val + test) real clips.")
+    rows = []
+    for k in r["ks"]:
+        h = r["headline"][str(k)]
+        rows.append([str(k), f"{fmt_spread(h['recognition'], 3)} ({fmt_range(h['recognition'], 3)})",
+                     f"{fmt_spread(h['own_column_is_minimum'], 1)} of {h['rows_per_seed']}",
+                     *(fmt_spread(h[m], 2) for m in ("v_sd", "step_sd", "pose_across_sd", "pose_sd", "diversity")),
+                     f"{fmt_spread(h['aims_met'], 1)} of {h['rows_per_seed']}"])
+    headline = (f"{label}Zero-shot style network from k examples of a style it never saw ({r['data']}, {seeds} seeds; "
+                f"left out: {', '.join(r['left_out'])}). Means over left-out styles, then mean ± sd (min–max for "
+                "recognition) over seeds.\n\n"
+                + md_table(["k", "recognition", "Table 5.1 rows whose minimum is the own example", "V_SD / real",
+                            "step_SD / real", "pose_across_SD / real", "pose_SD / real", "diversity / real",
+                            "styles meeting issue 27's k = 4 aims (V_SD, step_SD ≥ 80 %, diversity ≥ 70 %, "
+                            "recognition ≥ 90 %)"], rows)
+                + f"\n\n{protocol} {prov}")
+    style_rows = []
+    for p, styles in r["per_style"].items():
+        for s, v in styles.items():
+            for k in r["ks"]:
+                cell = v["ks"][str(k)]
+                style_rows.append([p, s, str(k), fmt_spread(cell["recognition"], 3),
+                                   f"{cell['own_column_is_minimum']}/{cell['recognition']['n']}",
+                                   *(fmt_spread(cell["vs_real"][m], 2) for m in ("v_sd", "step_sd", "pose_across_sd",
+                                                                                 "diversity"))])
+    clips = "; ".join(f"{p}/{s}: {v['train_clips']} train, {v['heldout_clips']} held-out"
+                      for p, styles in r["per_style"].items() for s, v in styles.items())
+    per_style = (f"{label}Per left-out style and k ({r['data']}, {seeds} seeds): mean ± sd over seeds; seeds whose "
+                 "Table 5.1 row has the style's own example as its minimum.\n\n"
+                 + md_table(["primitive", "left-out style", "k", "recognition", "own column", "V_SD / real",
+                             "step_SD / real", "pose_across_SD / real", "diversity / real"], style_rows)
+                 + f"\n\nClips of each style: {clips}. {protocol} {prov}")
+    return {"headline": headline, "per_style": per_style,
+            "real": md_table(["primitive", "left-out style", *VARIATION],
+                             [[p, s, *(fmt(v["real"][m], 3) for m in VARIATION)]
+                              for p, styles in r["per_style"].items() for s, v in styles.items()])
+            + f"\n\nThe held-out real clips' own figures (pose_SD, step_SD, pose_across_SD in cm; V_SD in m/s ⊕ "
+              f"rad/s; diversity in classifier feature units). {prov}"}
