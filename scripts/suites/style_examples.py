@@ -10,8 +10,10 @@ trained here: the suite reads the finished leave-one-style-out trainings of suit
    :func:`~stylemotion.evaluation.zero_shot.generator_autoencoder`);
 2. for each k of ``--ks``: k example clips drawn from the **train-split** clips of ``s`` of ``p`` (one seeded
    permutation per seed, primitive and style, its first k: the draws are nested, k = 2 holds k = 1's clip),
-   bound to the network (their mean embedding and anchor, the pooling ``stylemotion-style example=[…]`` uses,
-   :meth:`~stylemotion.models.zero_shot.ZeroShotStyleVAE.condition`);
+   bound to the network and pooled by each of ``--pooling``: ``mean`` (their mean embedding and anchor, the pooling
+   ``stylemotion-style example=[…]`` uses, :meth:`~stylemotion.models.zero_shot.ZeroShotStyleVAE.condition`) and
+   ``per_sample`` (each sample conditioned on one of the k clips drawn with the sampling seed,
+   :meth:`~stylemotion.models.zero_shot.ZeroShotStyleVAE.per_sample_condition`; for k ≥ 2, where it differs);
 3. ``--samples`` samples (seed ``k``), measured by the judge of suite ``zero_shot`` (the reproduction the trainings
    were evaluated with, ``zero_shot.json``'s ``meta.run``: its autoencoder's Table 5.1 space and its style
    classifier, :func:`stylemotion.evaluation.pipeline.real_side`): **recognition** (the share classified as
@@ -50,6 +52,18 @@ VARIATION = ("pose_sd", "v_sd", "step_sd", "pose_across_sd", "diversity")
 AIMS = {"v_sd": 0.8, "step_sd": 0.8, "diversity": 0.7}
 #: The aimed recognition at k = 4.
 AIM_RECOGNITION = 0.9
+#: Poolings of the k clips (:data:`stylemotion.models.zero_shot.POOLINGS`, kept here for a light ``--help``).
+POOLINGS = ("mean", "per_sample")
+
+
+def row_label(k: int, pooling: str) -> str:
+    """The key and table label of one row: ``"4"`` (mean pooling) or ``"4 per_sample"``."""
+    return str(k) if pooling == "mean" else f"{k} {pooling}"
+
+
+def row_labels(ks: list[int], poolings: list[str]) -> list[str]:
+    """Every row of the curve, by k then pooling (``per_sample`` only for k ≥ 2, where it differs from the mean)."""
+    return [row_label(k, p) for k in ks for p in POOLINGS if p in poolings and (p == "mean" or k > 1)]
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -60,6 +74,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="the data the trainings are of (checked against their judge run)")
     parser.add_argument("--ks", type=int, nargs="+", default=list(KS), help="example counts of the curve")
     parser.add_argument("--samples", type=int, default=1000, help="samples per network, k and seed")
+    parser.add_argument("--pooling", nargs="+", choices=POOLINGS, default=["mean"],
+                        help="how the k clips condition the samples: mean (their mean embedding, stylemotion-style's) "
+                             "and/or per_sample (one clip drawn per sample)")
     parser.add_argument("--styles", nargs="+", default=None, help="left-out styles (default: every one trained)")
     parser.add_argument("--primitives", nargs="+", default=None, help="primitives (default: every one trained)")
 
@@ -125,7 +142,7 @@ def variation_figures(real, motions) -> dict[str, float]:
 
 
 def style_curve(judge: Judge, network, primitive: str, style: str, ks: list[int], samples: int,
-                seed: int) -> dict[str, Any]:
+                seed: int, poolings: tuple[str, ...] = ("mean",)) -> dict[str, Any]:
     """The curve of one left-out network: per k its recognition, Table 5.1 row and variation (and shares of the
     held-out real clips'), and the held-out real clips' figures."""
     from stylemotion.datamodules.features import describe_clip
@@ -143,9 +160,12 @@ def style_curve(judge: Judge, network, primitive: str, style: str, ks: list[int]
     train = real.data.split("train", style)
     out: dict[str, Any] = {"train_clips": len(train), "heldout_clips": len(heldout.num_frames), "real": reference,
                            "ks": {}}
-    for k, clips in draw_examples(train, ks, seed, primitive, style).items():
+    draws = draw_examples(train, ks, seed, primitive, style)
+    for label in row_labels(list(draws), list(poolings)):
+        k, pooling = int(label.split()[0]), (label.split()[1:] or ["mean"])[0]
+        clips = draws[k]
         records = [describe_clip(c) for c in clips]
-        bound = network.bind_example(clips, style, records)
+        bound = network.bind_example(clips, style, records, pooling)
         model = EvalModel(f"zero_shot:{style}", primitive, style, bound, records, dict(network.spec["autoencoder"]),
                           network.checkpoint_file, network.timeline_frames, bound.target_gram,
                           network.spec.get("dataset"), "canonical")
@@ -153,7 +173,7 @@ def style_curve(judge: Judge, network, primitive: str, style: str, ks: list[int]
         judged = recognition(real, model, real.features(drawn), truth)
         row = _table_row(judge.autoencoder, drawn.normalized_frames, style, columns, grams, settings)
         figures = variation_figures(real, drawn)
-        out["ks"][str(k)] = {
+        out["ks"][label] = {
             "recognition": judged.share, "own_column_is_minimum": bool(row["own_column_is_minimum"]),
             "nearest_column": row["nearest_column"], "table_5_1_row": row["table_5_1_row"], **figures,
             "vs_real": {m: figures[m] / reference[m] if reference[m] else None for m in VARIATION},
@@ -171,6 +191,7 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
     ks = sorted({int(k) for k in args.ks})
     if not ks or ks[0] < 1:
         raise ZeroShotRunError(f"--ks must be whole numbers ≥ 1, got {args.ks}")
+    poolings = [p for p in POOLINGS if p in (getattr(args, "pooling", None) or ["mean"])]
     judges: dict[str, Judge] = {}
     per_seed: dict[str, Any] = {}
     for seed in seeds:
@@ -197,13 +218,16 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
                 network = load_left_out(Path(row["zero_shot"]["checkpoint"]), p, s,
                                         row["generator_autoencoder"]["fingerprint"])
                 with progress_printed(f"[seed {seed} {p}/{s}]"):
-                    curves.setdefault(p, {})[s] = style_curve(judge, network, p, s, ks, args.samples, seed)
+                    curves.setdefault(p, {})[s] = style_curve(judge, network, p, s, ks, args.samples, seed,
+                                                              tuple(poolings))
         per_seed[str(seed)] = {"loso": relative(folder), "judge": relative(judge_folder), "curves": curves}
-    return summarize(per_seed, ks, args)
+    return summarize(per_seed, ks, args, poolings)
 
 
-def summarize(per_seed: dict[str, Any], ks: list[int], args: argparse.Namespace) -> dict[str, Any]:
+def summarize(per_seed: dict[str, Any], ks: list[int], args: argparse.Namespace,
+              poolings: list[str] | None = None) -> dict[str, Any]:
     """Spreads over seeds per style and k, the headline per k (means over styles), and the aims met at each k."""
+    rows = row_labels(ks, poolings or ["mean"])
     first = next(iter(per_seed.values()))
     left_out = [(p, s) for p, styles in first["curves"].items() for s in styles]
     per_style: dict[str, Any] = {}
@@ -217,9 +241,9 @@ def summarize(per_seed: dict[str, Any], ks: list[int], args: argparse.Namespace)
                                                          for c in curves if str(k) in c["ks"]),
                             "vs_real": {m: spread(c["ks"][str(k)]["vs_real"][m] for c in curves if str(k) in c["ks"])
                                         for m in VARIATION}}
-                   for k in ks}}
+                   for k in rows}}
     headline: dict[str, Any] = {}
-    for k in ks:
+    for k in rows:
         by_seed = {}
         for key, v in per_seed.items():
             cells = [v["curves"][p][s]["ks"][str(k)] for p, s in left_out
@@ -234,7 +258,8 @@ def summarize(per_seed: dict[str, Any], ks: list[int], args: argparse.Namespace)
         headline[str(k)] = {**{key: spread(b[key] for b in by_seed.values())
                                for key in ("recognition", "own_column_is_minimum", "aims_met", *VARIATION)},
                             "rows_per_seed": max((b["rows"] for b in by_seed.values()), default=0)}
-    return {"data": args.data, "loso": relative(args.loso.expanduser()), "ks": ks, "samples": args.samples,
+    return {"data": args.data, "loso": relative(args.loso.expanduser()), "ks": ks, "rows": rows,
+            "poolings": poolings or ["mean"], "samples": args.samples,
             "judge": sorted({v["judge"] for v in per_seed.values()}),
             "left_out": [f"{p}/{s}" for p, s in left_out],
             "subsample": {"primitives": args.primitives, "styles": args.styles},
@@ -273,12 +298,13 @@ def render(record: dict[str, Any]) -> dict[str, str]:
     label = _label(r)
     protocol = (f"Networks of suite zero_shot (`{r['loso']}`: per seed an autoencoder and a network that never saw "
                 f"the left-out style), each conditioned on k clips of the style drawn from its train split (nested "
-                f"draws; their mean embedding and anchor, as `stylemotion-style example=[…]` pools them); "
+                f"draws), pooled by their mean embedding and anchor (as `stylemotion-style example=[…]` pools them) "
+                f"or, in rows named per_sample, one clip drawn per sample; "
                 f"{r['samples']:,} samples per network, k and seed, judged by run(s) {', '.join(r['judge'])} (its "
                 f"autoencoder's Table 5.1 columns and its style classifier). Variation as a share of the style's "
                 f"held-out (val + test) real clips.")
     rows = []
-    for k in r["ks"]:
+    for k in r.get("rows") or r["ks"]:
         h = r["headline"][str(k)]
         rows.append([str(k), f"{fmt_spread(h['recognition'], 3)} ({fmt_range(h['recognition'], 3)})",
                      f"{fmt_spread(h['own_column_is_minimum'], 1)} of {h['rows_per_seed']}",
@@ -287,15 +313,16 @@ def render(record: dict[str, Any]) -> dict[str, str]:
     headline = (f"{label}Zero-shot style network from k examples of a style it never saw ({r['data']}, {seeds} seeds; "
                 f"left out: {', '.join(r['left_out'])}). Means over left-out styles, then mean ± sd (min–max for "
                 "recognition) over seeds.\n\n"
-                + md_table(["k", "recognition", "Table 5.1 rows whose minimum is the own example", "V_SD / real",
-                            "step_SD / real", "pose_across_SD / real", "pose_SD / real", "diversity / real",
+                + md_table(["k (pooling: mean unless named)", "recognition",
+                            "Table 5.1 rows whose minimum is the own example", "V_SD / real", "step_SD / real",
+                            "pose_across_SD / real", "pose_SD / real", "diversity / real",
                             "styles meeting issue 27's k = 4 aims (V_SD, step_SD ≥ 80 %, diversity ≥ 70 %, "
                             "recognition ≥ 90 %)"], rows)
                 + f"\n\n{protocol} {prov}")
     style_rows = []
     for p, styles in r["per_style"].items():
         for s, v in styles.items():
-            for k in r["ks"]:
+            for k in r.get("rows") or r["ks"]:
                 cell = v["ks"][str(k)]
                 style_rows.append([p, s, str(k), fmt_spread(cell["recognition"], 3),
                                    f"{cell['own_column_is_minimum']}/{cell['recognition']['n']}",

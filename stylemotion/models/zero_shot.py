@@ -55,6 +55,11 @@ logged as ``style`` on val/test whatever its weight.
 
 Sampling: :meth:`ZeroShotStyleVAE.sample` ``(n, seed, example=…)``, or :meth:`ZeroShotStyleVAE.bind_example`,
 which returns a :class:`BoundExample` with the ``sample(n, seed)`` of every other model.
+
+Several example clips (e.g. ``stylemotion-style example=[…]``) are pooled by ``pooling``: ``mean`` (default) conditions
+every sample on their mean embedding and anchor (:meth:`ZeroShotStyleVAE.condition`); ``per_sample`` conditions each
+sample on one clip drawn with the sampling seed (:meth:`ZeroShotStyleVAE.per_sample_condition`), so the samples
+spread over the examples instead of sitting at their centre. Suite ``style_examples --pooling`` compares the two.
 """
 
 from __future__ import annotations
@@ -72,6 +77,9 @@ from stylemotion.models.sampling import DEFAULT_CHUNK, MotionSamples, decode_fea
 from stylemotion.models.style import feature_style_distance, mean_gram
 from stylemotion.models.vae import MLPVAE, PrimitiveVAE, kl_divergence, prior_draws, reconstruction_loss
 from stylemotion.primitives.segmentation import time_normalize
+
+#: How several example clips condition the samples (see the module doc).
+POOLINGS = ("mean", "per_sample")
 
 
 class ConditionalMLPVAE(MLPVAE):
@@ -275,16 +283,33 @@ class ZeroShotStyleVAE(PrimitiveVAE):
         anchor = torch.stack([self.anchor(f) for f in features]).mean(0) if self.hparams.anchor else None
         return StyleCondition(embedding, anchor)
 
+    @torch.no_grad()
+    def per_sample_condition(self, example: Any, n: int, seed: int | None = None) -> StyleCondition:
+        """``pooling=per_sample``: the condition of ``n`` samples, each that of one clip of ``example`` (see
+        :meth:`example_features`) drawn uniformly with ``seed`` (a generator of its own, apart from the codes'):
+        embeddings ``(n, E)`` and, with ``anchor``, anchors ``(n, D)``."""
+        features = self.example_features(example)
+        generator = torch.Generator()
+        if seed is None:
+            generator.seed()
+        else:
+            generator.manual_seed(int(seed) + 1)
+        picks = torch.randint(len(features), (n,), generator=generator)
+        embedding = torch.stack([self.embed(f) for f in features])[picks.to(self.device)]
+        anchor = torch.stack([self.anchor(f) for f in features])[picks.to(self.device)] if self.hparams.anchor else None
+        return StyleCondition(embedding, anchor)
+
     def bind_example(self, example: Any, style: str | None = None,
-                     records: Sequence[dict[str, Any]] | None = None) -> BoundExample:
+                     records: Sequence[dict[str, Any]] | None = None, pooling: str = "mean") -> BoundExample:
         """This model with one style example bound: a sampler with ``sample(n, seed)`` (see :class:`BoundExample`).
 
         Args:
             example: as :meth:`example_features`.
             style: the style's name (for reports).
             records: plain-value records of the example clip(s) (take, start, stop, …).
+            pooling: how several clips condition the samples (:data:`POOLINGS`, see the module doc).
         """
-        return BoundExample(self, self.example_features(example), style, records)
+        return BoundExample(self, self.example_features(example), style, records, pooling)
 
     # -- objective
 
@@ -411,10 +436,15 @@ class BoundExample:
         condition: their :class:`StyleCondition` (computed at binding: bind again after further training).
         style: the style's name, or None.
         style_examples: plain-value records of the example clip(s) (take, start, stop, …).
+        pooling: how several clips condition :meth:`sample` (``mean``: :attr:`condition`; ``per_sample``: one clip
+            drawn per sample); the path-following synthesis decodes under :attr:`condition`.
     """
 
     def __init__(self, model: ZeroShotStyleVAE, example_features: list[torch.Tensor], style: str | None = None,
-                 records: Sequence[dict[str, Any]] | None = None):
+                 records: Sequence[dict[str, Any]] | None = None, pooling: str = "mean"):
+        if pooling not in POOLINGS:
+            raise ValueError(f"pooling must be one of {POOLINGS}, got {pooling!r}")
+        self.pooling = pooling
         self.model = model
         self.example_features = list(example_features)
         self.condition = model.condition(self.example_features)
@@ -483,7 +513,11 @@ class BoundExample:
         return mean_gram([f.cpu() for f in self.example_features])
 
     def sample(self, n: int, seed: int | None = None, chunk_size: int = DEFAULT_CHUNK) -> MotionSamples:
-        """``n`` motions in the bound example's style (see :meth:`ZeroShotStyleVAE.sample`)."""
+        """``n`` motions in the bound example's style (see :meth:`ZeroShotStyleVAE.sample`; ``pooling=per_sample``:
+        each conditioned on one clip drawn with ``seed``, :meth:`ZeroShotStyleVAE.per_sample_condition`)."""
+        if self.pooling == "per_sample":
+            condition = self.model.per_sample_condition(self.example_features, n, seed)
+            return self.model.sample(n, seed, chunk_size, example=condition)
         return self.model.sample(n, seed, chunk_size, example=self.condition)
 
     def decode_latent(self, z: torch.Tensor, chunk_size: int = DEFAULT_CHUNK) -> MotionSamples:

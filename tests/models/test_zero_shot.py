@@ -214,3 +214,27 @@ def test_the_condition_of_k_examples_is_the_mean_embedding_and_anchor_of_all_the
                        model.sample(6, seed=2, example=pooled).positions)
     assert torch.equal(network.sample(6, seed=2, example=[files[0]]).positions,
                        network.sample(6, seed=2, example=str(files[0])).positions)
+
+
+def test_per_sample_pooling_conditions_each_sample_on_one_seeded_clip(trained) -> None:
+    """``pooling=per_sample``: every sample's condition is exactly that of one of the clips, drawn with the seed."""
+    from stylemotion.style_example.example import cut_examples
+
+    model = trained[True].eval()
+    clips = cut_examples(user_examples(2), "tired", "walk", [model.primitive], None).used[model.primitive]
+    singles = [model.condition([c]) for c in clips]
+    condition = model.per_sample_condition(clips, 40, seed=3)
+    assert condition.embedding.shape == (40, model.hparams.embedding_dim)
+    picks = [next(i for i, one in enumerate(singles) if torch.allclose(e, one.embedding, atol=1e-6)
+                  and torch.allclose(a, one.anchor, atol=1e-6))
+             for e, a in zip(condition.embedding, condition.anchor)]
+    assert len(set(picks)) > 1  # the samples spread over the clips
+    again = model.per_sample_condition(clips, 40, seed=3)
+    assert torch.equal(again.embedding, condition.embedding)
+    assert not torch.equal(model.per_sample_condition(clips, 40, seed=4).embedding, condition.embedding)
+    bound = model.bind_example(clips, "tired", pooling="per_sample")
+    assert torch.equal(bound.sample(40, seed=3).features, model.sample(40, seed=3, example=condition).features)
+    assert torch.equal(model.bind_example(clips).sample(8, seed=3).features,
+                       model.sample(8, seed=3, example=model.condition(clips)).features)
+    with pytest.raises(ValueError, match="pooling must be one of"):
+        model.bind_example(clips, pooling="max")

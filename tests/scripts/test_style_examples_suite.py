@@ -45,13 +45,16 @@ def test_the_examples_are_nested_seeded_draws_of_the_given_clips() -> None:
     assert all(o != draws[8] for o in others)
 
 
-def curve(seed: int, style: str, ks: list[int]) -> dict:
+def curve(seed: int, style: str, ks: list[int], poolings: tuple[str, ...] = ("mean",)) -> dict:
     real = {"pose_sd": 4.0, "v_sd": 2.0, "step_sd": 10.0, "pose_across_sd": 3.0, "diversity": 5.0}
     out = {"train_clips": 9, "heldout_clips": 4, "real": real, "ks": {}}
-    for i, k in enumerate(ks):
-        figures = {"pose_sd": 4.0, "v_sd": V_SD[k], "step_sd": 10.0 * V_SD[k] / 2.0, "pose_across_sd": 1.5,
+    for label in style_examples.row_labels(ks, list(poolings)):
+        k = int(label.split()[0])
+        i = list(V_SD).index(k)
+        spread_out = 1.5 if label.endswith("per_sample") else 1.0  # one clip per sample: more variation
+        figures = {"pose_sd": 4.0, "v_sd": V_SD[k] * spread_out, "step_sd": 10.0 * V_SD[k] / 2.0, "pose_across_sd": 1.5,
                    "diversity": 5.0 * (0.6 if style == "youthful" else 0.8)}
-        out["ks"][str(k)] = {"recognition": SHARES[seed][style][i], "own_column_is_minimum": k >= 4 or seed == 0,
+        out["ks"][label] = {"recognition": SHARES[seed][style][i], "own_column_is_minimum": k >= 4 or seed == 0,
                              "nearest_column": style, "table_5_1_row": {}, **figures,
                              "vs_real": {m: figures[m] / real[m] for m in figures}, "examples": []}
     return out
@@ -74,9 +77,9 @@ def planted(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> dict:
             calls.setdefault("judges", []).append(folder)
             self.source = SimpleNamespace(data_cfg={"name": "synthetic"})
 
-    def fake_curve(judge, network, primitive, style, ks, samples, seed):
-        calls["curves"].append((seed, style, tuple(ks), samples))
-        return curve(seed, style, ks)
+    def fake_curve(judge, network, primitive, style, ks, samples, seed, poolings=("mean",)):
+        calls["curves"].append((seed, style, tuple(ks), samples, poolings))
+        return curve(seed, style, ks, poolings)
 
     monkeypatch.setattr(style_examples, "Judge", FakeJudge)
     monkeypatch.setattr(style_examples, "style_curve", fake_curve)
@@ -87,7 +90,8 @@ def planted(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> dict:
 
 
 def args(loso: Path, **changes) -> argparse.Namespace:
-    values = {"loso": loso, "data": "synthetic", "ks": [8, 1, 2, 4], "samples": 50, "styles": None, "primitives": None}
+    values = {"loso": loso, "data": "synthetic", "ks": [8, 1, 2, 4], "samples": 50, "styles": None, "primitives": None,
+              "pooling": ["mean"]}
     return argparse.Namespace(**{**values, **changes})
 
 
@@ -133,3 +137,16 @@ def test_narrowing_a_leaky_training_and_other_data(planted) -> None:
         style_examples.run(args(planted["loso"]), [0])
     with pytest.raises(Exception, match="seed7"):
         style_examples.run(args(planted["loso"]), [7])
+
+
+def test_per_sample_pooling_is_a_row_of_its_own_for_k_of_two_and_more(planted) -> None:
+    assert style_examples.row_labels([1, 2, 4], ["per_sample", "mean"]) == ["1", "2", "2 per_sample", "4",
+                                                                           "4 per_sample"]
+    results = style_examples.run(args(planted["loso"], pooling=["per_sample", "mean"], ks=[1, 4]), [0, 1])
+    assert all(c[4] == ("mean", "per_sample") for c in planted["curves"])
+    assert results["rows"] == ["1", "4", "4 per_sample"] and results["poolings"] == ["mean", "per_sample"]
+    assert results["headline"]["4 per_sample"]["v_sd"]["mean"] == pytest.approx(1.5 * 1.7 / 2.0)
+    assert results["headline"]["4"]["v_sd"]["mean"] == pytest.approx(1.7 / 2.0)
+    record = {"results": results, "seeds": [0, 1], "command": "c", "commit": "x", "started": "2026-01-01",
+              "machine": {}, "seconds": 0}
+    assert "| 4 per_sample | " in style_examples.render(record)["headline"]
