@@ -3,6 +3,8 @@
     stylemotion-eval 'checkpoints=[runs/reproduce/synthetic/vae,runs/reproduce/synthetic/cvae]'
     stylemotion-eval data=bandai 'data.contents=[walk,walk-turn-left,walk-turn-right]' \\
         'checkpoints=[runs/train/primitive_vae/multirun/*/*/checkpoints/best.ckpt]' out=reports/eval/bandai
+    stylemotion-eval 'checkpoints=[runs/reproduce/synthetic/vae,runs/reproduce/synthetic/cvae,<zero-shot best.ckpt>]'
+    stylemotion-eval 'checkpoints=[<zero-shot best.ckpt>]' example=angry_walk.bvh:120-480 example_style=angry
 
 The work is :func:`stylemotion.evaluation.run.run_evaluation`; progress and the summary go to the log
 (console and ``eval.log`` in the Hydra run folder).
@@ -25,7 +27,8 @@ def evaluate(cfg: DictConfig, command: str) -> None:
 
     set_torch_threads(cfg.get("threads"))
     results = run_evaluation(cfg.data, list(cfg.checkpoints), cfg.evaluation, cfg.out, int(cfg.seed),
-                             cfg.get("autoencoder_ckpt"), bool(cfg.force), command)
+                             cfg.get("autoencoder_ckpt"), bool(cfg.force), command, example=cfg.get("example"),
+                             example_style=cfg.get("example_style"))
     for line in summary_lines(results):
         log.info(line)
     log.info("report written to %s", cfg.out)

@@ -44,6 +44,12 @@ DEFINITIONS = {
                  "the number of time steps (stylemotion.models.style); s the style example clip(s) the style model "
                  "was trained with, and for the neutral column the frame-wise mean motion of the neutral training "
                  "clips. Lower = closer to that example's style.",
+    "shift_baseline": "row shift:<s> (Tables 5.1–5.3; evaluation.shift_baseline): the neutral VAE's samples, each "
+                      "moved in the autoencoder's feature space by (mean features of s's example clip(s) − mean "
+                      "features of the neutral training clips), durations by the same offset in log duration, then "
+                      "decoded: the baseline any style model has to beat.",
+    "zero_shot": "rows zero_shot:<s>: a zero-shot network bound to the example clip(s) of style s (a CVAE's example: "
+                 "its Table 5.1 row is measured against that CVAE's column, no column of its own).",
     "pose_sd": "sqrt(Σ‖p_i − p̄‖² / (N−1)) over all valid frames of all motions, p_i the 21 joints relative to the "
                "root's ground projection, facing +Z (eq. 5.13); cm.",
     "v_sd": "sqrt((Σ(v_i − v̄)² + Σ(ω_i − ω̄)²) / (N−1)) over motions, v_i the mean root ground speed (m/s), ω_i the "
@@ -106,9 +112,10 @@ def format_markdown(results: dict[str, Any], figures: list[str], tables: list[st
             f"{fmt(100 * ae['test_mpjpe_m'], 3)} cm (root-local poses {fmt(100 * ae['test_local_mpjpe_m'], 3)} cm) "
             f"over {fmt(ae['test_windows'])} test windows of {ae['window_frames']} frames." if ae else "", ""]
     if meta.get("checkpoints"):
-        out += ["Models:", "", md_table(["primitive", "model", "style", "checkpoint"],
-                                         [[c.get("primitive", ""), c.get("name", ""), c.get("style", ""),
-                                           f"`{c.get('path')}`"] for c in meta["checkpoints"]]), ""]
+        out += ["Models:", "", md_table(["primitive", "model", "kind", "style", "checkpoint"],
+                                         [[c.get("primitive", ""), c.get("name", ""), c.get("kind") or "",
+                                           c.get("style", ""), f"`{c.get('path')}`"] for c in meta["checkpoints"]]),
+                ""]
     out += _thesis_section(results)
     out += _table_5_1_section(results)
     out += _variance_section(results)
@@ -158,7 +165,11 @@ def _table_5_1_section(results: dict[str, Any]) -> list[str]:
         matrix = np.asarray(t["distance"])
         rows = [[f"**{m}**"] + [f"**{fmt(v)}**" if j == matrix[i].argmin() else fmt(v) for j, v in enumerate(matrix[i])]
                 for i, m in enumerate(t["models"])]
-        rows += [[f"*{name}* (extra row)"] + [fmt(v) for v in values]
+        shared = t.get("shared_columns", {})
+        rows += [[f"*{name}* " + (f"(example of {shared[name]['column']})" if name in shared else
+                                  "(shift baseline)" if name.startswith("shift:") else "(extra row)")]
+                 + [f"*{fmt(v)}*" if name in shared and j == int(np.argmin(values)) else fmt(v)
+                    for j, v in enumerate(values)]
                  for name, values in t.get("extra_rows", {}).items()]
         d = t["diagonal"]
         out += [f"### {p} ({fmt(t['samples'])} samples per model)", "",
@@ -168,6 +179,10 @@ def _table_5_1_section(results: dict[str, Any]) -> list[str]:
                 f"({', '.join(d['columns'])}).",
                 "Rows whose minimum is elsewhere: " + (", ".join(f"{r} → {c}" for r, c in d["row_argmin"].items()
                                                               if r != c) or "none") + ".", "",
+                *(["Rows on another model's example (zero-shot networks bound to a CVAE's example; no column of "
+                   "their own, italic: row minimum): " + ", ".join(
+                       f"{n} → {r['row_argmin']} ({'its' if r['own_column_is_minimum'] else 'not its'} example's "
+                       f"column {r['column']})" for n, r in shared.items()) + ".", ""] if shared else []),
                 "Examples: " + "; ".join(f"{m}: {e if isinstance(e, str) else ', '.join(e)}"
                                          for m, e in t["example_clips"].items()) + ".", "",
                 f"![Table 5.1 {p}](table_5_1_{p}.png)", ""]

@@ -13,7 +13,9 @@ trained on and the autoencoder they share, and computes per primitive:
   ``samples.metrics`` samples per model (:mod:`.metrics`), each against the model's ground truth
   (:meth:`.reference.PrimitiveData.ground_truth`);
 
-and, once, the autoencoder's reconstruction error on the data's test split. ``extra_rows`` adds row-only
+and, once, the autoencoder's reconstruction error on the data's test split. With ``settings.shift_baseline`` and
+a neutral VAE, each style example (Table 5.1 column) adds the row ``shift:<column>`` (:class:`ShiftBaseline`).
+``extra_rows`` adds row-only
 sources (e.g. the Morphable Graph's neutral models): sampled like the models, they get rows in Tables
 5.2/5.3 and a row of distances to the models' examples in Table 5.1 (``table_5_1.<p>.extra_rows``), no column
 and no other metric. Every model is sampled
@@ -27,6 +29,7 @@ one function returning a small dataclass (:func:`real_variance`, :func:`recognit
 from __future__ import annotations
 
 import logging
+import math
 import time
 from collections import defaultdict
 from collections.abc import Mapping, Sequence
@@ -36,7 +39,7 @@ from typing import Any
 import numpy as np
 import torch
 
-from stylemotion.datamodules.features import encode_examples
+from stylemotion.datamodules.features import encode_examples, encode_frames
 from stylemotion.datamodules.windows import MotionWindowDataModule
 from stylemotion.datasets import TakeSet
 from stylemotion.evaluation.classifier import StyleClassifier, predicted_shares
@@ -55,7 +58,7 @@ from stylemotion.evaluation.sources import MissingExampleError, check_one_autoen
 from stylemotion.evaluation.tables import diagonal_minima, distance_table, example_gram, mean_motion, variance_stats
 from stylemotion.models.autoencoder import local_mpjpe, mpjpe
 from stylemotion.models.loading import NEUTRAL, EvalModel
-from stylemotion.models.sampling import MotionSamples
+from stylemotion.models.sampling import MotionSamples, decode_features
 from stylemotion.models.style import mean_gram
 from stylemotion.primitives.segmentation import Segmentation, parse_primitive, segment_action, time_normalize
 
@@ -129,6 +132,8 @@ def evaluate_models(models: Sequence[EvalModel], takeset: TakeSet, autoencoder, 
         for key in results:
             if key in out:
                 results[key][primitive] = out[key]
+        if out["extra_rows"]:
+            results.setdefault("extra_rows", {})[primitive] = out["extra_rows"]
         recognition["per_primitive"][primitive] = out["classifier"]
         recognition["per_model_detail"][primitive] = out["recognition"]
         for name, rec in out["recognition"].items():
@@ -145,10 +150,12 @@ def evaluate_models(models: Sequence[EvalModel], takeset: TakeSet, autoencoder, 
     results["foot_skating"] = {n: pooled_skating(v).ratio for n, v in skating.items()}
     results["foot_skating_real"] = {n: pooled_skating(v).ratio for n, v in skating_real.items()}
     results["primitives"] = sorted(by_primitive)
-    if extra_rows:
-        results["extra_rows"] = {p: sorted(rows) for p, rows in extra_rows.items()}
-    results["models"] = [{"name": m.name, "primitive": m.primitive, "style": m.style, "checkpoint": m.checkpoint,
-                          "examples": m.examples} for p in sorted(by_primitive) for m in by_primitive[p]]
+    extra = results.pop("extra_rows", {})
+    if extra:
+        results["extra_rows"] = extra
+    results["models"] = [{"name": m.name, "primitive": m.primitive, "style": m.style, "kind": m.kind,
+                          "checkpoint": m.checkpoint, "examples": m.examples}
+                         for p in sorted(by_primitive) for m in by_primitive[p]]
     return results
 
 
@@ -182,14 +189,17 @@ def _segment_values(settings: EvalSettings) -> dict[str, Any]:
 
 
 def _order(models: Sequence[EvalModel], styles: Sequence[str]) -> list[EvalModel]:
-    """Neutral first, then style models in the data's style order."""
+    """Neutral first, then style models in the data's style order (per style a CVAE before a zero-shot network)."""
     rank = {s: i for i, s in enumerate(styles)}
-    return sorted(models, key=lambda m: (m.name != NEUTRAL, rank.get(m.style, len(rank)), m.name))
+    return sorted(models, key=lambda m: (m.name != NEUTRAL, rank.get(m.style, len(rank)), m.kind == "zero_shot",
+                                         m.name))
 
 
 def _example_clips(data: PrimitiveData, model: EvalModel) -> list:
     if model.name == NEUTRAL:
         return []
+    if model.example_clips is not None:  # a user's recording, not a clip of the data
+        return list(model.example_clips)
     if not model.examples:
         raise MissingExampleError(f"style model {model.checkpoint or model.label} records no style example clip, so "
                                   "Table 5.1 has no column for it; was it trained as a StyleCVAE with a style?")
@@ -270,6 +280,8 @@ def real_side(primitive: str, models: Sequence[EvalModel], takeset: TakeSet, set
                                       "ground truth")
     ordered = _order(models, data.styles)
     examples = {m.name: _example_clips(data, m) for m in ordered}
+    for m in ordered:  # a zero-shot network samples once bound to the clips found here
+        m.bind(examples[m.name])
     truth = {}
     for m in ordered:
         clips = data.ground_truth(m, examples[m.name])
@@ -414,13 +426,18 @@ def skating(real: RealSide, model: EvalModel, samples: MotionSamples, settings: 
 
 @dataclass
 class StyleTable:
-    """Table 5.1 of one primitive: ``distance[i][j]`` = D(models[i], examples[j])."""
+    """Table 5.1 of one primitive: ``distance[i][j]`` = D(models[i], examples[j]).
+
+    ``shared_columns``: rows of models whose example is another model's column (a zero-shot network bound to a
+    CVAE's example), in ``extra_rows``, → that column's name.
+    """
 
     models: list[str]
     distance: np.ndarray
     samples: int
     example_clips: dict[str, Any]
     extra_rows: dict[str, list[float]] = field(default_factory=dict)
+    shared_columns: dict[str, str] = field(default_factory=dict)
 
     def as_dict(self) -> dict[str, Any]:
         out = {"models": self.models, "examples": self.models, "distance": self.distance.tolist(),
@@ -428,20 +445,47 @@ class StyleTable:
                "example_clips": self.example_clips}
         if self.extra_rows:
             out["extra_rows"] = self.extra_rows
+        if self.shared_columns:
+            out["shared_columns"] = {
+                name: {"column": column, "row_argmin": self.models[int(np.argmin(self.extra_rows[name]))],
+                       "own_column_is_minimum": self.models[int(np.argmin(self.extra_rows[name]))] == column}
+                for name, column in self.shared_columns.items()}
         return out
+
+
+def column_owners(real: RealSide) -> tuple[list[EvalModel], dict[str, str]]:
+    """Table 5.1's columns: the models whose example clip(s) no model before them (``real.models`` order) has,
+    and, for each other model, the name of the column of its example (two columns of one example would tie in
+    every row)."""
+    owners: list[EvalModel] = []
+    shared: dict[str, str] = {}
+    seen: dict[tuple, str] = {}
+    for m in real.models:
+        key = ((NEUTRAL,) if m.name == NEUTRAL else
+               tuple((c.take, c.start, c.stop, c.primitive) for c in real.examples[m.name]))
+        if key in seen:
+            shared[m.name] = seen[key]
+        else:
+            seen[key] = m.name
+            owners.append(m)
+    return owners, shared
 
 
 def style_table(real: RealSide, autoencoder, model_frames: Sequence[np.ndarray], settings: EvalSettings,
                 extra_frames: Mapping[str, np.ndarray] | None = None) -> StyleTable:
     """Table 5.1 from each model's first ``samples.table_5_1`` normalized sample frames (in ``real.models`` order);
-    ``extra_frames`` (row name → frames) give rows against the same examples."""
-    grams = torch.stack([example_column_gram(autoencoder, real, m) for m in real.models])
-    table = distance_table(autoencoder, model_frames, grams, settings.gram_chunk)
+    a model whose example is an earlier model's column (:func:`column_owners`) is a row against the columns, and
+    so are ``extra_frames`` (row name → frames)."""
+    owners, shared = column_owners(real)
+    frames = dict(zip([m.name for m in real.models], model_frames))
+    grams = torch.stack([example_column_gram(autoencoder, real, m) for m in owners])
+    table = distance_table(autoencoder, [frames[m.name] for m in owners], grams, settings.gram_chunk)
+    rows = {**{name: frames[name] for name in shared}, **dict(extra_frames or {})}
     extra = {name: distance_table(autoencoder, [f], grams, settings.gram_chunk)[0].tolist()
-             for name, f in (extra_frames or {}).items()}
+             for name, f in rows.items()}
     clips = {m.name: ("mean motion of the neutral training clips" if m.name == NEUTRAL
-                      else [c.describe() for c in real.examples[m.name]]) for m in real.models}
-    return StyleTable([m.name for m in real.models], table, settings.samples.table_5_1, clips, extra)
+                      else [c.describe() for c in real.examples[m.name]]) for m in owners}
+    return StyleTable([m.name for m in owners], table, settings.samples.table_5_1, clips, extra, shared)
 
 
 def example_column_gram(autoencoder, real: RealSide, model: EvalModel) -> torch.Tensor:
@@ -504,7 +548,9 @@ def _evaluate_primitive(primitive: str, models: list[EvalModel], takeset: TakeSe
         log.debug("%s/%s evaluated in %.1f s", primitive, m.name, time.perf_counter() - t0)
     n_models, n_table = len(real.models), settings.samples.table_5_1
     extra_frames = {}
-    for name, source in (extra_rows or {}).items():
+    rows = {**(shift_baselines(real, autoencoder) if settings.shift_baseline else {}), **dict(extra_rows or {})}
+    out["extra_rows"] = sorted(rows)
+    for name, source in rows.items():
         log.info(f"{primitive}: {name} (Tables 5.1–5.3 row): {max(n_table, settings.samples.variance)} samples")
         samples = source.sample(max(n_table, settings.samples.variance), seed=settings.seed)
         variance.rows[name] = _variance(samples.subset(slice(0, settings.samples.variance)))
@@ -518,6 +564,56 @@ def _evaluate_primitive(primitive: str, models: list[EvalModel], takeset: TakeSe
     out["variance_ratio"] = variance.ratio
     out["variation_vs_style"] = variation_vs_style(variance, out["diversity"], real.models)
     return out
+
+
+class ShiftBaseline:
+    """The shift baseline of a style example (issue 27): a neutral model's sample plus (example − neutral mean) in the
+    autoencoder's feature space — what any style model has to beat.
+
+    Sample ``i`` of seed ``s`` is the neutral model's sample ``i`` of seed ``s`` (raw features ``F_i`` ``(C, T')``,
+    duration ``d_i``), moved by the example's offset from the neutral training clips::
+
+        F_i + mean_k Φ(x_k) − mean_j Φ(n_j)          d_i · exp(mean_k log d(x_k) − mean_j log d(n_j))
+
+    (``Φ``: the autoencoder's features of a clip resampled to the canonical ``length``; ``x``: the example clip(s),
+    ``n``: the neutral train clips; the duration moves in log space, as the models standardize it), decoded by the
+    autoencoder as the models' samples are.
+
+    Args:
+        neutral: the neutral model's source (samples carry ``features`` ``(n, C, T')``).
+        autoencoder: the models' autoencoder.
+        examples: the example clip(s).
+        training: the neutral train clips as motions (``normalized_frames`` on the canonical timeline, ``duration_s``).
+        length: the canonical timeline, frames.
+    """
+
+    def __init__(self, neutral: Any, autoencoder, examples: Sequence, training: MotionSamples, length: int):
+        self.neutral, self.autoencoder, self.length = neutral, autoencoder, int(length)
+        with torch.no_grad():
+            example = torch.stack(encode_examples(autoencoder, examples, self.length)).mean(0)
+            base = encode_frames(autoencoder, training.normalized_frames.float()).mean(0)
+        self.shift = (example - base).float().cpu()  # (C, T')
+        self.log_duration_shift = (float(np.mean(np.log([c.duration_s for c in examples])))
+                                   - float(training.duration_s.double().log().mean()))
+
+    @torch.no_grad()
+    def sample(self, n: int, seed: int | None = None) -> MotionSamples:
+        """``n`` motions: the neutral model's ``n`` samples of ``seed``, shifted (class doc)."""
+        drawn = self.neutral.sample(n, seed=seed)
+        return decode_features(self.autoencoder, drawn.features + self.shift,
+                               drawn.duration_s * math.exp(self.log_duration_shift), self.length, drawn.fps)
+
+
+def shift_baselines(real: RealSide, autoencoder) -> dict[str, ShiftBaseline]:
+    """``shift:<column>`` → the :class:`ShiftBaseline` of each style column of Table 5.1 (:func:`column_owners`), when
+    the neutral model is a VAE (its samples carry features); else none."""
+    neutral = next((m for m in real.models if m.name == NEUTRAL), None)
+    if neutral is None or getattr(neutral.source, "autoencoder", None) is None:
+        return {}
+    owners, _ = column_owners(real)
+    return {f"shift:{m.name}": ShiftBaseline(neutral.source, autoencoder, real.examples[m.name], real.training,
+                                             real.length)
+            for m in owners if m.name != NEUTRAL}
 
 
 def _frechet_reference(real: RealSide, model: EvalModel, f_truth: np.ndarray,

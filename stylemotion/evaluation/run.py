@@ -6,9 +6,13 @@
     stylemotion-eval ... evaluation.samples.variance=2000 force=true
 
 ``checkpoints`` lists PrimitiveVAE/StyleCVAE checkpoint files, glob patterns or folders (searched for
-``**/checkpoints/best.ckpt``); all models must share one autoencoder (``autoencoder_ckpt``, default
-the one they record). ``data`` must be the data they were trained on. The report folder ``out``
-(see :mod:`stylemotion.evaluation.report`) is refused if it exists, unless ``force=true``.
+``**/checkpoints/best.ckpt``), and zero-shot network checkpoints (files or globs; a folder search skips them);
+all models must share one autoencoder (``autoencoder_ckpt``, default the one they record). ``data`` must be the
+data they were trained on. A zero-shot network is evaluated once per example it is bound to
+(:func:`stylemotion.evaluation.sources.zero_shot_models`, rows ``zero_shot:<style>``): each style's example clip(s)
+of the evaluated CVAEs of its primitive (else the ones it records), or ``example=<BVH>[:a-b]`` (one or a list)
+showing the data's style ``example_style``. The report folder ``out`` (see :mod:`stylemotion.evaluation.report`)
+is refused if it exists, unless ``force=true``.
 """
 
 from __future__ import annotations
@@ -29,7 +33,12 @@ from stylemotion.evaluation.html_report import SAMPLES_PER_MODEL
 from stylemotion.evaluation.pipeline import evaluate_models
 from stylemotion.evaluation.report import write_report
 from stylemotion.evaluation.settings import EvalSettings
-from stylemotion.evaluation.sources import check_one_autoencoder
+from stylemotion.evaluation.sources import (
+    MissingExampleError,
+    check_one_autoencoder,
+    read_user_example,
+    zero_shot_models,
+)
 from stylemotion.io.outputs import check_new_output
 from stylemotion.models.autoencoder import IncompatibleModelError, MotionAutoencoder
 from stylemotion.models.checkpoints import autoencoder_info, find_checkpoints, load_autoencoder
@@ -80,7 +89,8 @@ def models_autoencoder(model: EvalModel) -> tuple[MotionAutoencoder, str | None]
 def run_evaluation(data_cfg: Mapping[str, Any], checkpoints: Sequence[str], evaluation: Mapping[str, Any],
                    out: str | os.PathLike, seed: int = 0, autoencoder_ckpt: str | None = None, force: bool = False,
                    command: str = "", root: str | os.PathLike | None = None,
-                   extra_rows: Mapping[str, Mapping[str, Any]] | None = None) -> dict[str, Any]:
+                   extra_rows: Mapping[str, Mapping[str, Any]] | None = None,
+                   example: Any = None, example_style: str | None = None) -> dict[str, Any]:
     """Load the models and their autoencoder, evaluate them on ``data_cfg``'s data, write the report.
 
     The autoencoder is ``autoencoder_ckpt`` if given, else the models' own (embedded in their
@@ -88,7 +98,9 @@ def run_evaluation(data_cfg: Mapping[str, Any], checkpoints: Sequence[str], eval
     autoencoder paths inside ``root`` (default ``out``; a ``stylemotion-reproduce`` run passes its
     run folder) are recorded relative to it, and ``meta.paths_relative_to`` says where ``root`` is
     from ``out``, so a moved folder still describes itself. ``extra_rows`` (``{primitive: {row: SampleSource}}``)
-    are rows of Tables 5.1–5.3 only (:func:`~stylemotion.evaluation.pipeline.evaluate_models`).
+    are rows of Tables 5.1–5.3 only (:func:`~stylemotion.evaluation.pipeline.evaluate_models`). ``example`` (motion
+    files ``<BVH>[:start-end]``) and ``example_style`` (the data's style they show) bind the zero-shot networks
+    among the checkpoints to a user's recording (module doc).
 
     Returns:
         The results as written to ``report.json`` (with ``meta``).
@@ -103,7 +115,7 @@ def run_evaluation(data_cfg: Mapping[str, Any], checkpoints: Sequence[str], eval
     settings = settings_from_config(evaluation, seed)
     data_cfg = OmegaConf.to_container(data_cfg, resolve=True) if isinstance(data_cfg, DictConfig) else dict(data_cfg)
     paths = find_checkpoints(checkpoints)
-    models = [load_model(p, settings.neutral_style) for p in paths]
+    models = [load_model(p, settings.neutral_style, zero_shot=True) for p in paths]
     if autoencoder_ckpt:
         autoencoder = load_autoencoder(autoencoder_ckpt)
         info = autoencoder_info(autoencoder, autoencoder_ckpt)
@@ -116,6 +128,14 @@ def run_evaluation(data_cfg: Mapping[str, Any], checkpoints: Sequence[str], eval
         m.source.attach_autoencoder(autoencoder)
     info = {**info, "path": recorded_path(info["path"], base)}
     takeset = build_dataset(data_cfg)
+    user = None
+    if example is not None:
+        user = read_user_example(example, example_style or "", takeset,
+                                 list(dict.fromkeys(m.primitive for m in models if m.unbound)), settings.segment,
+                                 settings.neutral_style)
+    elif example_style:
+        raise MissingExampleError(f"example_style={example_style} names the style of example=, which is not given")
+    models = zero_shot_models(models, user)
     results = evaluate_models(models, takeset, autoencoder, settings, split=data_cfg.get("split"),
                               autoencoder_info=info, extra_rows=extra_rows)
     for entry in results.get("models", []):
@@ -124,7 +144,7 @@ def run_evaluation(data_cfg: Mapping[str, Any], checkpoints: Sequence[str], eval
         "data": data_cfg, "data_name": takeset.name, "seed": int(seed),
         "samples": asdict(settings.samples),
         "checkpoints": [{"path": recorded_path(m.checkpoint, base), "primitive": m.primitive, "name": m.name,
-                         "style": m.style} for m in models],
+                         "style": m.style, "kind": m.kind} for m in models],
         "autoencoder": {"path": info["path"], "fingerprint": info["fingerprint"]},
         "paths_relative_to": Path(os.path.relpath(base, out.resolve())).as_posix(),
         "settings": asdict(settings), **provenance(command or None),

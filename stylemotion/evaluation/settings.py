@@ -69,6 +69,9 @@ class EvalSettings:
         gram_chunk: motions encoded at once for the Gram matrices of Table 5.1.
         autoencoder_test: windows of the autoencoder's test error (:class:`WindowSettings`).
         segment: segmentation settings, as for training.
+        shift_baseline: add, per style example, the row ``shift:<style>`` to Tables 5.1–5.3: a neutral VAE sample
+            plus (example − neutral mean) in the autoencoder's feature space
+            (:class:`stylemotion.evaluation.pipeline.ShiftBaseline`).
         seed: sampling seed (every model is sampled with it) and classifier seed; set from the
             command's top-level ``seed``.
     """
@@ -81,6 +84,7 @@ class EvalSettings:
     gram_chunk: int = 256
     autoencoder_test: WindowSettings = field(default_factory=WindowSettings)
     segment: SegmentSettings = field(default_factory=SegmentSettings)
+    shift_baseline: bool = True
     seed: int = 0
 
     def __post_init__(self) -> None:

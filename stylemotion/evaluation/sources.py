@@ -3,7 +3,9 @@
 A :class:`SampleSource` has ``sample(n, seed) -> MotionSamples`` (:mod:`stylemotion.models.sampling`):
 the trained :class:`~stylemotion.models.vae.PrimitiveVAE` and
 :class:`~stylemotion.models.cvae.StyleCVAE` are sources, and so is :class:`RealClipSource`
-(real clips drawn with replacement: an "oracle model" for tests and reference rows).
+(real clips drawn with replacement: an "oracle model" for tests and reference rows). A
+:class:`~stylemotion.models.zero_shot.ZeroShotStyleVAE` becomes one model per example it is bound to
+(:func:`zero_shot_models`): the styles' own example clips, or a user's recording (:func:`read_user_example`).
 :class:`EvalModel` wraps a source with the primitive it models, the style it targets and the style
 example it was conditioned on; :func:`load_model` makes one from a checkpoint. Those three and
 :data:`NEUTRAL` live with the models (:mod:`stylemotion.models.loading`, the one loading path) and are
@@ -13,14 +15,16 @@ named here too, as the evaluation's inputs.
 from __future__ import annotations
 
 from collections import defaultdict
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
+from dataclasses import asdict, dataclass
+from typing import Any
 
 import numpy as np
 import torch
 
 from stylemotion.io.errors import UserInputError
 from stylemotion.models.autoencoder import IncompatibleModelError
-from stylemotion.models.loading import EvalModel
+from stylemotion.models.loading import EvalModel, zero_shot_model
 from stylemotion.models.sampling import MotionSamples, pad_motions
 from stylemotion.primitives.segmentation import Clip, time_normalize
 
@@ -92,3 +96,110 @@ class RealClipSource:
             raise ValueError(f"n must be ≥ 1, got {n}")
         index = torch.from_numpy(np.random.default_rng(seed).integers(0, len(self.motions), n))
         return self.motions.subset(index)
+
+
+# -- zero-shot networks: one model per example
+
+
+@dataclass
+class UserExample:
+    """A user's recording that zero-shot networks are bound to (``stylemotion-eval example=… example_style=…``).
+
+    Attributes:
+        spec: what ``example=`` named (files and frame ranges), for messages and records.
+        style: the data's style the recording shows (its samples' ground truth and recognition target).
+        clips: primitive → the recording's clips of that primitive (cut as ``stylemotion-style`` cuts an example;
+            where it has none of a primitive, every clip of the same action).
+        records: primitive → plain-value records of those clips (file, sha256, frames, take, start, stop, …).
+    """
+
+    spec: str
+    style: str
+    clips: dict[str, list]
+    records: dict[str, list[dict[str, Any]]]
+
+
+def read_user_example(files: Any, style: str, takeset, primitives: Sequence[str], segment: Mapping[str, Any] | Any,
+                      neutral_style: str = "normal") -> UserExample:
+    """``example=`` of ``stylemotion-eval``: a motion file ``<BVH>[:start-end]`` or a list of them, read exactly as
+    ``stylemotion-style`` reads its examples (:func:`stylemotion.style_example.example.parse_examples`, each converted
+    and put on the data's skeleton, then :func:`~stylemotion.style_example.example.cut_examples` with the
+    evaluation's segmentation: the clips of each primitive pooled over the files).
+
+    Raises:
+        MissingExampleError: no zero-shot network's ``primitives`` to condition, ``style`` missing, no file, a file
+            that cannot be read or put on the data's skeleton (a joint map no skeleton fits), or a recording without
+            one whole step of a primitive's action (each one line naming ``example=``).
+    """
+    from stylemotion.datamodules.features import describe_clip
+    from stylemotion.datasets.loading import ConversionSettings
+    from stylemotion.datasets.user_motion import UserMotionError, convert_example, on_run_skeleton
+    from stylemotion.primitives.segmentation import parse_primitive
+    from stylemotion.style_example.example import cut_examples, parse_examples
+
+    if hasattr(files, "_content") and not isinstance(files, str):  # an OmegaConf list from the command line
+        from omegaconf import OmegaConf
+
+        files = OmegaConf.to_container(files, resolve=True)
+    shown = ", ".join(map(str, files)) if isinstance(files, (list, tuple)) else str(files)
+    if not primitives:
+        raise MissingExampleError(f"example={shown} conditions zero-shot networks, but checkpoints= holds none "
+                                  "(VAE/CVAE checkpoints carry their style themselves)")
+    if not style:
+        raise MissingExampleError(f"example={shown} needs example_style=<a style of the data>: the style the "
+                                  "recording shows (its samples' ground truth and recognition target)")
+    segment = asdict(segment) if not isinstance(segment, Mapping) else dict(segment)
+    clips: dict[str, list] = {}
+    records: dict[str, list[dict[str, Any]]] = {}
+    try:
+        converted = [on_run_skeleton(convert_example(spec, ConversionSettings(fps=takeset.fps)), takeset,
+                                     neutral_style) for spec in parse_examples(files)]
+        for action in dict.fromkeys(parse_primitive(p)[0] for p in primitives):
+            cut = cut_examples(converted, style, action, [p for p in primitives if parse_primitive(p)[0] == action],
+                               segment)
+            for p, used in cut.used.items():
+                clips[p] = list(used)
+                records[p] = [{**describe_clip(c), **r} for c, r in zip(used, cut.records[p])]
+    except UserMotionError as err:
+        raise MissingExampleError(str(err)) from None
+    return UserExample(shown, str(style), clips, records)
+
+
+def zero_shot_models(models: Sequence[EvalModel], user: UserExample | None = None) -> list[EvalModel]:
+    """``models`` with each zero-shot network (an unbound :class:`EvalModel`, ``load_model(…, zero_shot=True)``)
+    replaced by one model per example (:func:`stylemotion.models.loading.zero_shot_model`, row
+    ``zero_shot:<style>``):
+
+    * ``user``: the user's recording, bound now (its clips are not the data's);
+    * else, per style, the example clip(s) of the evaluated CVAE of the network's primitive and that style (as
+      the leave-one-style-out evaluation conditions it, :mod:`stylemotion.evaluation.zero_shot`); without a
+      CVAE of its primitive, each style's example as the network records it (``spec.style_examples_by_style``,
+      the clip a StyleCVAE of that style takes by default; the neutral style left out). Those clips are found
+      in the evaluation data and bound there (:func:`stylemotion.evaluation.pipeline.real_side`).
+
+    Raises:
+        MissingExampleError: a network with no example (``user`` without clips of its primitive, or nothing else).
+    """
+    out: list[EvalModel] = []
+    for m in models:
+        if not m.unbound:
+            out.append(m)
+            continue
+        network = m.source
+        if user is not None:
+            if not user.clips.get(m.primitive):
+                raise MissingExampleError(f"example={user.spec} has no clip for {m.checkpoint} (primitive "
+                                          f"{m.primitive})")
+            out.append(zero_shot_model(network, user.style, user.records[m.primitive], user.clips[m.primitive],
+                                       user_clips=True))
+            continue
+        cvaes = [c for c in models if c.kind == "cvae" and c.primitive == m.primitive]
+        neutral = network.spec.get("neutral_style")
+        chosen = ([(c.style, c.examples) for c in cvaes] if cvaes else
+                  [(s, [r]) for s, r in (network.spec.get("style_examples_by_style") or {}).items() if s != neutral])
+        if not chosen:
+            raise MissingExampleError(f"{m.checkpoint} is a zero-shot style network and nothing gives it an example: "
+                                      "evaluate it with CVAEs of its primitive (their examples), or give "
+                                      "example=<BVH>[:start-end] example_style=<style>")
+        out += [zero_shot_model(network, style, records) for style, records in chosen]
+    return out

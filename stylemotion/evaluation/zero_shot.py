@@ -68,7 +68,7 @@ from stylemotion.io.jsonfile import read_json_object as read_record
 from stylemotion.io.jsonfile import write_json
 from stylemotion.io.outputs import check_new_output, inside, safe_name
 from stylemotion.models.checkpoints import fingerprint, load_autoencoder, read_checkpoint
-from stylemotion.models.loading import NEUTRAL, EvalModel, load_generative, load_model
+from stylemotion.models.loading import NEUTRAL, EvalModel, load_generative, load_model, zero_shot_model
 from stylemotion.models.zero_shot import ZeroShotStyleVAE
 from stylemotion.primitives.segmentation import parse_primitive
 from stylemotion.provenance import provenance
@@ -401,10 +401,7 @@ def evaluate_primitive(primitive: str, left_out: Mapping[str, ZeroShotStyleVAE],
         generator = generator_autoencoder(network)
         # the CVAE's example clip(s) (frames), encoded by the network's own autoencoder as its training examples
         # were (canonical length); its samples come back as frames decoded by that autoencoder
-        bound = network.bind_example(real.examples[cvae.name], style, cvae.examples)
-        model = EvalModel(f"zero_shot:{style}", primitive, style, bound, list(cvae.examples),
-                          dict(network.spec["autoencoder"]), network.checkpoint_file, network.timeline_frames,
-                          bound.target_gram, network.spec.get("dataset"), "canonical")
+        model = zero_shot_model(network, style, cvae.examples, real.examples[cvae.name])
         if shared_autoencoder:
             check_one_autoencoder([cvae, model], fingerprint(autoencoder))
         log.info(f"{primitive}/{style}: {samples} samples of the network without {style} and of the {style} CVAE")

@@ -5,12 +5,14 @@
 from its checkpoint (read, and its autoencoder resolved, by :mod:`stylemotion.models.checkpoints`, the
 checkpoint records, which import no model class). :func:`load_model` wraps a PrimitiveVAE or StyleCVAE in
 an :class:`EvalModel`: the primitive it models, the style it targets (:data:`NEUTRAL` for the plain VAE)
-and the style examples it was conditioned on, as evaluation, synthesis and new styles use it.
+and the style examples it was conditioned on, as evaluation, synthesis and new styles use it;
+:func:`zero_shot_model` does the same for a ZeroShotStyleVAE bound to one style's example clip(s).
 """
 
 from __future__ import annotations
 
 import os
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Protocol, runtime_checkable
@@ -96,6 +98,11 @@ class EvalModel:
         dataset: name of the dataset it was trained on, or None.
         example_length: how its examples were encoded: ``canonical`` (resampled to the timeline,
             the default) or ``natural`` (as recorded).
+        kind: what the model is, named in reports: ``vae``, ``cvae``, ``zero_shot`` (a zero-shot network bound to
+            an example, :func:`zero_shot_model`), or None (any other source).
+        example_clips: the example clips themselves when they are not clips of the evaluation's data (a user's
+            motion file; anything with ``frames`` ``(frames, 66)``, ``positions``, ``duration_s``, ``describe()``);
+            None: ``examples`` name clips of the data, found there.
     """
 
     name: str
@@ -109,13 +116,54 @@ class EvalModel:
     target_gram: torch.Tensor | None = None
     dataset: str | None = None
     example_length: str | None = "canonical"
+    kind: str | None = None
+    example_clips: list[Any] | None = None
 
     @property
     def label(self) -> str:
         return f"{self.primitive}/{self.name}"
 
+    @property
+    def unbound(self) -> bool:
+        """Whether its source is a zero-shot network still waiting for its example clips (:meth:`bind`)."""
+        return isinstance(self.source, ZeroShotStyleVAE)
 
-def load_model(path: str | Path, neutral_style: str = "normal", autoencoder=None) -> EvalModel:
+    def bind(self, clips: Sequence[Any]) -> None:
+        """Bind a zero-shot network's source to its example ``clips`` (``frames`` ``(frames, 66)`` each: encoded by
+        its autoencoder at the canonical length, as its training examples were); other sources are left as
+        they are. ``target_gram`` becomes the clips' mean Gram (:attr:`BoundExample.target_gram`)."""
+        if self.unbound:
+            self.source = self.source.bind_example(list(clips), self.style, self.examples)
+            self.target_gram = self.source.target_gram
+
+
+#: Row-name prefix of a zero-shot network bound to a style's example (``zero_shot:<style>``).
+ZERO_SHOT_PREFIX = "zero_shot:"
+
+
+def zero_shot_model(network: ZeroShotStyleVAE, style: str, records: Sequence[dict[str, Any]],
+                    clips: Sequence[Any] | None = None, user_clips: bool = False) -> EvalModel:
+    """A zero-shot network as the evaluation's model of ``style``, row ``zero_shot:<style>``.
+
+    Args:
+        network: the network (its autoencoder is the one recorded in its spec).
+        style: the data's style its samples should show (its ground truth, its recognition target).
+        records: plain-value records of the example clip(s) (``take``, ``start``, ``stop``, …).
+        clips: the example clips; given: bound now, else bound by :meth:`EvalModel.bind` once found in the data.
+        user_clips: ``clips`` are not clips of the data (a user's recording): the evaluation takes them as they
+            are (:attr:`EvalModel.example_clips`) instead of looking ``records`` up in the data.
+    """
+    model = EvalModel(f"{ZERO_SHOT_PREFIX}{style}", str(network.spec["primitive"]), str(style), network,
+                      [dict(r) for r in records], dict(network.spec["autoencoder"]), network.checkpoint_file,
+                      int(network.timeline_frames), None, network.spec.get("dataset"), "canonical", "zero_shot",
+                      list(clips) if user_clips and clips is not None else None)
+    if clips is not None:
+        model.bind(clips)
+    return model
+
+
+def load_model(path: str | Path, neutral_style: str = "normal", autoencoder=None,
+               zero_shot: bool = False) -> EvalModel:
     """An :class:`EvalModel` from a PrimitiveVAE or StyleCVAE checkpoint (loaded on the CPU, eval mode).
 
     Args:
@@ -123,17 +171,25 @@ def load_model(path: str | Path, neutral_style: str = "normal", autoencoder=None
         neutral_style: data style of the neutral model when its spec names several content styles.
         autoencoder: an already loaded autoencoder to attach (must be the model's own: same weights);
             None takes the one embedded in the checkpoint (or recorded) on first use.
+        zero_shot: also take a zero-shot network: returned unbound (``kind`` ``zero_shot``, no style yet), for
+            the evaluation to make one :func:`zero_shot_model` per example
+            (:func:`stylemotion.evaluation.sources.zero_shot_models`).
 
     Raises:
         FileNotFoundError, IncompatibleModelError: no file, or not a trained primitive model
-        (:func:`load_generative` reads it).
+        (:func:`load_generative` reads it), or a zero-shot network without ``zero_shot``.
     """
     model = load_generative(path, autoencoder)
     if isinstance(model, ZeroShotStyleVAE):
+        if zero_shot:
+            return EvalModel("zero_shot", str(model.spec["primitive"]), "", model,
+                             autoencoder=dict(model.spec["autoencoder"]), checkpoint=str(path),
+                             timeline_frames=int(model.timeline_frames), dataset=model.spec.get("dataset"),
+                             kind="zero_shot")
         raise IncompatibleModelError(f"{path} is a zero-shot style network: it samples only given a style example "
                                      "(in Python: stylemotion.load(path).sample(n, example='walk.bvh'); "
-                                     "model.bind_example(...); its leave-one-style-out evaluation: "
-                                     "python scripts/benchmarks.py run zero_shot)")
+                                     "model.bind_example(...); stylemotion-eval binds it to the styles' examples; "
+                                     "its leave-one-style-out evaluation: python scripts/benchmarks.py run zero_shot)")
     spec = model.spec
     styled = isinstance(model, StyleCVAE)
     if styled:
@@ -148,4 +204,5 @@ def load_model(path: str | Path, neutral_style: str = "normal", autoencoder=None
                      # a centred style term keeps a covariance, not the thesis' Gram that Table 5.1 recomputes
                      target_gram=(model.style_gram.detach().clone()
                                   if styled and not model.hparams.get("style_centred", False) else None),
-                     dataset=spec.get("dataset"), example_length=spec.get("example_length") or "canonical")
+                     dataset=spec.get("dataset"), example_length=spec.get("example_length") or "canonical",
+                     kind="cvae" if styled else "vae")
