@@ -51,8 +51,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="LNG vs DTW queries per seed, query length and split (val, test)")
     parser.add_argument("--lengths-s", type=float, nargs="+", default=[1.0, 3.0, 5.0], help="LNG vs DTW query lengths")
     parser.add_argument("--grow-rules", nargs="+", default=["stable", "path"], help="k growth rules chosen among")
-    parser.add_argument("--grow-bounds", type=int, nargs="+", default=[4096, 16384],
-                        help="k_max candidates of the growth")
+    parser.add_argument("--grow-bounds", type=int, nargs="+", default=[16384, 65536],
+                        help="k_max candidates of the growth (capped at the database's frames)")
+    parser.add_argument("--grow-stable-for", type=int, nargs="+", default=[1, 2, 3],
+                        help="stable_for candidates of grow=stable: doublings in a row the best segment must hold")
     parser.add_argument("--eps", type=float, nargs="+", default=[0.1, 0.5], help="ε-approximate k-NN evaluated")
     parser.add_argument("--radii", type=float, nargs="+", default=[0.2], help="fixed radii (E15 units) evaluated")
     parser.add_argument("--approx-lengths-s", type=float, nargs="+", default=[1.0, 3.0],
@@ -90,9 +92,19 @@ def _choose_k(val: dict[int, list[float]], ks: list[int]) -> tuple[int, str]:
                                                     f"highest share")
 
 
-def _growth_name(grow: str, k_max: int) -> str:
-    """Key of a growth rule in the results: ``grow <rule> to <k_max>``."""
-    return f"grow {grow} to {k_max}"
+#: The command's growth (grow, k_max, stable_for) before issue 28's stricter stop: run on test beside the chosen.
+PREVIOUS_GROWTH = ("stable", 16384, 1)
+
+
+def _growth_name(grow: str, k_max: int, stable_for: int = 1) -> str:
+    """Key of a growth rule in the results: ``grow <rule> to <k_max>``, ``grow stable over <n> to <k_max>``
+    when the best segment must hold over n > 1 doublings."""
+    return f"grow {grow} to {k_max}" if stable_for == 1 else f"grow {grow} over {stable_for} to {k_max}"
+
+
+def _rule(chosen: list[Any] | tuple[Any, ...]) -> tuple[str, int, int]:
+    """``(grow, k_max, stable_for)`` of a recorded rule (a results file before ``stable_for``: 1)."""
+    return str(chosen[0]), int(chosen[1]), int(chosen[2]) if len(chosen) > 2 else 1
 
 
 def _val_share(per: dict[Any, list], seeds: list[int], lengths: list[float], ks: list[int]) -> dict[int, list[float]]:
@@ -103,41 +115,51 @@ def _val_share(per: dict[Any, list], seeds: list[int], lengths: list[float], ks:
 
 
 def _choose_growth(per: dict[Any, list], used: dict[Any, list], seeds: list[int], lengths: list[float],
-                   candidates: list[tuple[str, int]], start_k: int) -> dict[str, Any]:
-    """The growth rule (grow, k_max) chosen on every val query (all lengths): among those that answer every
-    query and return DTW's best segment for the aim's share (mean over seeds), the one of least mean k used;
-    else the highest share (then fewest unanswered, then least mean k). Remaining ties (a bound no val query
-    reached costs nothing more on val) go to the larger k_max: headroom for queries unlike validation's."""
+                   candidates: list[tuple[str, int, int]], start_k: int) -> dict[str, Any]:
+    """The growth rule (grow, k_max, stable_for) chosen on every val query (all lengths): among those that answer
+    every query and return DTW's best segment for the aim's share at **every** query length (mean over seeds; the
+    aim holds per length, so 1 s queries cannot carry 5 s ones), the one of least mean k used; else the highest
+    share at the worst length (then the highest overall, fewest unanswered, least mean k). Remaining ties (a bound
+    no val query reached costs nothing more on val) go to the larger k_max: headroom for queries unlike
+    validation's."""
     scores = {}
-    for grow, km in candidates:
-        name = _growth_name(grow, km)
+    for grow, km, sf in candidates:
+        name = _growth_name(grow, km, sf)
         records = {seed: [r for sec in lengths for r in per[("val", seed, sec, name)]] for seed in seeds}
         ks_used = [u for seed in seeds for sec in lengths for u in used[("val", seed, sec, name)]]
-        scores[name] = {"grow": grow, "k_max": km,
+        by_length = {f"{sec:g}": float(np.mean([np.mean([r["same_segment"] for r in per[("val", seed, sec, name)]])
+                                                for seed in seeds])) for sec in lengths}
+        scores[name] = {"grow": grow, "k_max": km, "stable_for": sf,
                         "same_segment": [float(np.mean([r["same_segment"] for r in rs])) for rs in records.values()],
+                        "same_segment_by_length": by_length,
                         "no_path": int(sum(r["no_path"] for rs in records.values() for r in rs)),
                         "queries": int(sum(len(rs) for rs in records.values())),
                         "mean_k_used": float(np.mean(ks_used)), "max_k_used": int(np.max(ks_used))}
     mean = {n: float(np.mean(v["same_segment"])) for n, v in scores.items()}
-    reaching = [n for n, v in scores.items() if v["no_path"] == 0 and mean[n] >= SAME_SEGMENT_AIM]
+    worst = {n: min(v["same_segment_by_length"].values()) for n, v in scores.items()}
+    reaching = [n for n, v in scores.items() if v["no_path"] == 0 and worst[n] >= SAME_SEGMENT_AIM]
     if reaching:
         name = min(reaching, key=lambda n: (scores[n]["mean_k_used"], -scores[n]["k_max"]))
         why = (f"least mean k used among the rules answering every val query with DTW's best segment for "
-               f"≥ {SAME_SEGMENT_AIM:.0%} of them (ties: the larger k_max)")
+               f"≥ {SAME_SEGMENT_AIM:.0%} of them at every query length (ties: the larger k_max)")
     else:
-        name = max(scores, key=lambda n: (mean[n], -scores[n]["no_path"], -scores[n]["mean_k_used"],
+        name = max(scores, key=lambda n: (worst[n], mean[n], -scores[n]["no_path"], -scores[n]["mean_k_used"],
                                           scores[n]["k_max"]))
-        why = f"no rule reached {SAME_SEGMENT_AIM:.0%} with every val query answered: the highest share"
+        why = (f"no rule reached {SAME_SEGMENT_AIM:.0%} at every length with every val query answered: the highest "
+               f"share at the worst length")
     return {"candidates": scores, "start_k": start_k, "rule": why, "aim": SAME_SEGMENT_AIM, "chosen_name": name,
-            "chosen": [scores[name]["grow"], scores[name]["k_max"]],
-            "default_at_run": [SearchSettings.grow, SearchSettings.k_max], "lengths_s": lengths}
+            "chosen": [scores[name]["grow"], scores[name]["k_max"], scores[name]["stable_for"]],
+            "chosen_on": "val: queries cut from the val takes against the train takes (never test)",
+            "default_at_run": [SearchSettings.grow, SearchSettings.k_max, SearchSettings.stable_for],
+            "lengths_s": lengths}
 
 
-def _test_variants(chosen: list[Any]) -> list[tuple[str, int]]:
-    """The growth rules run on test: the chosen one and, beside it, its other rule to the same bound."""
-    grow, km = chosen
+def _test_variants(chosen: list[Any]) -> list[tuple[str, int, int]]:
+    """The growth rules run on test: the chosen one and, beside it, its other rule to the same bound, ``stable``
+    with ``stable_for`` 1 to the same bound, and :data:`PREVIOUS_GROWTH` (each once)."""
+    grow, km, sf = _rule(chosen)
     other = "path" if grow == "stable" else "stable"
-    return [(grow, km), (other, km)]
+    return list(dict.fromkeys([(grow, km, sf), (other, km, 1), ("stable", km, 1), PREVIOUS_GROWTH]))
 
 
 def _as_best(result: Any, index: Any) -> tuple[int, int, float, int] | None:
@@ -155,7 +177,7 @@ def _test_extras(features: np.ndarray, index: Any, cache: Any, seconds: float, a
     from stylemotion.search import search_features
     from stylemotion.search.lng import GAP_STEPS, lng_match
 
-    grow, km = chosen
+    grow, km, sf = _rule(chosen)
     dist, ind = cache(start_k)
     found = lng_match(ind, dist, index.database.take_bounds, steps=GAP_STEPS, top=1)
     out = {f"gaps at {start_k}": (found[0].start, found[0].end, found[0].cost, found[0].take) if found else None}
@@ -167,16 +189,16 @@ def _test_extras(features: np.ndarray, index: Any, cache: Any, seconds: float, a
         return result, time.perf_counter() - t0
 
     _, old = timed()
-    result, new = timed(k_max=km, grow=grow)
-    costs[(seconds, _growth_name(grow, km))].append(new / old)
+    result, new = timed(k_max=km, grow=grow, stable_for=sf)
+    costs[(seconds, _growth_name(grow, km, sf))].append(new / old)
     if seconds in args.approx_lengths_s:
         for eps in args.eps:
-            result, t = timed(k_max=km, grow=grow, eps=eps)
+            result, t = timed(k_max=km, grow=grow, stable_for=sf, eps=eps)
             out[f"eps {eps:g}"] = _as_best(result, index)
             used[("test", seed, seconds, f"eps {eps:g}")].append(result.k)
             costs[(seconds, f"eps {eps:g}")].append(t / old)
         for radius in args.radii:
-            result, t = timed(k_max=km, grow=grow, radius=radius)
+            result, t = timed(k_max=km, grow=grow, stable_for=sf, radius=radius)
             out[f"radius {radius:g}"] = _as_best(result, index)
             used[("test", seed, seconds, f"radius {radius:g}")].append(result.k)
             costs[(seconds, f"radius {radius:g}")].append(t / old)
@@ -211,7 +233,8 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
     classes: dict[tuple[str, float], list[str]] = defaultdict(list)
     costs: dict[Any, list] = defaultdict(list)  # (seconds, key) -> test seconds per query
     swept = []
-    candidates = [(rule, km) for rule in args.grow_rules for km in sorted(set(args.grow_bounds))]
+    candidates = [(rule, km, sf) for rule in args.grow_rules for km in sorted(set(args.grow_bounds))
+                  for sf in (sorted(set(args.grow_stable_for)) if rule == "stable" else [1])]
     growth_choice: dict[str, Any] = {}
     for p, part in enumerate(("val", "test")):
         index, takes = indexes[part], split[part]
@@ -230,9 +253,9 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
                     cache = NeighbourCache(index, features, bounds)
                     cache(max(ks))
                     variants = {}
-                    for grow, km in candidates:
-                        name = _growth_name(grow, km)
-                        variants[name], k_used = cache.grown(DEFAULT_K, km, grow)
+                    for grow, km, sf in candidates:
+                        name = _growth_name(grow, km, sf)
+                        variants[name], k_used = cache.grown(DEFAULT_K, km, grow, sf)
                         used[(part, seed, seconds, name)].append(k_used)
                     bounding = list(variants)
                     if part == "test":
@@ -377,14 +400,14 @@ def _retrieval(index: Any, takes: list[Any], seeds: list[int], seconds: float, k
 def _captures(bandai: Any, seeds: list[int], windows: int, lengths_s: list[float], k: int,
               growth: list[Any]) -> dict[str, Any]:
     """Windows of the other-skeletons walks against all of Bandai: from the command's k, growing by the rule
-    chosen on validation (``growth``: grow, k_max), and, beside it, the fixed k alone (the search before
+    chosen on validation (``growth``: grow, k_max, stable_for), and, beside it, the fixed k alone (the search before
     growth); each against exact subsequence DTW."""
     from stylemotion.search import FrameIndex, search_features
     from stylemotion.search.command import load_query
     from stylemotion.search.dtw import best_subsequence_match
     from stylemotion.search.evaluation import precision_at, spearman_with_misses
 
-    grow, k_max = growth
+    grow, k_max, stable_for = _rule(growth)
     index = FrameIndex.build(bandai, "E15")
     bounds = index.database.take_bounds
     folder = DATA_ROOT / "other-skeletons"
@@ -408,7 +431,7 @@ def _captures(bandai: Any, seeds: list[int], windows: int, lengths_s: list[float
                     t0 = time.perf_counter()
                     fixed = search_features(features, index, k, 10)
                     t1 = time.perf_counter()
-                    result = search_features(features, index, k, 10, k_max=k_max, grow=grow)
+                    result = search_features(features, index, k, 10, k_max=k_max, grow=grow, stable_for=stable_for)
                     ratios.append((time.perf_counter() - t1) / (t1 - t0))
                     ks_used.append(result.k)
                     found = result.matches
@@ -444,8 +467,8 @@ def _captures(bandai: Any, seeds: list[int], windows: int, lengths_s: list[float
                      "p10_walk": spread(per_seed["p10_walk"]),
                      "p10_walk_or_turn": spread(per_seed["p10_walk_or_turn"]),
                      "nearest_walk_or_turn": spread(per_seed["nearest_walk_or_turn"])})
-    return {"files": list(CAPTURES), "k": k, "k_max": k_max, "grow": grow,
-            "defaults": [SearchSettings.grow, SearchSettings.k_max], "top": 10,
+    return {"files": list(CAPTURES), "k": k, "k_max": k_max, "grow": grow, "stable_for": stable_for,
+            "defaults": [SearchSettings.grow, SearchSettings.k_max, SearchSettings.stable_for], "top": 10,
             "features": "E15", "windows_per_file_length_seed": windows,
             "database_takes": index.database.num_takes, "database_frames": index.database.num_frames,
             "file_fps": {n: q.record["file_fps"] for n, q in files.items()},
@@ -461,18 +484,23 @@ def _growth_blocks(r: dict[str, Any], seeds: int, prov: str) -> dict[str, str]:
     name, start = growth["chosen_name"], growth["start_k"]
     crow = []
     for cname, c in growth["candidates"].items():
-        crow.append([c["grow"], f"{c['k_max']:,}", _pct(float(np.mean(c["same_segment"]))),
+        by_length = c.get("same_segment_by_length", {})
+        crow.append([c["grow"], f"{c['k_max']:,}", str(c.get("stable_for", 1)) if c["grow"] == "stable" else "—",
+                     _pct(float(np.mean(c["same_segment"]))),
+                     ", ".join(f"{sec} s {_pct(v)}" for sec, v in by_length.items()) or "—",
                      ", ".join(_pct(v) for v in c["same_segment"]), f"{c['no_path']} of {c['queries']}",
                      fmt(c["mean_k_used"], 0), f"{c['max_k_used']:,}", "**chosen**" if cname == name else ""])
     default = growth["default_at_run"]
-    note = ("the command's default (grow, k_max)" if list(default) == list(growth["chosen"])
-            else f"**differs from the command's default at the run ({default[0]}, {default[1]})**")
-    choice_block = (md_table(["grow", "k_max", "val: same best segment (mean)", "per seed", "no path",
-                              "mean k used", "max k used", ""], crow)
+    note = ("the command's default (grow, k_max, stable_for)" if _rule(default) == _rule(growth["chosen"])
+            else f"**differs from the command's default at the run {_rule(default)}**")
+    choice_block = (md_table(["grow", "k_max", "stable for (doublings)", "val: same best segment (mean)",
+                              "per length", "per seed", "no path", "mean k used", "max k used", ""], crow)
                     + f"\n\nEvery val query of {', '.join(f'{x:g}' for x in growth['lengths_s'])} s (all seeds) from "
                       f"the val takes against the train takes, k starting at {start} (the command's k) and doubled: "
-                      f"`stable` until the best segment at 2k is the one at k, `path` until a path exists, never past "
-                      f"k_max. Rule: {growth['rule']} (aim {_pct(growth['aim'])}); chosen {name}: {note}. {prov}")
+                      f"`stable` until the best segment has held over `stable_for` doublings in a row (1: the same "
+                      f"at k and 2k; 2: at k, 2k and 4k), `path` until a path exists, never past k_max (nor the "
+                      f"database's frames). Chosen on {growth.get('chosen_on', 'val')}. Rule: {growth['rule']} (aim "
+                      f"{_pct(growth['aim'])}); chosen {name}: {note}. {prov}")
     lengths = sorted({p["query_s"] for p in r["lng_pooled"]})
     variants = [start, *[_growth_name(*v) for v in _test_variants(growth["chosen"])], f"gaps at {start}"]
     rows = []
@@ -484,7 +512,8 @@ def _growth_blocks(r: dict[str, Any], seeds: int, prov: str) -> dict[str, str]:
             ratio = r["time_ratio"].get(f"{seconds:g}|{v}", {})
             ku = p.get("k_used") or {}
             label = (f"k = {v} alone (before)" if isinstance(v, int) else
-                     f"{v} (**chosen**)" if v == name else str(v))
+                     f"{v} (**chosen**)" if v == name else
+                     f"{v} (the default before the stricter stop)" if v == _growth_name(*PREVIOUS_GROWTH) else str(v))
             rows.append([f"{seconds:g} s", label, f"{p['queries'] - p['no_path']} of {p['queries']}",
                          fmt_spread(_seed_spread(r, "test", seconds, v, "same_segment")),
                          fmt_spread(_seed_spread(r, "test", seconds, v, "spearman_rho"), 3),
@@ -679,7 +708,9 @@ def render(record: dict[str, Any]) -> dict[str, str]:
                    f"{cap['database_takes']:,} Bandai takes ({cap['database_frames']:,} frames) with the command's "
                    f"defaults (E15, k = {cap['k']}"
                    + (f" growing to k_max = {cap['k_max']} by grow = {cap['grow']}, as chosen on validation"
-                      + ("" if cap.get("defaults") == [cap["grow"], cap["k_max"]] else
+                      + (f" over {cap['stable_for']} doublings" if cap.get("stable_for", 1) > 1 else "")
+                      + ("" if _rule(cap.get("defaults") or ()) == _rule([cap["grow"], cap["k_max"],
+                                                                         cap.get("stable_for", 1)]) else
                          f" (**the command's default at the run was {cap.get('defaults')}**)") if grown else "")
                    + f", top {cap['top']}); precision counts missing matches wrong, mean ± sd over seeds"
                    + ("; same best segment and ρ against exact subsequence DTW over all of Bandai (thesis steps), "

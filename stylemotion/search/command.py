@@ -151,8 +151,10 @@ def _checked_search(eps: Any, radius: Any) -> tuple[float, float | None]:
     return _number(eps), None if radius is None else _number(radius)
 
 
-def _checked_growth(k: int, k_max: Any, grow: Any, steps: Any, skip_cost: Any) -> tuple[int, str, str, float | None]:
+def _checked_growth(k: int, k_max: Any, grow: Any, steps: Any, skip_cost: Any,
+                    stable_for: Any = 1) -> tuple[int, str, str, float | None, int]:
     k_max = positive_int(k_max, "k_max")
+    stable_for = positive_int(stable_for, "stable_for")
     if k_max < k:
         raise SearchInputError(f"k_max={k_max} is below k={k}: the growth bound must be at least the first k")
     if grow not in GROWTH:
@@ -161,11 +163,12 @@ def _checked_growth(k: int, k_max: Any, grow: Any, steps: Any, skip_cost: Any) -
         raise SearchInputError(f"steps={steps} is none of {list(STEP_SETS)}")
     if skip_cost is not None and not (_number(skip_cost) >= 0 and np.isfinite(_number(skip_cost))):
         raise SearchInputError(f"skip_cost={skip_cost} must be a finite number ≥ 0 (feature units), or null")
-    return k_max, str(grow), str(steps), None if skip_cost is None else _number(skip_cost)
+    return k_max, str(grow), str(steps), None if skip_cost is None else _number(skip_cost), stable_for
 
 
 def search(data: Mapping[str, Any], query: str, out: str | os.PathLike, *, features: str = _D.features,
-           k: int = _D.k, k_max: int = _D.k_max, grow: str = _D.grow, steps: str = _D.steps,
+           k: int = _D.k, k_max: int = _D.k_max, grow: str = _D.grow, stable_for: int = _D.stable_for,
+           steps: str = _D.steps,
            skip_cost: float | None = _D.skip_cost, top: int = _D.top, eps: float = _D.eps,
            radius: float | None = _D.radius,
            engine: str = _D.engine, normalize: str = _D.normalize, exclude_query_take: bool = _D.exclude_query_take,
@@ -189,7 +192,7 @@ def search(data: Mapping[str, Any], query: str, out: str | os.PathLike, *, featu
     out = check_new_output(out, force)
     features, k, top = _checked_settings(features, k, top, engine, normalize)
     eps, radius = _checked_search(eps, radius)
-    k_max, grow, steps, skip_cost = _checked_growth(k, k_max, grow, steps, skip_cost)
+    k_max, grow, steps, skip_cost, stable_for = _checked_growth(k, k_max, grow, steps, skip_cost, stable_for)
     export_top = positive_int(export_top, "export.top")
     figure_matches = positive_int(figure_matches, "figure.matches")
     try:
@@ -222,15 +225,16 @@ def search(data: Mapping[str, Any], query: str, out: str | os.PathLike, *, featu
     build_s = time.perf_counter() - t0
     try:
         result = search_motion(q.positions, index, k, top, exclude_takes=exclude, eps=eps, radius=radius,
-                               normalize=normalize, k_max=k_max, grow=grow, steps=STEP_SETS[steps],
+                               normalize=normalize, k_max=k_max, grow=grow, stable_for=stable_for,
+                               steps=STEP_SETS[steps],
                                skip_cost=skip_cost)
     except ValueError as exc:
         raise SearchInputError(f"query={query}: {exc}") from None
     records = [m.record() for m in result.matches]
     report = {
         "query": {"value": str(query), **q.record}, "features": features, "k": k, "k_max": k_max, "grow": grow,
-        "k_used": result.k, "k_tried": list(result.k_tried), "steps": steps, "skip_cost": skip_cost,
-        "top": top, "eps": eps,
+        "stable_for": stable_for, "k_used": result.k, "k_tried": list(result.k_tried), "steps": steps,
+        "skip_cost": skip_cost, "top": top, "eps": eps,
         "radius": radius, "engine": engine, "normalize": normalize, "excluded_takes": list(result.excluded_takes),
         "database": {"name": database.name, "takes": database.num_takes, "frames": database.num_frames,
                      "fps": database.fps, "digest": database.digest},
@@ -258,7 +262,8 @@ def search(data: Mapping[str, Any], query: str, out: str | os.PathLike, *, featu
         log.info(f"{len(records)} of top={top} found: the {result.k} nearest frames of each query frame hold few "
                  f"paths; a larger k finds more (benchmarks/search.md)")
     if len(result.k_tried) > 1:
-        log.info(f"k grew {' → '.join(map(str, result.k_tried))} (grow={grow}, k_max={k_max}); k used {result.k}")
+        log.info(f"k grew {' → '.join(map(str, result.k_tried))} (grow={grow}, stable_for={stable_for}, "
+                 f"k_max={k_max}); k used {result.k}")
     log.info(f"{len(records)} match(es) written to {out}" + (f"; best: {records[0]['take']} "
                                                          f"{records[0]['start']}-{records[0]['end']} cost "
                                                          f"{records[0]['cost']:.4g}" if records else ""))
@@ -299,7 +304,8 @@ def search_from_config(cfg: DictConfig, command: str = "") -> dict[str, Any]:
     data, settings = settings_from_config(cfg, SearchSettings, "search")
     return search(
         data, settings.query, settings.out, features=settings.features, k=settings.k, k_max=settings.k_max,
-        grow=settings.grow, steps=settings.steps, skip_cost=settings.skip_cost, top=settings.top,
+        grow=settings.grow, stable_for=settings.stable_for, steps=settings.steps, skip_cost=settings.skip_cost,
+        top=settings.top,
         eps=settings.eps, radius=settings.radius, engine=settings.engine, normalize=settings.normalize,
         exclude_query_take=settings.exclude_query_take, retarget_query=settings.retarget_query,
         conversion=conversion_keys(vars(settings)), export_bvh=settings.export.bvh, export_gif=settings.export.gif,

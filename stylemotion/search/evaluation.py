@@ -114,12 +114,13 @@ class NeighbourCache:
         found = self.match(*self(k)[::-1])
         return (found[0].start, found[0].end, found[0].cost, found[0].take) if found else None
 
-    def grown(self, k: int, k_max: int, grow: str) -> tuple[tuple[int, int, float, int] | None, int]:
-        """The best match of :func:`~stylemotion.search.matching.grow_k` from ``k`` up to ``k_max`` and the k
-        it used."""
+    def grown(self, k: int, k_max: int, grow: str, stable_for: int = 1
+              ) -> tuple[tuple[int, int, float, int] | None, int]:
+        """The best match of :func:`~stylemotion.search.matching.grow_k` from ``k`` up to ``k_max`` (``grow``,
+        ``stable_for``: its rule) and the k it used."""
         from stylemotion.search.matching import grow_k
 
-        found, _, ind, _ = grow_k(self, self.match, k, min(k_max, self.index.size), grow)
+        found, _, ind, _ = grow_k(self, self.match, k, min(k_max, self.index.size), grow, stable_for)
         best = (found[0].start, found[0].end, found[0].cost, found[0].take) if found else None
         return best, int(ind.shape[1])
 

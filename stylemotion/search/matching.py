@@ -41,6 +41,9 @@ from stylemotion.search.settings import SearchSettings
 DEFAULT_K: int = SearchSettings.k
 #: Largest neighbours per query frame a growing search reaches by default (:class:`SearchSettings`'s ``k_max``).
 DEFAULT_K_MAX: int = SearchSettings.k_max
+#: Doublings in a row over which ``grow="stable"`` needs the same best segment (:class:`SearchSettings`'s
+#: ``stable_for``).
+DEFAULT_STABLE_FOR: int = SearchSettings.stable_for
 #: How the search grows ``k`` (:func:`grow_k`): not at all, until a path exists, until the best segment is stable.
 GROWTH: tuple[str, ...] = ("none", "path", "stable")
 #: Keys of a match's record in ``matches.json``, in order.
@@ -160,21 +163,26 @@ def _segment(index: FrameIndex, match: Match, rank: int) -> SegmentMatch:
 
 def grow_k(neighbours: Callable[[int], tuple[np.ndarray, np.ndarray]],
            match: Callable[[np.ndarray, np.ndarray], list[Match]], k: int, k_max: int,
-           grow: str = "stable") -> tuple[list[Match], np.ndarray, np.ndarray, tuple[int, ...]]:
+           grow: str = "stable", stable_for: int = DEFAULT_STABLE_FOR
+           ) -> tuple[list[Match], np.ndarray, np.ndarray, tuple[int, ...]]:
     """The LNG's matches with ``k`` doubled (capped at ``k_max``) until the answer holds.
 
     ``neighbours(k)`` → ``(distances, indices)`` ``(m, k)``, ascending per row (the first ``j`` columns are the
     ``j`` nearest, so one query serves every smaller k); ``match(indices, distances)`` → ranked matches.
     ``grow``: ``"none"`` searches ``k`` only; ``"path"`` doubles until a path exists; ``"stable"`` doubles until
-    a path exists and the best segment (start and end frame) at ``2k`` is the one at ``k``, and returns the
-    ``2k`` answer (with every frame a neighbour the LNG is exact DTW, so the doubling converges to it).
-    Returns ``(matches at the k used, its distances, its indices, every k searched)``; the last k searched
-    is the k used. At ``k_max`` the answer stands as it is (possibly no path).
+    a path exists and the best segment (start and end frame) has held over ``stable_for`` doublings in a row
+    (1: the same at k and 2k; 2: at k, 2k and 4k), and returns the last answer (with every frame a neighbour the
+    LNG is exact DTW, so the doubling converges to it). With exact neighbours the graph at 2k holds the graph
+    at k, so the best cost never rises as k grows: a larger ``stable_for`` or ``k_max`` only searches further and
+    never answers worse. Returns ``(matches at the k used, its distances, its indices, every k searched)``; the
+    last k searched is the k used. At ``k_max`` the answer stands as it is (possibly no path).
     """
     if grow not in GROWTH:
         raise ValueError(f"grow must be one of {GROWTH}, got {grow!r}")
     if k_max < k:
         raise ValueError(f"k_max={k_max} is below k={k}: the growth bound must be at least the starting k")
+    if isinstance(stable_for, bool) or not isinstance(stable_for, (int, np.integer)) or stable_for < 1:
+        raise ValueError(f"stable_for must be a whole number ≥ 1, got {stable_for!r}")
     if grow == "none" or k == k_max:
         dist, ind = neighbours(k)
         return match(ind, dist), dist, ind, (k,)
@@ -190,6 +198,7 @@ def grow_k(neighbours: Callable[[int], tuple[np.ndarray, np.ndarray]],
     dist, ind = neighbours(min(2 * k, k_max))
     found = match(ind[:, :k], dist[:, :k])
     tried = [k]
+    held = 0  # doublings in a row over which the best segment stayed the same
     while k < k_max:
         nxt = min(2 * k, k_max)
         if dist.shape[1] < nxt:
@@ -197,8 +206,9 @@ def grow_k(neighbours: Callable[[int], tuple[np.ndarray, np.ndarray]],
         better = match(ind[:, :nxt], dist[:, :nxt])
         tried.append(nxt)
         same = found and better and (found[0].start, found[0].end) == (better[0].start, better[0].end)
+        held = held + 1 if same else 0
         found, k = better, nxt
-        if same:
+        if held >= stable_for:
             break
     return found, dist[:, :k], ind[:, :k], tuple(tried)
 
@@ -206,18 +216,19 @@ def grow_k(neighbours: Callable[[int], tuple[np.ndarray, np.ndarray]],
 def search_features(features: np.ndarray, index: FrameIndex, k: int = DEFAULT_K, top: int = 10, *,
                     exclude_takes: Iterable[str] = (), eps: float = 0.0, radius: float | None = None,
                     steps: tuple[Step, ...] = THESIS_STEPS, normalize: Normalization = "none",
-                    k_max: int | None = None, grow: str = "none", skip_cost: float | None = None) -> SearchResult:
+                    k_max: int | None = None, grow: str = "none", stable_for: int = DEFAULT_STABLE_FOR,
+                    skip_cost: float | None = None) -> SearchResult:
     """Ranked database segments matching query features ``(m, d)`` (the index's feature set) as a whole.
 
     ``k``: neighbours per query frame (1 ≤ k ≤ database frames outside ``exclude_takes``), the first k a
-    growing search tries; ``k_max``, ``grow``: :func:`grow_k` (``k_max`` None: no growth; capped at the
+    growing search tries; ``k_max``, ``grow``, ``stable_for``: :func:`grow_k` (``k_max`` None: no growth; capped at the
     frames outside ``exclude_takes``); ``top``: at most this many matches; ``exclude_takes``: take names left
     out; ``eps``/``radius``: the k-NN search's approximation and fixed radius (:meth:`FrameIndex.query`);
     ``steps``/``normalize``/``skip_cost``: the LNG's (:func:`lng_match`; ``skip_cost`` None: the radius when one
     is given, else each frame's k-th distance).
 
     Raises:
-        ValueError: bad ``k``/``k_max``/``top``/``grow``/features, an unknown take name (KeyError).
+        ValueError: bad ``k``/``k_max``/``top``/``grow``/``stable_for``/features, an unknown take name (KeyError).
     """
     for value, key in ((k, "k"), (top, "top"), (k if k_max is None else k_max, "k_max")):
         if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
@@ -242,7 +253,7 @@ def search_features(features: np.ndarray, index: FrameIndex, k: int = DEFAULT_K,
         spent["lng"] += time.perf_counter() - t0
         return out
 
-    found, distances, indices, tried = grow_k(neighbours, match, int(k), bound, grow)
+    found, distances, indices, tried = grow_k(neighbours, match, int(k), bound, grow, stable_for)
     matches = [_segment(index, m, rank) for rank, m in enumerate(found, start=1)]
     return SearchResult(matches, indices, distances, tried[-1], names, spent, tried)
 

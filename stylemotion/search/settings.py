@@ -46,11 +46,12 @@ class SearchSettings(MotionFileKeys):
     often finds no path. Chosen among 64, 256 and 1024 on 1 s queries cut from Bandai's validation takes against
     its train takes (the smallest k for which the LNG returns exact DTW's best segment for 95 % of the queries;
     else the highest share) by ``python scripts/benchmarks.py run search``; test figures in benchmarks/search.md.
-    ``k_max``, ``grow``: a search that finds no path, or whose answer still changes, doubles ``k`` up to ``k_max``
-    (:func:`stylemotion.search.matching.grow_k`): ``grow=stable`` until the best segment at 2k is the one at k,
-    ``path`` until a path exists, ``none`` never; ``search.json`` reports the k used and every k tried. Chosen
-    (with ``k``'s role as the first k tried) on 1, 3 and 5 s queries cut from Bandai's validation takes against
-    its train takes by ``python scripts/benchmarks.py run search`` (block ``growth`` of benchmarks/search.md).
+    ``k_max``, ``grow``, ``stable_for``: a search that finds no path, or whose answer still changes, doubles ``k``
+    up to ``k_max`` (:func:`stylemotion.search.matching.grow_k`): ``grow=stable`` until the best segment has held
+    over ``stable_for`` doublings in a row (1: the same at k and 2k; 2: at k, 2k and 4k), ``path`` until a path
+    exists, ``none`` never; ``search.json`` reports the k used and every k tried. Chosen (with ``k``'s role as
+    the first k tried) on 1, 3 and 5 s queries cut from Bandai's validation takes against its train takes by
+    ``python scripts/benchmarks.py run search`` (blocks ``growth_choice`` and ``growth`` of benchmarks/search.md).
     ``steps``: the LNG's step set: thesis (diagonal, vertical, horizontal: a path may stay on one database
     frame) | online (the OLNG's (1,1), (1,2), (2,1), (2,2)) | gaps (thesis + online skips: a path may skip a query
     frame whose neighbours missed it, paying ``skip_cost``); not tuned: the thesis' set, as §2.4.1.
@@ -72,8 +73,9 @@ class SearchSettings(MotionFileKeys):
     query: str = MISSING
     features: str = "E15"
     k: int = 1024
-    k_max: int = 16384
+    k_max: int = 65536
     grow: str = "stable"
+    stable_for: int = 2
     steps: str = "thesis"
     skip_cost: float | None = None
     top: int = 10

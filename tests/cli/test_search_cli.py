@@ -23,6 +23,7 @@ from stylemotion.io.outputs import OutputExistsError
 from stylemotion.io.sources import FileSource
 from stylemotion.search import DEFAULT_K, MATCH_KEYS
 from stylemotion.search.command import SearchInputError, search
+from stylemotion.search.settings import SearchSettings
 
 SYNTHETIC = {"name": "synthetic", "takes_per_pair": 1, "seed": 0, "fps": 30, "duration_s": 8.0}
 TAKE = "synthetic_walk_normal_000"
@@ -97,6 +98,7 @@ def test_the_query_take_is_excluded_by_default_and_gifs_are_written(tmp_path: Pa
     ({"engine": "annoy"}, "engine=annoy is no search engine"),
     ({"k_max": 512}, "k_max=512 is below k=1024: the growth bound must be at least the first k"),
     ({"grow": "always"}, "grow=always is none of ['none', 'path', 'stable']"),
+    ({"stable_for": 0}, "stable_for must be a whole number ≥ 1, got 0"),
     ({"steps": "wide"}, "steps=wide is none of ['thesis', 'online', 'gaps']"),
     ({"skip_cost": -1}, "skip_cost=-1 must be a finite number ≥ 0"),
 ])
@@ -168,6 +170,9 @@ def test_k_grows_from_k_to_k_max_and_search_json_says_which_k_answered(steps: st
     assert report["matches"] and tried[0] == 2 and report["k_used"] == tried[-1] <= 64
     assert all(b == 2 * a for a, b in zip(tried, tried[1:]))
     assert (report["k"], report["k_max"], report["grow"], report["steps"]) == (2, 64, "stable", steps)
+    assert report["stable_for"] == SearchSettings.stable_for  # the stop the command used, recorded
+    if tried[-1] < 64:  # stopped early: at least stable_for + 1 graphs were searched
+        assert len(tried) > report["stable_for"]
     assert len(tried) == 1 or any("k grew 2 → " in line for line in caplog.messages)
     fixed = search(SYNTHETIC, f"{TAKE}:30-90", tmp_path / "fixed", k=2, grow="none", top=1)
     assert fixed["k_tried"] == [2] and fixed["k_used"] == 2

@@ -143,3 +143,90 @@ def test_growth_rules_and_their_refusals() -> None:
         grow_k(neighbours, match, 2, 9, "forever")
     with pytest.raises(ValueError, match="k_max=3 is below k=4"):
         grow_k(neighbours, match, 4, 3, "path")
+
+
+def _longer_case(seed: int) -> tuple[np.ndarray, np.ndarray, list[int]]:
+    """A query ``(m, 3)`` of 6–10 frames cut from a noisy random walk of 70–110 frames in 1–5 takes: long enough
+    that k doubles several times before it holds every frame."""
+    rng = np.random.default_rng(100 + seed)
+    n = int(rng.integers(70, 111))
+    cuts = np.sort(rng.choice(np.arange(12, n - 12), size=int(rng.integers(0, 5)), replace=False))
+    lengths = np.diff(np.concatenate([[0], cuts, [n]])).tolist()
+    walk = np.cumsum(rng.normal(size=(n, 3)), axis=0)
+    m = int(rng.integers(6, 11))
+    take = int(np.argmax(lengths))
+    first = int(np.sum(lengths[:take]))
+    begin = first + int(rng.integers(0, lengths[take] - m + 1))
+    return walk[begin:begin + m] + rng.normal(scale=1.0, size=(m, 3)), walk, lengths
+
+
+@pytest.mark.parametrize("seed", range(12))
+def test_a_stricter_stable_stop_never_answers_worse_than_the_older_one_and_stops_by_k_max(seed: int) -> None:
+    query, walk, lengths = _longer_case(seed)
+    takes = TakeBounds.from_lengths(lengths)
+    n = walk.shape[0]
+    want = brute_dtw(cdist(query, walk), lengths, THESIS_STEPS, 0.0)  # exact subsequence DTW, independent code
+
+    def neighbours(k: int) -> tuple[np.ndarray, np.ndarray]:
+        return _knn(query, walk, k)
+
+    def match(ind: np.ndarray, dist: np.ndarray) -> list:
+        return lng_match(ind, dist, takes)
+
+    def run(k_max: int, stable_for: int) -> tuple[list, tuple[int, ...]]:
+        found, dist, ind, tried = grow_k(neighbours, match, 1, k_max, "stable", stable_for)
+        assert tried[0] == 1 and tried[-1] == ind.shape[1] == dist.shape[1] <= k_max  # bounded by k_max
+        assert all(b == min(2 * a, k_max) for a, b in zip(tried, tried[1:]))  # doubling, capped
+        if tried[-1] < k_max:  # stopped early: the best segment held over the last stable_for doublings
+            assert len(tried) > stable_for
+            for j in tried[-1 - stable_for:-1]:
+                earlier = match(*neighbours(j)[::-1])
+                assert earlier and (earlier[0].start, earlier[0].end) == (found[0].start, found[0].end)
+        return found, tried
+
+    rules = [(k_max, stable_for) for k_max in (16, 64, n) for stable_for in (1, 2, 3)]
+    answers = {rule: run(*rule) for rule in rules}
+    for older in rules:  # e.g. (16, 1): k and 2k agree, to a small bound
+        before, before_tried = answers[older]
+        for stricter in rules:
+            if stricter == older or stricter[0] < older[0] or stricter[1] < older[1]:
+                continue  # only rules at least as strict in both the bound and the stop
+            after, tried = answers[stricter]
+            assert tried[:len(before_tried)] == before_tried  # it searches on from where the older rule stopped
+            if before:
+                assert after and after[0].cost <= before[0].cost + 1e-12, (older, stricter)  # never worse
+                if (before[0].start, before[0].end) == (want[1], want[2]):  # DTW's segment is kept
+                    assert (after[0].start, after[0].end) == (want[1], want[2])
+    for found, _ in answers.values():
+        assert not found or found[0].cost >= want[0] - 1e-12  # the LNG never beats exact DTW
+    exact, tried = run(n, 2 * n)  # a stop that never holds runs to every frame: exact DTW
+    assert tried[-1] == n and exact[0].cost == pytest.approx(want[0], rel=1e-12)
+    assert (exact[0].start, exact[0].end) == (want[1], want[2])
+
+
+def test_stable_for_is_refused_below_one() -> None:
+    query, walk, lengths = _random_case(1)
+    takes = TakeBounds.from_lengths(lengths)
+    for bad in (0, -1, 1.5, True):
+        with pytest.raises(ValueError, match="stable_for must be a whole number ≥ 1"):
+            grow_k(lambda k: _knn(query, walk, k), lambda i, d: lng_match(i, d, takes), 1, 8, "stable", bad)
+
+
+def test_where_k_and_2k_agree_on_a_wrong_segment_the_stricter_stop_finds_dtws() -> None:
+    """A planted case (found by scanning seeds of :func:`_longer_case`): the older stop settles at k = 16 on a
+    segment that is not exact DTW's; requiring two doublings in a row reaches DTW's best segment."""
+    query, walk, lengths = _longer_case(10)
+    takes = TakeBounds.from_lengths(lengths)
+    n = walk.shape[0]
+    want = brute_dtw(cdist(query, walk), lengths, THESIS_STEPS, 0.0)
+
+    def grown(stable_for: int) -> tuple[list, tuple[int, ...]]:
+        found, _, _, tried = grow_k(lambda k: _knn(query, walk, k), lambda i, d: lng_match(i, d, takes), 1, n,
+                                    "stable", stable_for)
+        return found, tried
+
+    older, tried = grown(1)
+    assert tried[-1] < n and (older[0].start, older[0].end) != (want[1], want[2]) and older[0].cost > want[0]
+    stricter, _ = grown(2)
+    assert (stricter[0].start, stricter[0].end) == (want[1], want[2])
+    assert stricter[0].cost == pytest.approx(want[0], rel=1e-12)
