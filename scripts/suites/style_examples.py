@@ -38,6 +38,7 @@ from pathlib import Path
 from typing import Any
 
 from suites.common import fmt, fmt_range, fmt_spread, md_table, progress_printed, provenance_line, spread
+from suites.zero_shot import data_label
 
 DESCRIPTION = ("zero-shot style network conditioned on k = 1, 2, 4, 8 train-split examples of a style it never saw "
                "(suite zero_shot's leave-one-style-out trainings, no training per k): recognition, Table 5.1 row, "
@@ -282,20 +283,11 @@ def _mean(values) -> float | None:
     return sum(finite) / len(finite) if finite else None
 
 
-def _label(r: dict[str, Any]) -> str:
-    label = ("**Synthetic data: a smoke test of the pipeline, not evidence that the method works.** "
-             if r["data"] == "synthetic" else "")
-    sub = r.get("subsample") or {}
-    if sub.get("styles") or sub.get("primitives"):
-        label += "**Narrowed** (not every trained style and primitive): " + ", ".join(r["left_out"]) + ". "
-    return label
-
-
 def render(record: dict[str, Any]) -> dict[str, str]:
     r = record["results"]
     seeds = len(record.get("seeds", []))
     prov = provenance_line(record)
-    label = _label(r)
+    label = data_label(r)
     protocol = (f"Networks of suite zero_shot (`{r['loso']}`: per seed an autoencoder and a network that never saw "
                 f"the left-out style), each conditioned on k clips of the style drawn from its train split (nested "
                 f"draws), pooled by their mean embedding and anchor (as `stylemotion-style example=[…]` pools them) "

@@ -179,7 +179,8 @@ def read_splits(per_seed: dict[str, Any], base: Path, seeds: list[int]) -> dict[
     return dict(record["splits"])
 
 
-def _label(r: dict[str, Any]) -> str:
+def data_label(r: dict[str, Any]) -> str:
+    """The label a block starts with: synthetic data (a smoke test) and narrowed left-out styles."""
     label = ("**Synthetic data: a smoke test of the pipeline, not evidence that the method works.** "
              if r["data"] == "synthetic" else "")
     sub = r.get("subsample") or {}
@@ -193,7 +194,7 @@ def render(record: dict[str, Any]) -> dict[str, str]:
     r = record["results"]
     seeds = len(record.get("seeds", []))
     prov = provenance_line(record)
-    label = _label(r)
+    label = data_label(r)
     split = r["splits"]["data"]
     protocol = (f"Each seed trains, per left-out style, an autoencoder on the judge run's data split by take (seed "
                 f"{split.get('seed')}, val {split.get('val_fraction')}, test {split.get('test_fraction')}) minus every "

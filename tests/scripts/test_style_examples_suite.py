@@ -126,7 +126,7 @@ def test_narrowing_a_leaky_training_and_other_data(planted) -> None:
     assert results["left_out"] == ["walk_leftStance/youthful"] and list(results["headline"]) == ["2"]
     record = {"results": results, "seeds": [1], "command": "c", "commit": "x", "started": "2026-01-01",
               "machine": {}, "seconds": 0}
-    assert "**Narrowed**" in style_examples.render(record)["headline"]
+    assert "**Narrowed to fit the machine**" in style_examples.render(record)["headline"]
     with pytest.raises(library.ZeroShotRunError, match="holds 'synthetic' data, not --data bandai"):
         style_examples.run(args(planted["loso"], data="bandai"), [0])
     leaky = planted["loso"] / "seed0" / "zero_shot.json"
