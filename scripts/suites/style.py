@@ -233,6 +233,38 @@ def seed_figures(report: dict[str, Any]) -> dict[str, Any]:
     return out
 
 
+def summarize(per_seed: dict[str, dict[str, Any]]) -> tuple[dict[str, Any], dict[str, Any]]:
+    """Spreads over seeds of :func:`seed_figures`: per primitive (``summary``) and over all (``overall``)."""
+    first = next(iter(per_seed.values()))
+    primitives = list(first["primitives"])
+    summary: dict[str, Any] = {}
+    for p in primitives:
+        figs = [s["primitives"][p] for s in per_seed.values()]
+        models = list(figs[0]["variance_ratio"])
+        summary[p] = {
+            "models": figs[0]["models"],
+            "diagonal_rows": spread(f["diagonal_rows"] for f in figs),
+            "diagonal_columns": spread(f["diagonal_columns"] for f in figs),
+            "classifier_heldout_accuracy": spread(f["classifier"]["heldout_accuracy"] for f in figs),
+            # rows without a recognition or a style of their own (the shift baselines shift:<style>) are left out
+            # of those tables, not shown as missing figures
+            "recognition": {m: spread(f["recognition"].get(m) for f in figs) for m in models
+                            if m in figs[0]["recognition"]},
+            "variance_ratio": {m: {k: spread(f["variance_ratio"][m][k] for f in figs) for k in RATIOS}
+                               for m in models},
+            "variation_vs_style": {m: {k: spread(f["variation_vs_style"].get(m, {}).get(k) for f in figs)
+                                       for k in VS_STYLE} for m in models if m in figs[0]["variation_vs_style"]},
+        }
+    styled = [m for m in first["recognition_per_model"] if m != "neutral"]
+    overall = {
+        "recognition_mean_styled": spread(sum(s["recognition_per_model"][m] for m in styled) / len(styled)
+                                          for s in per_seed.values()),
+        "classifier_heldout_accuracy": spread(s["classifier_heldout_accuracy"] for s in per_seed.values()),
+        "autoencoder": {k: spread(s["autoencoder"][k] for s in per_seed.values()) for k in AUTOENCODER[:2]},
+    }
+    return summary, overall
+
+
 def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
     import torch
 
@@ -254,28 +286,7 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
             "stage_status": sorted({str(st.get("status")) for st in stages})}
     first = next(iter(per_seed.values()))
     primitives = list(first["primitives"])
-    summary: dict[str, Any] = {}
-    for p in primitives:
-        figs = [s["primitives"][p] for s in per_seed.values()]
-        models = list(figs[0]["variance_ratio"])
-        summary[p] = {
-            "models": figs[0]["models"],
-            "diagonal_rows": spread(f["diagonal_rows"] for f in figs),
-            "diagonal_columns": spread(f["diagonal_columns"] for f in figs),
-            "classifier_heldout_accuracy": spread(f["classifier"]["heldout_accuracy"] for f in figs),
-            "recognition": {m: spread(f["recognition"].get(m) for f in figs) for m in models},
-            "variance_ratio": {m: {k: spread(f["variance_ratio"][m][k] for f in figs) for k in RATIOS}
-                               for m in models},
-            "variation_vs_style": {m: {k: spread(f["variation_vs_style"].get(m, {}).get(k) for f in figs)
-                                       for k in VS_STYLE} for m in models},
-        }
-    styled = [m for m in first["recognition_per_model"] if m != "neutral"]
-    overall = {
-        "recognition_mean_styled": spread(sum(s["recognition_per_model"][m] for m in styled) / len(styled)
-                                          for s in per_seed.values()),
-        "classifier_heldout_accuracy": spread(s["classifier_heldout_accuracy"] for s in per_seed.values()),
-        "autoencoder": {k: spread(s["autoencoder"][k] for s in per_seed.values()) for k in AUTOENCODER[:2]},
-    }
+    summary, overall = summarize(per_seed)
     split = first["split"] or {}
     clips = {p: first["primitives"][p]["classifier"] for p in primitives}
     subsample = {"primitives": args.primitives, "styles": styles,

@@ -1,0 +1,61 @@
+"""Suite ``style`` (scripts/suites/style.py): a report's figures per seed and their spreads over seeds, from planted
+reports; the shift baseline rows (``shift:<style>``, no recognition and no style of their own) stay in the variation
+table and out of the recognition and variation-vs-style tables and the styled mean."""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(ROOT / "scripts"))
+
+from suites import style  # noqa: E402
+
+PRIMITIVE = "walk_leftStance"
+
+
+def planted_report(share: float, v_sd: float) -> dict:
+    """A report.json as stylemotion-eval writes it, cut to what the suite reads: a neutral VAE, one CVAE
+    (angry, recognition ``share``) and the shift baseline of the angry column."""
+    ratios = {"pose_sd": 0.9, "v_sd": v_sd, "step_sd": 1.1}
+    return {
+        "table_5_1": {PRIMITIVE: {"models": ["neutral", "angry"],
+                                  "diagonal": {"rows": ["neutral", "angry"], "columns": ["angry"]}}},
+        "style_recognition": {
+            "per_model_detail": {PRIMITIVE: {"neutral": {"share": 0.95}, "angry": {"share": share}}},
+            "per_model": {"neutral": 0.95, "angry": share},
+            "per_primitive": {PRIMITIVE: {"heldout_accuracy": 0.99, "heldout_clips": 40, "train_clips": 100}},
+            "classifier_heldout_accuracy": 0.99},
+        "variance_ratio": {PRIMITIVE: {"training_data": {"pose_sd": 1, "v_sd": 1, "step_sd": 1},
+                                       "neutral": ratios, "angry": ratios, "shift:angry": ratios}},
+        "variation_vs_style": {PRIMITIVE: {m: {"style": m, "pose_across_sd": 0.5, "v_sd": v_sd, "step_sd": 0.4,
+                                               "diversity": 0.3} for m in ("neutral", "angry")}},
+        "autoencoder": {"test_mpjpe_m": 0.02, "test_local_mpjpe_m": 0.01, "test_windows": 10, "window_frames": 64},
+        "meta": {"data": {"split": {"train": 0.8}}},
+    }
+
+
+def test_spreads_over_seeds_and_the_shift_rows_only_where_they_have_figures():
+    per_seed = {"0": style.seed_figures(planted_report(0.8, 0.5)), "1": style.seed_figures(planted_report(0.9, 0.7)),
+                "2": style.seed_figures(planted_report(1.0, 0.6))}
+    summary, overall = style.summarize(per_seed)
+    s = summary[PRIMITIVE]
+    assert s["models"] == 2 and s["diagonal_rows"]["mean"] == 2 and s["diagonal_columns"]["mean"] == 1
+    assert set(s["recognition"]) == {"neutral", "angry"}
+    assert s["recognition"]["angry"]["mean"] == pytest.approx(0.9) and s["recognition"]["angry"]["sd"] == \
+        pytest.approx(0.1) and s["recognition"]["angry"]["missing"] == 0
+    assert set(s["variance_ratio"]) == {"neutral", "angry", "shift:angry"}
+    assert s["variance_ratio"]["shift:angry"]["v_sd"]["mean"] == pytest.approx(0.6)
+    assert set(s["variation_vs_style"]) == {"neutral", "angry"}
+    assert overall["recognition_mean_styled"]["mean"] == pytest.approx(0.9)  # the CVAE's only, not the shift row
+    # rendered into the committed Bandai record (its provenance and per-seed rows) with this summary
+    record = json.loads((ROOT / "benchmarks" / "results" / "style_bandai.json").read_text())
+    record["results"]["summary"][PRIMITIVE] = s
+    blocks = style.render(record)
+    assert "| walk_leftStance | shift:angry |" in blocks["variation"]
+    assert "shift:angry" not in blocks["recognition"] and "shift:angry" not in blocks["variation_vs_style"]
+    assert "| walk_leftStance | angry |" in blocks["recognition"]
