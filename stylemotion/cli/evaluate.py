@@ -23,12 +23,14 @@ log = logging.getLogger(__name__)
 
 
 def evaluate(cfg: DictConfig, command: str) -> None:
+    from stylemotion.datasets.user_motion import conversion_keys
     from stylemotion.evaluation.run import run_evaluation, summary_lines
 
     set_torch_threads(cfg.get("threads"))
     results = run_evaluation(cfg.data, list(cfg.checkpoints), cfg.evaluation, cfg.out, int(cfg.seed),
                              cfg.get("autoencoder_ckpt"), bool(cfg.force), command, example=cfg.get("example"),
-                             example_style=cfg.get("example_style"))
+                             example_style=cfg.get("example_style"),
+                             example_conversion=conversion_keys(cfg))
     for line in summary_lines(results):
         log.info(line)
     log.info("report written to %s", cfg.out)

@@ -90,7 +90,8 @@ def run_evaluation(data_cfg: Mapping[str, Any], checkpoints: Sequence[str], eval
                    out: str | os.PathLike, seed: int = 0, autoencoder_ckpt: str | None = None, force: bool = False,
                    command: str = "", root: str | os.PathLike | None = None,
                    extra_rows: Mapping[str, Mapping[str, Any]] | None = None,
-                   example: Any = None, example_style: str | None = None) -> dict[str, Any]:
+                   example: Any = None, example_style: str | None = None,
+                   example_conversion: Mapping[str, Any] | None = None) -> dict[str, Any]:
     """Load the models and their autoencoder, evaluate them on ``data_cfg``'s data, write the report.
 
     The autoencoder is ``autoencoder_ckpt`` if given, else the models' own (embedded in their
@@ -100,7 +101,8 @@ def run_evaluation(data_cfg: Mapping[str, Any], checkpoints: Sequence[str], eval
     from ``out``, so a moved folder still describes itself. ``extra_rows`` (``{primitive: {row: SampleSource}}``)
     are rows of Tables 5.1–5.3 only (:func:`~stylemotion.evaluation.pipeline.evaluate_models`). ``example`` (motion
     files ``<BVH>[:start-end]``) and ``example_style`` (the data's style they show) bind the zero-shot networks
-    among the checkpoints to a user's recording (module doc).
+    among the checkpoints to a user's recording (module doc), its file read with ``example_conversion``
+    (``joint_map``, ``unit_scale``, ``up_axis``; None values auto-detected, as ``stylemotion-style`` reads it).
 
     Returns:
         The results as written to ``report.json`` (with ``meta``).
@@ -132,9 +134,16 @@ def run_evaluation(data_cfg: Mapping[str, Any], checkpoints: Sequence[str], eval
     if example is not None:
         user = read_user_example(example, example_style or "", takeset,
                                  list(dict.fromkeys(m.primitive for m in models if m.unbound)), settings.segment,
-                                 settings.neutral_style)
+                                 settings.neutral_style, example_conversion)
     elif example_style:
         raise MissingExampleError(f"example_style={example_style} names the style of example=, which is not given")
+    else:
+        given = {k: v for k, v in dict(example_conversion or {}).items()
+                 if v is not None and (k, v) != ("up_axis", "y")}
+        if given:
+            key, value = next(iter(given.items()))
+            raise MissingExampleError(f"{key}={value} reads the file of example=, which is not given (the data's "
+                                      f"files: data.{key}=)")
     models = zero_shot_models(models, user)
     results = evaluate_models(models, takeset, autoencoder, settings, split=data_cfg.get("split"),
                               autoencoder_info=info, extra_rows=extra_rows)

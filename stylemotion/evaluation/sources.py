@@ -120,11 +120,12 @@ class UserExample:
 
 
 def read_user_example(files: Any, style: str, takeset, primitives: Sequence[str], segment: Mapping[str, Any] | Any,
-                      neutral_style: str = "normal") -> UserExample:
+                      neutral_style: str = "normal", conversion: Mapping[str, Any] | None = None) -> UserExample:
     """``example=`` of ``stylemotion-eval``: a motion file ``<BVH>[:start-end]`` or a list of them, read exactly as
     ``stylemotion-style`` reads its examples (:func:`stylemotion.style_example.example.parse_examples`, each converted
     and put on the data's skeleton, then :func:`~stylemotion.style_example.example.cut_examples` with the
-    evaluation's segmentation: the clips of each primitive pooled over the files).
+    evaluation's segmentation: the clips of each primitive pooled over the files). ``conversion``: the files'
+    ``joint_map``, ``unit_scale``, ``up_axis`` (None or missing: auto-detected, Y up).
 
     Raises:
         MissingExampleError: no zero-shot network's ``primitives`` to condition, ``style`` missing, no file, a file
@@ -152,7 +153,8 @@ def read_user_example(files: Any, style: str, takeset, primitives: Sequence[str]
     clips: dict[str, list] = {}
     records: dict[str, list[dict[str, Any]]] = {}
     try:
-        converted = [on_run_skeleton(convert_example(spec, ConversionSettings(fps=takeset.fps)), takeset,
+        options = {k: v for k, v in dict(conversion or {}).items() if v is not None}
+        converted = [on_run_skeleton(convert_example(spec, ConversionSettings(fps=takeset.fps, **options)), takeset,
                                      neutral_style) for spec in parse_examples(files)]
         for action in dict.fromkeys(parse_primitive(p)[0] for p in primitives):
             cut = cut_examples(converted, style, action, [p for p in primitives if parse_primitive(p)[0] == action],

@@ -321,7 +321,13 @@ def find_checkpoints(patterns: Sequence[str] | str) -> list[Path]:
     for pattern in patterns:
         path = Path(pattern).expanduser()
         if path.is_dir():
-            hits = [h for h in sorted(path.glob("**/checkpoints/best.ckpt")) if is_model_checkpoint(h)]
+            kinds = {h: checkpoint_kind(checkpoint_hparams(h)) for h in sorted(path.glob("**/checkpoints/best.ckpt"))}
+            hits = [h for h, kind in kinds.items() if kind in ("vae", "cvae")]
+            networks = [h for h, kind in kinds.items() if kind == "zero_shot"]
+            if not hits and networks:
+                raise MissingCheckpointError(
+                    f"{pattern!r} holds zero-shot networks only, which a folder search skips (they sample only given "
+                    f"an example): name each one, e.g. checkpoints=[<the run's vae>,{networks[0]}] (docs/zero_shot.md)")
         elif path.is_file():
             hits = [path]
         else:

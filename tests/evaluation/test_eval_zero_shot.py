@@ -29,7 +29,7 @@ from stylemotion.evaluation.reference import primitive_data
 from stylemotion.evaluation.run import run_evaluation, settings_from_config
 from stylemotion.evaluation.sources import MissingExampleError, motions_from_clips
 from stylemotion.evaluation.zero_shot import network_train_config, read_run, train_once
-from stylemotion.models.checkpoints import load_autoencoder
+from stylemotion.models.checkpoints import MissingCheckpointError, find_checkpoints, load_autoencoder
 from stylemotion.models.loading import load_generative, load_model
 from stylemotion.primitives.segmentation import time_normalize
 from stylemotion.synthesis.graph import available_models
@@ -158,13 +158,24 @@ def test_a_users_recordings_get_their_own_column(run, network, tmp_path):
 @pytest.mark.parametrize("kwargs, message", [
     ({"example": "{bvh}", "example_style": "elderly"}, "conditions zero-shot networks, but checkpoints= holds none"),
     ({"example_style": "elderly"}, "example_style=elderly names the style of example=, which is not given"),
+    ({"example_conversion": {"joint_map": "cmu21", "unit_scale": None, "up_axis": "y"}},
+     "joint_map=cmu21 reads the file of example=, which is not given"),
 ])
 def test_an_example_without_a_network_to_bind_is_refused(run, tmp_path, kwargs, message):
     bvh = example_bvh(tmp_path, style="elderly")
-    kwargs = {k: v.format(bvh=bvh) for k, v in kwargs.items()}
+    kwargs = {k: v.format(bvh=bvh) if isinstance(v, str) else v for k, v in kwargs.items()}
     with pytest.raises(MissingExampleError, match=message):
         evaluate(run, tmp_path / "report", [checkpoints(run)["neutral"]], **kwargs)
     assert not (tmp_path / "report").exists()
+
+
+@pytest.mark.slow  # the network of the first test
+def test_a_folder_of_zero_shot_networks_only_names_them_in_one_line(network):
+    assert network.parent.name == "checkpoints"
+    with pytest.raises(MissingCheckpointError, match="zero-shot networks only") as refused:
+        find_checkpoints([str(network.parent.parent)])
+    assert str(network) in str(refused.value) and "\n" not in str(refused.value)
+    assert find_checkpoints([str(network)]) == [network]  # named, it is taken
 
 
 @pytest.mark.slow  # the network of the first test; each refusal before any sample is drawn
@@ -173,6 +184,9 @@ def test_an_example_without_a_network_to_bind_is_refused(run, tmp_path, kwargs, 
     ("{skeleton}", "elderly", "example={skeleton}: "),
     ("{short}", "elderly", "no complete step of the run's primitives"),
     ("{bvh}", "", "needs example_style=<a style of the data>"),
+    ("{skeleton}", "elderly", "joint_map=<map.yaml>"),
+    ("{bvh} joint_map=cmu31", "elderly", "example={bvh}: "),
+    ("{bvh} unit_scale=-3", "elderly", "example={bvh}: "),
 ])
 def test_an_example_that_is_missing_or_does_not_fit_is_one_line(run, network, tmp_path, capsys, monkeypatch,
                                                                  example, style, message):
@@ -182,8 +196,8 @@ def test_an_example_that_is_missing_or_does_not_fit_is_one_line(run, network, tm
              "bvh": example_bvh(tmp_path, style="elderly")}
     files["skeleton"].write_text(tiny_bvh_text())
     assert files["short"] != files["bvh"]
-    example, message = example.format(**files), message.format(**files)
-    args = ["data=synthetic", *DATA, f"checkpoints=[{network}]", f"example={example}", "out=report",
+    (example, *conversion), message = example.format(**files).split(" "), message.format(**files)
+    args = ["data=synthetic", *DATA, f"checkpoints=[{network}]", f"example={example}", *conversion, "out=report",
             "hydra.run.dir=hydra", "evaluation.samples.table_5_1=4", "evaluation.samples.variance=4",
             "evaluation.samples.metrics=4"] + ([f"example_style={style}"] if style else [])
     done = run_command("evaluate", *args, capsys=capsys, monkeypatch=monkeypatch, cwd=tmp_path)
