@@ -246,15 +246,10 @@ def _morphable_model(path: Path) -> Model:
         model = MorphableModel.load(path)
     except (OSError, ValueError, KeyError) as err:
         raise LoadError(f"{path}: not a Morphable Graph model file ({err})") from None
-    meta = model.meta
-    primitive = meta.get("primitive")
-    if primitive and meta.get("action") and not str(primitive).startswith(f"{meta['action']}_"):
-        primitive = f"{meta['action']}_{primitive}"
-    style = meta.get("style")
     provenance = run_provenance(path.parent)
     return Model("morphable", path, model,
-                 Description("morphable", str(path), primitive=None if primitive is None else str(primitive),
-                             style="all" if style in (None, "all") else str(style), data=meta.get("data"),
+                 Description("morphable", str(path), primitive=model.primitive_name, style=model.style_name,
+                             data=model.meta.get("data"),
                              command=provenance.get("command"), commit=provenance.get("git_commit")))
 
 

@@ -48,6 +48,9 @@ DEFINITIONS = {
                       "moved in the autoencoder's feature space by (mean features of s's example clip(s) − mean "
                       "features of the neutral training clips), durations by the same offset in log duration, then "
                       "decoded: the baseline any style model has to beat.",
+    "morphable": "row morphable (morphable:<s>): a Morphable Graph model (Du ch. 3–4) fitted on the neutral clips "
+                 "(on those of style s; all: every style), its samples time-normalized onto the evaluation's "
+                 "timeline: rows of Tables 5.1–5.3 only (no example, so no recognition or column).",
     "zero_shot": "rows zero_shot:<s>: a zero-shot network bound to the example clip(s) of style s (a CVAE's example: "
                  "its Table 5.1 row is measured against that CVAE's column, no column of its own).",
     "pose_sd": "sqrt(Σ‖p_i − p̄‖² / (N−1)) over all valid frames of all motions, p_i the 21 joints relative to the "
@@ -167,7 +170,8 @@ def _table_5_1_section(results: dict[str, Any]) -> list[str]:
                 for i, m in enumerate(t["models"])]
         shared = t.get("shared_columns", {})
         rows += [[f"*{name}* " + (f"(example of {shared[name]['column']})" if name in shared else
-                                  "(shift baseline)" if name.startswith("shift:") else "(extra row)")]
+                                  "(shift baseline)" if name.startswith("shift:") else
+                                  "(Morphable Graph)" if name.split(":")[0] == "morphable" else "(extra row)")]
                  + [f"*{fmt(v)}*" if name in shared and j == int(np.argmin(values)) else fmt(v)
                     for j, v in enumerate(values)]
                  for name, values in t.get("extra_rows", {}).items()]

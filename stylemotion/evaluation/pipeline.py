@@ -54,7 +54,12 @@ from stylemotion.evaluation.metrics import (
 )
 from stylemotion.evaluation.reference import PrimitiveData, primitive_data
 from stylemotion.evaluation.settings import EvalSettings
-from stylemotion.evaluation.sources import MissingExampleError, check_one_autoencoder, motions_from_clips
+from stylemotion.evaluation.sources import (
+    EvaluationInputError,
+    MissingExampleError,
+    check_one_autoencoder,
+    motions_from_clips,
+)
 from stylemotion.evaluation.tables import diagonal_minima, distance_table, example_gram, mean_motion, variance_stats
 from stylemotion.models.autoencoder import local_mpjpe, mpjpe
 from stylemotion.models.loading import NEUTRAL, EvalModel
@@ -94,22 +99,24 @@ def evaluate_models(models: Sequence[EvalModel], takeset: TakeSet, autoencoder, 
     """
     settings = settings or EvalSettings()
     if not models:
-        raise ValueError("no model to evaluate")
+        raise EvaluationInputError("no model to evaluate")
     fp = None if autoencoder_info is None else autoencoder_info.get("fingerprint")
     check_one_autoencoder(models, fp)
     by_primitive: dict[str, list[EvalModel]] = defaultdict(list)
     for m in models:
         if any(o.name == m.name for o in by_primitive[m.primitive]):
-            raise ValueError(f"two models of {m.label}: evaluate one model per primitive and style")
+            raise EvaluationInputError(f"two models of {m.label}: evaluate one model per primitive and style")
         if m.dataset is not None and m.dataset != takeset.name:
-            raise ValueError(f"{m.checkpoint or m.label} was trained on dataset {m.dataset!r}, not {takeset.name!r}")
+            raise EvaluationInputError(f"{m.checkpoint or m.label} was trained on dataset {m.dataset!r}, "
+                                       f"not {takeset.name!r}")
         by_primitive[m.primitive].append(m)
     extra_rows = {p: dict(rows) for p, rows in (extra_rows or {}).items() if rows}
     for p, rows in extra_rows.items():
         clash = sorted(set(rows) & ({m.name for m in by_primitive.get(p, [])} | {"training_data"}))
         if p not in by_primitive or clash:
-            raise ValueError(f"extra rows {sorted(rows)} of {p}: " + (f"names {clash} are taken" if clash else
-                                                                     "no model of that primitive is evaluated"))
+            raise EvaluationInputError(f"extra rows {sorted(rows)} of {p}: " + (
+                f"names {clash} are taken" if clash else
+                "no VAE/CVAE of that primitive is evaluated (such rows stand beside one)"))
     results: dict[str, Any] = {key: {} for key in (
         "table_5_1", "variance", "variance_ratio", "variance_real", "variation_vs_style", "frechet",
         "frechet_reference", "diversity", "foot_skating_detail", "nearest_training")}
@@ -248,8 +255,8 @@ def _canonical_length(primitive: str, models: Sequence[EvalModel], takeset: Take
     """The models' (one) canonical timeline; for sources without one, the median neutral train clip."""
     lengths = {m.timeline_frames for m in models if m.timeline_frames is not None}
     if len(lengths) > 1:
-        raise ValueError(f"the models of {primitive} use different canonical timelines {sorted(lengths)}: they were "
-                         "trained on different data")
+        raise EvaluationInputError(f"the models of {primitive} use different canonical timelines {sorted(lengths)}: "
+                                   "they were trained on different data")
     if lengths:
         return lengths.pop()
     probe = primitive_data(takeset, primitive, 2, settings.neutral_style, _segment_values(settings), split,
@@ -286,8 +293,8 @@ def real_side(primitive: str, models: Sequence[EvalModel], takeset: TakeSet, set
     for m in ordered:
         clips = data.ground_truth(m, examples[m.name])
         if len(clips) < 2:
-            raise ValueError(f"{m.label}: fewer than 2 real clips of style {m.style!r} besides its example; the "
-                             "metrics need ground truth")
+            raise EvaluationInputError(f"{m.label}: fewer than 2 real clips of style {m.style!r} besides its example; "
+                                       "the metrics need ground truth")
         truth[m.name] = motions_from_clips(clips, length)
     log.info(f"{primitive}: style classifier on {len(data.split('train'))} real train clips")
     classifier, result = fit_style_classifier(data, settings)

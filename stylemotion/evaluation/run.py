@@ -11,8 +11,10 @@ all models must share one autoencoder (``autoencoder_ckpt``, default the one the
 data they were trained on. A zero-shot network is evaluated once per example it is bound to
 (:func:`stylemotion.evaluation.sources.zero_shot_models`, rows ``zero_shot:<style>``): each style's example clip(s)
 of the evaluated CVAEs of its primitive (else the ones it records), or ``example=<BVH>[:a-b]`` (one or a list)
-showing the data's style ``example_style``. The report folder ``out`` (see :mod:`stylemotion.evaluation.report`)
-is refused if it exists, unless ``force=true``.
+showing the data's style ``example_style``. A Morphable Graph model (its ``model.npz`` or run folder) becomes the
+row ``morphable`` (another style's: ``morphable:<style>``) of its primitive's Tables 5.1–5.3 beside the VAE/CVAEs
+evaluated with it (:func:`stylemotion.evaluation.sources.morphable_rows`). The report folder ``out``
+(see :mod:`stylemotion.evaluation.report`) is refused if it exists, unless ``force=true``.
 """
 
 from __future__ import annotations
@@ -34,8 +36,11 @@ from stylemotion.evaluation.pipeline import evaluate_models
 from stylemotion.evaluation.report import write_report
 from stylemotion.evaluation.settings import EvalSettings
 from stylemotion.evaluation.sources import (
+    EvaluationInputError,
     MissingExampleError,
     check_one_autoencoder,
+    is_morphable_entry,
+    morphable_rows,
     read_user_example,
     zero_shot_models,
 )
@@ -116,7 +121,13 @@ def run_evaluation(data_cfg: Mapping[str, Any], checkpoints: Sequence[str], eval
     base = Path(root if root is not None else out).expanduser().resolve()
     settings = settings_from_config(evaluation, seed)
     data_cfg = OmegaConf.to_container(data_cfg, resolve=True) if isinstance(data_cfg, DictConfig) else dict(data_cfg)
-    paths = find_checkpoints(checkpoints)
+    morphable = [str(c) for c in checkpoints if is_morphable_entry(str(c))]
+    rest = [c for c in checkpoints if str(c) not in morphable]
+    if not rest:
+        raise EvaluationInputError("checkpoints= holds Morphable Graph models only: they are rows beside a VAE/CVAE of "
+                                   "their primitive (e.g. the run's vae folder), which brings the autoencoder, the "
+                                   "classifier and the style columns")
+    paths = find_checkpoints(rest)
     models = [load_model(p, settings.neutral_style, zero_shot=True) for p in paths]
     if autoencoder_ckpt:
         autoencoder = load_autoencoder(autoencoder_ckpt)
@@ -145,21 +156,28 @@ def run_evaluation(data_cfg: Mapping[str, Any], checkpoints: Sequence[str], eval
             raise MissingExampleError(f"{key}={value} reads the file of example=, which is not given (the data's "
                                       f"files: data.{key}=)")
     models = zero_shot_models(models, user)
+    graphs = morphable_rows(morphable, takeset.name, takeset.fps, settings.neutral_style)
+    rows = {p: dict(r) for p, r in (extra_rows or {}).items()}
+    for p, r in graphs.rows.items():
+        rows.setdefault(p, {}).update(r)
     results = evaluate_models(models, takeset, autoencoder, settings, split=data_cfg.get("split"),
-                              autoencoder_info=info, extra_rows=extra_rows)
+                              autoencoder_info=info, extra_rows=rows)
     for entry in results.get("models", []):
         entry["checkpoint"] = recorded_path(entry.get("checkpoint"), base)
     results["meta"] = {
         "data": data_cfg, "data_name": takeset.name, "seed": int(seed),
         "samples": asdict(settings.samples),
         "checkpoints": [{"path": recorded_path(m.checkpoint, base), "primitive": m.primitive, "name": m.name,
-                         "style": m.style, "kind": m.kind} for m in models],
+                         "style": m.style, "kind": m.kind} for m in models]
+        + [{**r, "path": recorded_path(r["path"], base)} for r in graphs.records],
         "autoencoder": {"path": info["path"], "fingerprint": info["fingerprint"]},
         "paths_relative_to": Path(os.path.relpath(base, out.resolve())).as_posix(),
         "settings": asdict(settings), **provenance(command or None),
         "seconds": time.perf_counter() - started,
     }
     viewer = {f"{m.primitive} {m.name}": m.source.sample(SAMPLES_PER_MODEL, seed=settings.seed) for m in models}
+    viewer |= {f"{p} {name}": source.sample(SAMPLES_PER_MODEL, seed=settings.seed)
+               for p, r in graphs.rows.items() for name, source in r.items()}
     write_report(results, out, force, samples=viewer)
     return results
 

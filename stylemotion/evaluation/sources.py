@@ -14,6 +14,7 @@ named here too, as the evaluation's inputs.
 
 from __future__ import annotations
 
+import math
 from collections import defaultdict
 from collections.abc import Mapping, Sequence
 from dataclasses import asdict, dataclass
@@ -35,6 +36,76 @@ class MixedAutoencodersError(IncompatibleModelError):
 
 class MissingExampleError(UserInputError, ValueError):
     """A style model's example clip cannot be found (or does not match) in the evaluation data."""
+
+
+class EvaluationInputError(UserInputError, ValueError):
+    """Models that cannot be evaluated together (two of one primitive and name, another data set, a row without a
+    model of its primitive)."""
+
+
+#: The file of a Morphable Graph model (``stylemotion-train experiment=morphable_graph``) in its run folder.
+MORPHABLE_FILE = "model.npz"
+#: Row name of a Morphable Graph model in Tables 5.1–5.3: ``morphable`` (the neutral style's, as
+#: ``stylemotion-reproduce morphable=true`` names it), ``morphable:<style>`` for another style (``all``: every style).
+MORPHABLE_ROW = "morphable"
+
+
+def is_morphable_entry(entry: str) -> bool:
+    """Whether a ``checkpoints=`` entry is a Morphable Graph model: a ``.npz`` file, or a folder holding
+    ``model.npz`` (its run folder)."""
+    from pathlib import Path
+
+    path = Path(str(entry)).expanduser()
+    return (path.is_file() and path.suffix == ".npz") or (path.is_dir() and (path / MORPHABLE_FILE).is_file())
+
+
+@dataclass
+class MorphableRows:
+    """Morphable Graph models as rows of Tables 5.1–5.3: ``rows`` ``{primitive: {row: model}}`` (:data:`MORPHABLE_ROW`)
+    (each samples ``MotionSamples``, time-normalized onto the evaluation's timeline by the pipeline), ``records``
+    one ``{path, primitive, name, style, kind}`` per model for the report's ``meta.checkpoints``."""
+
+    rows: dict[str, dict[str, Any]]
+    records: list[dict[str, Any]]
+
+
+def morphable_rows(entries: Sequence[str], data_name: str, fps: float, neutral_style: str = "normal") -> MorphableRows:
+    """Load Morphable Graph models (:func:`is_morphable_entry`) as rows beside the evaluated VAE/CVAEs: a Morphable
+    Graph has no autoencoder features or style example, so it gets the rows the shift baseline gets (Tables
+    5.1–5.3), not recognition or a Table 5.1 column.
+
+    Raises:
+        EvaluationInputError: a model of another data set or frame rate, one without a recorded primitive, or two
+            of one primitive and style (one line naming the file).
+    """
+    from pathlib import Path
+
+    from stylemotion.morphable.model import MorphableModel
+
+    rows: dict[str, dict[str, Any]] = defaultdict(dict)
+    records = []
+    for entry in entries:
+        path = Path(str(entry)).expanduser()
+        path = path / MORPHABLE_FILE if path.is_dir() else path
+        try:
+            model = MorphableModel.load(path)
+        except (OSError, ValueError, KeyError) as err:
+            raise EvaluationInputError(f"{path}: not a Morphable Graph model file ({err})") from None
+        primitive, style, data = model.primitive_name, model.style_name, model.meta.get("data")
+        if not primitive:
+            raise EvaluationInputError(f"{path}: a Morphable Graph model without a recorded primitive")
+        if data not in (None, "None") and data != data_name:
+            raise EvaluationInputError(f"{path} was fitted on data set {data!r}, not {data_name!r}")
+        if not math.isclose(float(model.fps), float(fps), rel_tol=1e-6):
+            raise EvaluationInputError(f"{path} samples at {model.fps:g} fps, the data at {fps:g} fps: fit it on "
+                                       "the evaluated data")
+        name = MORPHABLE_ROW if style == neutral_style else f"{MORPHABLE_ROW}:{style}"
+        if name in rows[primitive]:
+            raise EvaluationInputError(f"{path}: two Morphable Graph models of {primitive} and style {style}")
+        rows[primitive][name] = model
+        records.append({"path": str(path), "primitive": primitive, "name": name, "style": style,
+                        "kind": "morphable"})
+    return MorphableRows(dict(rows), records)
 
 
 def check_one_autoencoder(models: Sequence[EvalModel], fingerprint: str | None = None) -> str | None:

@@ -250,6 +250,20 @@ class MorphableModel:
                              torch.from_numpy(normalized), float(self.fps),
                              torch.from_numpy(latent.astype(np.float32)))
 
+    @property
+    def primitive_name(self) -> str | None:
+        """``<action>_<primitive>`` (e.g. ``walk_leftStance``) as the other models name it; None if not recorded."""
+        primitive, action = self.meta.get("primitive"), self.meta.get("action")
+        if primitive and action and not str(primitive).startswith(f"{action}_"):
+            return f"{action}_{primitive}"
+        return None if primitive is None else str(primitive)
+
+    @property
+    def style_name(self) -> str:
+        """The style of the clips it was fitted on; ``all`` for several styles (or none recorded)."""
+        style = self.meta.get("style")
+        return "all" if style in (None, "all") else str(style)
+
     @torch.no_grad()
     def sample(self, n: int, seed: int = 0, chunk: int = 2000) -> MotionSamples:
         """``n`` motions drawn from the mixture (seeded: the same seed gives the same motions)."""
@@ -422,7 +436,8 @@ def fit_primitive(clips: Sequence[Clip], settings: FitSettings | None = None, me
                   "reduction": record, "functions": names,
                   "function_weights": [float(reduction.scale[groups == g][0]) for g in range(len(names))],
                   "gmm_components": gmm.num_components}
-    meta = {"action": first.action, "primitive": first.primitive, "style": first.style,
+    styles = {c.style for c in clips}
+    meta = {"action": first.action, "primitive": first.primitive, "style": first.style if len(styles) == 1 else "all",
             "settings": {k_: v for k_, v in vars(settings).items()}, "fit": fit_record, **(meta or {})}
     log.info("%s_%s: %d clips, L=%d, K=%d, d=%d, %d GMM component(s), joint RMSE %.4f m", first.action,
              first.primitive, len(clips), data.length, k, settings.latent_dim, gmm.num_components,

@@ -18,6 +18,8 @@ def _files(folder):
     (folder / "cut.ckpt").write_bytes((folder / "whole.ckpt").read_bytes()[:200])
     torch.save({"hyper_parameters": {"hidden_units": 8, "kernel_size": 3, "representation": "x", "fps": 30},
                 "state_dict": {}}, folder / "autoencoder.ckpt")
+    (folder / "graph").mkdir()
+    (folder / "graph" / "model.npz").write_bytes(b"not a zip")
 
 
 @pytest.mark.parametrize("name, message", [
@@ -26,6 +28,7 @@ def _files(folder):
     ("junk.ckpt", "junk.ckpt is not a readable checkpoint"),
     ("cut.ckpt", "cut.ckpt is not a readable checkpoint"),
     ("autoencoder.ckpt", "autoencoder.ckpt is not a trained PrimitiveVAE/StyleCVAE/ZeroShotStyleVAE checkpoint"),
+    ("graph", "checkpoints= holds Morphable Graph models only"),
 ])
 def test_a_checkpoint_that_is_not_one_is_named_in_one_line(name, message, tmp_path, capsys, monkeypatch):
     _files(tmp_path)

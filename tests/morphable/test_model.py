@@ -69,3 +69,15 @@ def test_the_frames_representation_samples_too(left_clips):
     assert np.linalg.norm(first[-1, 0, [0, 2]] - first[0, 0, [0, 2]]) > 0.3  # it walks forward a step
     with pytest.raises(ValueError, match="orientations need the quaternion representation"):
         model.canonical_positions(s.latent.numpy(), rotations=True)
+
+
+def test_a_model_names_its_primitive_and_the_style_of_its_clips(left_model, left_clips):
+    from dataclasses import replace
+
+    from stylemotion.morphable import FitSettings, fit_primitive
+
+    assert left_model.primitive_name == "walk_leftStance" and left_model.style_name == "normal"
+    clips = list(left_clips["train"])
+    mixed = [replace(c, style="elderly") if i % 2 else c for i, c in enumerate(clips)]  # two styles
+    model = fit_primitive(mixed, FitSettings(latent_dim=4, reduction="fpca", num_coefficients=6))
+    assert model.meta["style"] == "all" and model.style_name == "all"

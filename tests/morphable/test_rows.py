@@ -64,7 +64,7 @@ def test_the_report_shows_extra_rows_and_keeps_them_out_of_the_style_ranges(eval
     _, _, _, results = evaluated
     text = format_markdown({**results, "meta": {"data_name": "synthetic", "seed": 0, "samples": {},
                                                 "checkpoints": [], "autoencoder": {}, "seconds": 1.0}}, [], [])
-    assert f"*{ROW}* (extra row)" in text
+    assert f"*{ROW}* (Morphable Graph)" in text
     assert "style models pose_sd / training data" not in text  # the only non-neutral rows are extra rows
     assert f"| {ROW} |" in text  # its Tables 5.2/5.3 row
 
@@ -73,7 +73,7 @@ def test_extra_rows_need_a_model_of_their_primitive_and_a_free_name(evaluated) -
     ae, info, neutral, _ = evaluated
     source = neutral.source
     for extra, message in (({PRIMITIVE: {NEUTRAL: source}}, "taken"), ({PRIMITIVE: {"training_data": source}}, "taken"),
-                           ({"walk_rightStance": {ROW: source}}, "no model of that primitive")):
+                           ({"walk_rightStance": {ROW: source}}, "no VAE/CVAE of that primitive")):
         with pytest.raises(ValueError, match=message):
             evaluate_models([neutral], tiny_takeset(), ae, SETTINGS, split=TINY_DATA["split"], autoencoder_info=info,
                             extra_rows=extra)
@@ -108,7 +108,7 @@ def test_reproduce_with_morphable_adds_its_rows_to_the_report(tiny_run, tmp_path
     assert [s["status"] for s in summary["stages"]] == ["reused", "reused"]
     assert (out / "morphable" / PRIMITIVE / "model.npz").is_file()
     report = (out / "report" / "report.md").read_text()
-    assert f"*{ROW}* (extra row)" in report and f"| {ROW} |" in report
+    assert f"*{ROW}* (Morphable Graph)" in report and f"| {ROW} |" in report
     results = json.loads((out / "report" / "report.json").read_text())
     assert results["extra_rows"] == {PRIMITIVE: [ROW]}
     ratio = results["variance_ratio"][PRIMITIVE][ROW]
