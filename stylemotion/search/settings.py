@@ -73,7 +73,7 @@ class SearchSettings(MotionFileKeys):
     query: str = MISSING
     features: str = "E15"
     k: int = 1024
-    k_max: int = 65536
+    k_max: int = 16384
     grow: str = "stable"
     stable_for: int = 2
     steps: str = "thesis"
