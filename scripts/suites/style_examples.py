@@ -221,8 +221,17 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
                 with progress_printed(f"[seed {seed} {p}/{s}]"):
                     curves.setdefault(p, {})[s] = style_curve(judge, network, p, s, ks, args.samples, seed,
                                                               tuple(poolings))
-        per_seed[str(seed)] = {"loso": relative(folder), "judge": relative(judge_folder), "curves": curves}
+        styles = set(judge.takeset.label_values("style")) - {judge.source.settings.neutral_style}
+        per_seed[str(seed)] = {"loso": relative(folder), "judge": relative(judge_folder), "curves": curves,
+                               "data_styles": sorted(styles)}
     return summarize(per_seed, ks, args, poolings)
+
+
+
+def _narrowed_upstream(per_seed: dict[str, Any], left_out: list[tuple[str, str]]) -> bool:
+    """Whether the trainings left out fewer styles than the judge's data has (seeds recorded before this: no)."""
+    data = {s for v in per_seed.values() for s in v.get("data_styles") or []}
+    return bool(data) and bool(data - {s for _, s in left_out})
 
 
 def summarize(per_seed: dict[str, Any], ks: list[int], args: argparse.Namespace,
@@ -263,7 +272,10 @@ def summarize(per_seed: dict[str, Any], ks: list[int], args: argparse.Namespace,
             "poolings": poolings or ["mean"], "samples": args.samples,
             "judge": sorted({v["judge"] for v in per_seed.values()}),
             "left_out": [f"{p}/{s}" for p, s in left_out],
-            "subsample": {"primitives": args.primitives, "styles": args.styles},
+            # narrowed here (--styles) or upstream (suite zero_shot left out fewer styles than the data has)
+            "subsample": {"primitives": args.primitives,
+                          "styles": args.styles or (sorted({s for _, s in left_out})
+                                                    if _narrowed_upstream(per_seed, left_out) else None)},
             "aims": {"k": 4, **{f"{m}_vs_real": a for m, a in AIMS.items()}, "recognition": AIM_RECOGNITION},
             "splits": {"examples": "k clips of the left-out style drawn from its train-split clips (nested: one seeded "
                                    "permutation per seed, primitive and style)",

@@ -75,7 +75,10 @@ def planted(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> dict:
     class FakeJudge:
         def __init__(self, folder):
             calls.setdefault("judges", []).append(folder)
-            self.source = SimpleNamespace(data_cfg={"name": "synthetic"})
+            self.source = SimpleNamespace(data_cfg={"name": "synthetic"},
+                                          settings=SimpleNamespace(neutral_style="normal"))
+            styles = calls.get("data_styles", ["normal", *STYLES])  # the data's styles: those left out + neutral
+            self.takeset = SimpleNamespace(label_values=lambda key: list(styles) if key == "style" else [])
 
     def fake_curve(judge, network, primitive, style, ks, samples, seed, poolings=("mean",)):
         calls["curves"].append((seed, style, tuple(ks), samples, poolings))
@@ -118,6 +121,7 @@ def test_spreads_counts_and_aims_are_over_seeds(planted) -> None:
     blocks = style_examples.render(record)
     assert set(blocks) == {"headline", "per_style", "real"}
     assert "Synthetic data" in blocks["headline"] and "| 4 | 0.887 ± 0." in blocks["headline"]
+    assert "Narrowed" not in blocks["headline"]  # every style of the data was left out
     assert "| walk_leftStance | youthful | 8 | 0.900 ± 0.100 | 3/3 | 0.95 ± 0.00 |" in blocks["per_style"]
 
 
@@ -126,6 +130,12 @@ def test_narrowing_a_leaky_training_and_other_data(planted) -> None:
     assert results["left_out"] == ["walk_leftStance/youthful"] and list(results["headline"]) == ["2"]
     record = {"results": results, "seeds": [1], "command": "c", "commit": "x", "started": "2026-01-01",
               "machine": {}, "seconds": 0}
+    assert "**Narrowed to fit the machine**" in style_examples.render(record)["headline"]
+    # narrowed upstream: suite zero_shot left out fewer styles than the judge's data has
+    planted["data_styles"] = ["normal", *STYLES, "angry"]
+    results = style_examples.run(args(planted["loso"], ks=[2]), [1])
+    record = {**record, "results": results}
+    assert results["subsample"]["styles"] == sorted(STYLES)
     assert "**Narrowed to fit the machine**" in style_examples.render(record)["headline"]
     with pytest.raises(library.ZeroShotRunError, match="holds 'synthetic' data, not --data bandai"):
         style_examples.run(args(planted["loso"], data="bandai"), [0])
