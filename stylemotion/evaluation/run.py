@@ -124,9 +124,10 @@ def run_evaluation(data_cfg: Mapping[str, Any], checkpoints: Sequence[str], eval
     morphable = [str(c) for c in checkpoints if is_morphable_entry(str(c))]
     rest = [c for c in checkpoints if str(c) not in morphable]
     if not rest:
-        raise EvaluationInputError("checkpoints= holds Morphable Graph models only: they are rows beside a VAE/CVAE of "
-                                   "their primitive (e.g. the run's vae folder), which brings the autoencoder, the "
-                                   "classifier and the style columns")
+        raise EvaluationInputError("checkpoints= is empty: name VAE/CVAE checkpoints or run folders" if not morphable
+                                   else "checkpoints= holds Morphable Graph models only: they are rows beside a "
+                                   "VAE/CVAE of their primitive (e.g. the run's vae folder), which brings the "
+                                   "autoencoder, the classifier and the style columns")
     paths = find_checkpoints(rest)
     models = [load_model(p, settings.neutral_style, zero_shot=True) for p in paths]
     if autoencoder_ckpt:

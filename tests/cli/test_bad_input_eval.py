@@ -29,6 +29,7 @@ def _files(folder):
     ("cut.ckpt", "cut.ckpt is not a readable checkpoint"),
     ("autoencoder.ckpt", "autoencoder.ckpt is not a trained PrimitiveVAE/StyleCVAE/ZeroShotStyleVAE checkpoint"),
     ("graph", "checkpoints= holds Morphable Graph models only"),
+    ("", "checkpoints= is empty"),
 ])
 def test_a_checkpoint_that_is_not_one_is_named_in_one_line(name, message, tmp_path, capsys, monkeypatch):
     _files(tmp_path)
