@@ -29,7 +29,7 @@ from typing import Any
 
 from omegaconf import DictConfig, OmegaConf
 
-from stylemotion.config import build_settings
+from stylemotion.config import MotionFileKeys, build_settings
 from stylemotion.datasets import build_dataset
 from stylemotion.evaluation.html_report import SAMPLES_PER_MODEL
 from stylemotion.evaluation.pipeline import evaluate_models
@@ -150,8 +150,8 @@ def run_evaluation(data_cfg: Mapping[str, Any], checkpoints: Sequence[str], eval
     elif example_style:
         raise MissingExampleError(f"example_style={example_style} names the style of example=, which is not given")
     else:
-        given = {k: v for k, v in dict(example_conversion or {}).items()
-                 if v is not None and (k, v) != ("up_axis", "y")}
+        defaults = MotionFileKeys()
+        given = {k: v for k, v in dict(example_conversion or {}).items() if v != getattr(defaults, k, None)}
         if given:
             key, value = next(iter(given.items()))
             raise MissingExampleError(f"{key}={value} reads the file of example=, which is not given (the data's "

@@ -18,6 +18,7 @@ import math
 from collections import defaultdict
 from collections.abc import Mapping, Sequence
 from dataclasses import asdict, dataclass
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -53,8 +54,6 @@ MORPHABLE_ROW = "morphable"
 def is_morphable_entry(entry: str) -> bool:
     """Whether a ``checkpoints=`` entry is a Morphable Graph model: a ``.npz`` file, or a folder holding
     ``model.npz`` (its run folder)."""
-    from pathlib import Path
-
     path = Path(str(entry)).expanduser()
     return (path.is_file() and path.suffix == ".npz") or (path.is_dir() and (path / MORPHABLE_FILE).is_file())
 
@@ -78,8 +77,6 @@ def morphable_rows(entries: Sequence[str], data_name: str, fps: float, neutral_s
         EvaluationInputError: a model of another data set or frame rate, one without a recorded primitive, or two
             of one primitive and style (one line naming the file).
     """
-    from pathlib import Path
-
     from stylemotion.morphable.model import MorphableModel
 
     rows: dict[str, dict[str, Any]] = defaultdict(dict)

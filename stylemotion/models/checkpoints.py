@@ -105,9 +105,13 @@ def checkpoint_kind(hparams: Mapping[str, Any]) -> str | None:
     return None
 
 
+#: The kinds a folder search for evaluation takes (a zero-shot network samples only given an example).
+MODEL_KINDS = ("vae", "cvae")
+
+
 def is_model_checkpoint(path: str | os.PathLike) -> bool:
     """Whether a checkpoint holds a trained PrimitiveVAE/StyleCVAE (its hyperparameters carry a data ``spec``)."""
-    return checkpoint_kind(checkpoint_hparams(path)) in ("vae", "cvae")
+    return checkpoint_kind(checkpoint_hparams(path)) in MODEL_KINDS
 
 
 def restore(cls: type[pl.LightningModule], checkpoint: Mapping[str, Any], source: str) -> pl.LightningModule:
@@ -322,7 +326,7 @@ def find_checkpoints(patterns: Sequence[str] | str) -> list[Path]:
         path = Path(pattern).expanduser()
         if path.is_dir():
             kinds = {h: checkpoint_kind(checkpoint_hparams(h)) for h in sorted(path.glob("**/checkpoints/best.ckpt"))}
-            hits = [h for h, kind in kinds.items() if kind in ("vae", "cvae")]
+            hits = [h for h, kind in kinds.items() if kind in MODEL_KINDS]
             networks = [h for h, kind in kinds.items() if kind == "zero_shot"]
             if not hits and networks:
                 raise MissingCheckpointError(
