@@ -41,7 +41,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--contents", nargs="+", default=["walk", "run", "wave-both-hands", "raise-up-both-hands"],
                         help="marker queries' contents")
     parser.add_argument("--takes", type=int, default=2, help="marker queries per content, in val and in test")
-    parser.add_argument("--k", type=int, nargs="+", default=[32, 64, 128, 256, 512], help="candidates of k")
+    parser.add_argument("--k", type=int, nargs="+", default=[32, 64, 128, 256, 512, 1024, 2048],
+                        help="candidates of k")
+    parser.add_argument("--k-tolerance", type=float, default=0.01,
+                        help="k: the smallest candidate whose val error is within this fraction of the lowest")
     parser.add_argument("--noise-mm", type=float, default=1.0, help="uniform marker noise, ± mm (thesis: 1)")
     parser.add_argument("--key-contents", nargs="+", default=["walk", "walk-turn-left", "walk-turn-right", "run"])
     parser.add_argument("--key-takes", type=int, default=2, help="keyframe test takes per content")
@@ -66,7 +69,7 @@ def _markers_section(args, bandai, parts, rng) -> dict[str, Any]:
     from stylemotion.reconstruct import DEFAULT_MARKERS, SparseReconstructor, read_markers
     from stylemotion.reconstruct.benchmark import (
         choose_queries,
-        choose_setting,
+        choose_smallest_within,
         database_of,
         error_figures,
         joint_error_table,
@@ -99,7 +102,7 @@ def _markers_section(args, bandai, parts, rng) -> dict[str, Any]:
     for k in args.k:
         tables = [e for db in ("same", "without") for _, e in errors(db, "val", k)]
         val_scores[k] = error_figures(tables)["mean_cm"]
-    k = choose_setting(val_scores)
+    k = choose_smallest_within(val_scores, args.k_tolerance)
     test: dict[str, Any] = {}
     for db in ("same", "without"):
         for name, baseline in (("ours", False), ("nn", True)):
@@ -262,6 +265,7 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
                        "other_captures": "the three walks of other-skeletons (other actors, studios, skeletons), "
                                          "never in any split; database = the seed's train takes"},
             "settings": {"contents": args.contents, "takes_per_content": args.takes, "k_candidates": args.k,
+                         "k_tolerance": args.k_tolerance,
                          "noise_mm": args.noise_mm, "key_contents": args.key_contents, "key_takes": args.key_takes,
                          "key_val_takes": args.key_val_takes,
                          "spacings_s": args.spacings, "val_spacings_s": args.val_spacings,
@@ -269,7 +273,9 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
                          "texture_takes": args.texture_takes, "texture_frames": args.texture_frames,
                          "texture_every": args.texture_every, "features": "E15", "markers": "DEFAULT_MARKERS"},
             "choice": {"k": int(k), "duration_weight": float(weight),
-                       "rule": "each seed chooses on its val takes; the default is the most frequent choice"},
+                       "rule": f"each seed chooses on its val takes (k: the smallest candidate within "
+                               f"{args.k_tolerance:g} of the lowest mean error; duration_weight: the lowest score); "
+                               f"the default is the most frequent choice"},
             "per_seed": per_seed}
 
 
@@ -316,10 +322,20 @@ def _edge(r: dict) -> str:
     edges = [name for name, value, grid in (("k", c["k"], s["k_candidates"]),
                                              ("duration_weight", c["duration_weight"], s["duration_weight_candidates"]))
              if len(grid) > 1 and value in (max(grid), min(grid))]
-    if not edges:
-        return ""
-    return (f" {' and '.join(edges)} {'lies' if len(edges) == 1 else 'lie'} at the edge of the candidates: values "
-            f"beyond them were not tried, so the optimum may lie there.")
+    out = ""
+    if edges:
+        out = (f" {' and '.join(edges)} {'lies' if len(edges) == 1 else 'lie'} at the edge of the candidates: values "
+               f"beyond them were not tried, so the optimum may lie there.")
+    tolerance = s.get("k_tolerance")
+    if tolerance is not None and "k" not in edges:
+        grid = s["k_candidates"]
+        means = {k: float(np.mean([x["markers"]["val_mean_cm_by_k"][str(k)] for x in r["per_seed"]])) for k in grid}
+        lowest = min(means, key=means.__getitem__)
+        if lowest == max(grid):
+            out += (f" The lowest mean val error ({fmt(means[lowest], 3)} cm) lies at the largest k tried, {lowest} "
+                    f"(k = {c['k']}: {fmt(means[c['k']], 3)} cm); larger k would change the choice only where the "
+                    f"error fell on by more than the tolerance.")
+    return out
 
 
 def render(record: dict[str, Any]) -> dict[str, str]:
@@ -413,7 +429,8 @@ def render(record: dict[str, Any]) -> dict[str, str]:
               + md_table(["k", *seeds_cols], krows)
               + "\n\nValidation score of each duration_weight (s: mean |duration error|, a failed pair counting its "
                 "whole spacing; joined / attempted val pairs):\n\n" + md_table(["duration_weight", *seeds_cols], wrows)
-              + f"\n\nDefaults (most frequent choice over seeds): k = {r['choice']['k']}, duration_weight = "
+              + f"\n\nRule: {r['choice']['rule']}."
+              + f" Defaults (most frequent choice over seeds): k = {r['choice']['k']}, duration_weight = "
                 f"{fmt(r['choice']['duration_weight'], 0)}.{_edge(r)} {prov}")
 
     # keyframes

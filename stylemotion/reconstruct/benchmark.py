@@ -94,6 +94,18 @@ def choose_setting(scores: Mapping[Any, float | None]) -> Any:
     return best
 
 
+def choose_smallest_within(scores: Mapping[float, float | None], tolerance: float) -> float:
+    """The smallest candidate whose validation score is at most ``(1 + tolerance)`` × the lowest score: the
+    cheapest setting as good as the best up to ``tolerance`` (a fraction, e.g. 0.01), for a setting whose cost grows
+    with its value (k neighbours) and whose score flattens. A None or non-finite score never qualifies; ValueError
+    when no candidate has a score or ``tolerance`` is negative."""
+    if not tolerance >= 0:
+        raise ValueError(f"tolerance must be >= 0, got {tolerance}")
+    best = choose_setting(scores)
+    limit = float(scores[best]) * (1.0 + tolerance)  # type: ignore[arg-type]
+    return min(c for c, s in scores.items() if s is not None and math.isfinite(s) and s <= limit)
+
+
 def key_pairs(positions: np.ndarray, fps: float, spacing_s: float, start_s: float = 0.2,
               ) -> list[tuple[Keyframe, Keyframe]]:
     """Consecutive key pairs of a motion ``(frames, 21, 3)`` m: a key every ``spacing_s`` s from ``start_s`` to its

@@ -13,6 +13,7 @@ from reconstruct_fixtures import synthetic_split
 from stylemotion.reconstruct.benchmark import (
     choose_queries,
     choose_setting,
+    choose_smallest_within,
     error_figures,
     key_pairs,
     pair_outcome,
@@ -86,6 +87,18 @@ def test_choice_and_scores():
     figures = error_figures([table[:1], table[1:]])
     assert figures["mean_cm"] == pytest.approx(20.5) and figures["max_cm"] == 41.0
     assert figures["per_joint"]["Hips"] == {"mean_cm": 10.5, "p95_cm": pytest.approx(19.95), "max_cm": 21.0}
+
+
+def test_smallest_candidate_within_a_tolerance_of_the_best():
+    scores = {32: 0.95, 64: 0.77, 128: 0.67, 256: 0.651, 512: 0.640, 1024: 0.636}
+    assert choose_smallest_within(scores, 0.0) == 1024  # the lowest itself
+    assert choose_smallest_within(scores, 0.01) == 512  # 0.640 <= 1.01 * 0.636; 0.651 is not
+    assert choose_smallest_within(scores, 0.03) == 256
+    assert choose_smallest_within({64: math.nan, 128: None, 256: 1.0, 512: 0.99}, 0.5) == 256  # no score: never
+    with pytest.raises(ValueError, match="tolerance"):
+        choose_smallest_within(scores, -0.1)
+    with pytest.raises(ValueError, match="no candidate"):
+        choose_smallest_within({1: None}, 0.01)
 
 
 def test_queries_are_drawn_by_seed_and_spread_over_styles(split):
