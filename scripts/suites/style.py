@@ -135,7 +135,7 @@ def train_candidate(container: dict[str, Any], folder: str) -> dict[str, float]:
 
     from stylemotion.io.jsonfile import read_json_object, write_json
     from stylemotion.training.fit import run as train_run
-    from stylemotion.training.style_weight import prior_sample_spread
+    from stylemotion.training.style_weight import prior_sample_figures
 
     path = Path(folder)
     record = path / "candidate.json"
@@ -145,11 +145,10 @@ def train_candidate(container: dict[str, Any], folder: str) -> dict[str, float]:
         train_run(OmegaConf.create(container))
         val = dict(read_json_object(path / "metrics.json", "an α candidate's metrics", f"delete {path}").get("val")
                    or {})
-    if "samples/pose_across_sd" in val:
+    if "samples/pose_across_sd" in val and "samples/style" in val:
         return val
-    # trained now, or recorded before the rule read the samples' spread
-    val["samples/pose_across_sd"] = prior_sample_spread(path / "checkpoints" / "best.ckpt",
-                                                        seed=int(container.get("seed", 0)))
+    # trained now, or recorded before the rules read the prior samples' figures
+    val.update(prior_sample_figures(path / "checkpoints" / "best.ckpt", seed=int(container.get("seed", 0))))
     write_json(record, {"val": val})
     return val
 
@@ -159,12 +158,39 @@ def choose_alpha(args: argparse.Namespace, seed: int, primitives: list[str] | No
     """Choose α among ``args.alphas`` on validation clips (stylemotion/training/style_weight.py): CVAEs of
     ``args.alpha_styles`` seeded styles, trained with seed ``args.alpha_seed`` on the autoencoder of the reported
     ``seed``'s run (trained here first, the same stage the seed's reproduction then reuses)."""
+    from stylemotion.training.style_weight import METRICS
+
+    candidates = {float(a): [f"model.style_weight={a}"] for a in sorted(args.alphas)}
+    choice = choose_cvae_setting(args, seed, primitives, styles, candidates, "alpha", METRICS,
+                                 folder=lambda a: f"alpha{a:g}")
+    return {**choice, "candidates": sorted(args.alphas),
+            "values": {f"{a:g}": v for a, v in choice["values"].items()},
+            "scores": {f"{a:g}": choice["scores"][a] for a in sorted(choice["scores"])},
+            "rule": "min over α of the mean over styles of log(val/style ÷ min) + log(val/mpjpe ÷ min) + "
+                    "log(max ÷ samples/pose_across_sd) (stylemotion/training/style_weight.py)"}
+
+
+def candidate_overrides(stage: list[str], candidate: list[str]) -> list[str]:
+    """The reproduction's CVAE stage overrides with the candidate's keys replaced by its values, and no sample GIFs
+    (nothing reads them when choosing)."""
+    keys = {o.split("=", 1)[0] for o in [*candidate, "callbacks.samples=null"]}
+    return [o for o in stage if o.split("=", 1)[0] not in keys] + [*candidate, "callbacks.samples=null"]
+
+
+def choose_cvae_setting(args: argparse.Namespace, seed: int, primitives: list[str] | None,
+                        styles: list[str] | None, candidates: dict[Any, list[str]], subfolder: str,
+                        metrics: dict[str, bool], folder: Any = str) -> dict[str, Any]:
+    """Choose among CVAE settings on validation clips by :func:`~stylemotion.training.style_weight.
+    choose_style_weight` over ``metrics``: each candidate (name → ``model.*`` overrides) trains CVAEs of
+    ``args.alpha_styles`` seeded styles with seed ``args.alpha_seed`` on the autoencoder of the reported ``seed``'s
+    run (trained here first, the same stage the seed's reproduction then reuses), into
+    ``<runs>/<setup>/<subfolder>/seed<alpha_seed>/<folder(name)>/<primitive>_<style>`` (finished ones reused)."""
     import numpy as np
     from hydra.core.global_hydra import GlobalHydra
     from omegaconf import OmegaConf
 
     from stylemotion.training.reproduction import Reproduction, stage_train_config
-    from stylemotion.training.style_weight import METRICS, choose_style_weight, style_weight_scores
+    from stylemotion.training.style_weight import choose_style_weight, style_weight_scores
 
     base = args.runs / args.data / setup_tag(primitives, styles)
     cfg = compose_reproduce(reproduce_overrides(args.data, seed, base / f"seed{seed}", 1, primitives, []))
@@ -177,35 +203,28 @@ def choose_alpha(args: argparse.Namespace, seed: int, primitives: list[str] | No
         pool = styles or [s for s in repro.data_summary["styles"] if s != str(cfg.evaluation.neutral_style)]
         chosen_styles = sorted(np.random.default_rng(1).choice(pool, min(args.alpha_styles, len(pool)),
                                                                replace=False).tolist())
-        # the reproduction's CVAE stage as it is, but α; no sample GIFs (nothing reads them here)
-        overrides = [o for o in OmegaConf.to_container(cfg.stages.cvae, resolve=True)
-                     if not str(o).startswith("model.style_weight=")] + ["callbacks.samples=null"]
+        stage = [str(o) for o in OmegaConf.to_container(cfg.stages.cvae, resolve=True)]
         jobs = {}
-        for alpha in sorted(args.alphas):
+        for name, overrides in candidates.items():
             for primitive in repro.primitives:
                 for style in chosen_styles:
-                    folder = base / "alpha" / f"seed{args.alpha_seed}" / f"alpha{alpha:g}" / f"{primitive}_{style}"
-                    train_cfg = stage_train_config([*overrides, f"model.style_weight={alpha}"],
-                                                   {"primitive": primitive, "style": style}, repro.data_cfg, folder,
-                                                   args.alpha_seed, 1, str(autoencoder.checkpoint))
-                    jobs[(alpha, f"{primitive}/{style}")] = (OmegaConf.to_container(train_cfg, resolve=True),
-                                                             str(folder))
+                    out = base / subfolder / f"seed{args.alpha_seed}" / folder(name) / f"{primitive}_{style}"
+                    train_cfg = stage_train_config(candidate_overrides(stage, overrides),
+                                                   {"primitive": primitive, "style": style},
+                                                   repro.data_cfg, out, args.alpha_seed, 1, str(autoencoder.checkpoint))
+                    jobs[(name, f"{primitive}/{style}")] = (OmegaConf.to_container(train_cfg, resolve=True), str(out))
     finally:
         GlobalHydra.instance().clear()
-    values: dict[float, dict[str, dict[str, float]]] = {}
+    values: dict[Any, dict[str, dict[str, float]]] = {}
     with ProcessPoolExecutor(max_workers=max(1, args.workers), mp_context=get_context("spawn")) as pool:
         futures = {key: pool.submit(train_candidate, *job) for key, job in jobs.items()}
-        for (alpha, name), future in futures.items():
+        for (name, clip), future in futures.items():
             val = future.result()
-            print(f"[α {alpha:g}] {name}: " + ", ".join(f"{m} {val.get(m)}" for m in METRICS), flush=True)
-            values.setdefault(alpha, {})[name] = {m: val.get(m) for m in METRICS}
-    scores = style_weight_scores(values)
-    chosen = choose_style_weight(values)
-    return {"candidates": sorted(args.alphas), "styles": chosen_styles, "seed": args.alpha_seed,
-            "autoencoder_of_seed": seed, "values": {f"{a:g}": v for a, v in values.items()},
-            "scores": {f"{a:g}": scores[a] for a in sorted(scores)}, "chosen": chosen,
-            "rule": "min over α of the mean over styles of log(val/style ÷ min) + log(val/mpjpe ÷ min) + "
-                    "log(max ÷ samples/pose_across_sd) (stylemotion/training/style_weight.py)"}
+            print(f"[{subfolder} {folder(name)}] {clip}: " + ", ".join(f"{m} {val.get(m)}" for m in metrics),
+                  flush=True)
+            values.setdefault(name, {})[clip] = {m: val.get(m) for m in metrics}
+    return {"styles": chosen_styles, "seed": args.alpha_seed, "autoencoder_of_seed": seed, "values": values,
+            "scores": style_weight_scores(values, metrics), "chosen": choose_style_weight(values, metrics)}
 
 
 def seed_figures(report: dict[str, Any]) -> dict[str, Any]:

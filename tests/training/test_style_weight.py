@@ -6,7 +6,7 @@ import math
 
 import pytest
 
-from stylemotion.training.style_weight import choose_style_weight, style_weight_scores
+from stylemotion.training.style_weight import SAMPLE_METRICS, choose_style_weight, style_weight_scores
 
 
 def metrics(style: float, mpjpe: float, spread: float = 1.0) -> dict[str, float]:
@@ -37,7 +37,7 @@ def test_a_failed_candidate_is_never_chosen() -> None:
                                                "samples/pose_across_sd": 1.0}}}
     assert style_weight_scores(values)[5.0] == math.inf
     assert choose_style_weight(values) == 1.0
-    with pytest.raises(ValueError, match="every α candidate failed"):
+    with pytest.raises(ValueError, match="every candidate failed"):
         choose_style_weight({1.0: {"a": {}}, 2.0: {"a": metrics(0, 1)}})
 
 
@@ -53,3 +53,36 @@ def test_a_collapsing_spread_costs_as_much_as_the_style_it_buys() -> None:
     assert choose_style_weight(values) == 5.0
     values[200.0]["a"]["samples/pose_across_sd"] = 8.0  # no collapse: the stronger style wins
     assert choose_style_weight(values) == 200.0
+
+
+def test_sample_metrics_read_the_samples_style_distance_not_the_logged_one() -> None:
+    # candidates whose logged val/style measures different decodes: SAMPLE_METRICS ignores it
+    values = {"distance/both": {"a": {**metrics(9, 1, 4), "samples/style": 2.0}},
+              "distance/posterior": {"a": {**metrics(1, 1, 4), "samples/style": 4.0}}}
+    assert choose_style_weight(values) == "distance/posterior"  # by the logged val/style
+    scores = style_weight_scores(values, SAMPLE_METRICS)
+    assert scores == pytest.approx({"distance/both": 0.0, "distance/posterior": math.log(2)})
+    assert choose_style_weight(values, SAMPLE_METRICS) == "distance/both"
+    del values["distance/both"]["a"]["samples/style"]  # a missing figure of the rule: a failure
+    assert choose_style_weight(values, SAMPLE_METRICS) == "distance/posterior"
+
+
+def test_prior_sample_figures_against_a_direct_gram_distance(tiny_run) -> None:
+    """``samples/style`` of a style CVAE is the mean ‖FFᵀ/T − G_example‖_F of its seeded prior samples' features,
+    recomputed here with numpy from the checkpoint's own target Gram; a plain VAE has no style figure."""
+    import numpy as np
+
+    from stylemotion.models.loading import load_generative
+    from stylemotion.training.style_weight import prior_sample_figures, prior_sample_spread
+
+    cvae = next(p for p in sorted((tiny_run.folder / "cvae").rglob("best.ckpt")))
+    figures = prior_sample_figures(cvae, samples=32, seed=3)
+    model = load_generative(cvae)
+    features = model.sample(32, seed=3).features.numpy().astype(np.float64)
+    grams = features @ features.transpose(0, 2, 1) / features.shape[-1]
+    target = model.style_gram.numpy().astype(np.float64)
+    expected = np.linalg.norm(grams - target, axis=(1, 2)).mean()
+    assert figures["samples/style"] == pytest.approx(expected, rel=1e-3)
+    assert figures["samples/pose_across_sd"] == pytest.approx(prior_sample_spread(cvae, samples=32, seed=3))
+    vae = next(p for p in sorted((tiny_run.folder / "vae").rglob("best.ckpt")))
+    assert set(prior_sample_figures(vae, samples=8)) == {"samples/pose_across_sd"}
