@@ -34,7 +34,7 @@ import numpy as np
 
 from stylemotion.datasets import TakeSet, load_dataset
 from stylemotion.datasets.base import Take
-from stylemotion.search import ENGINES, FrameIndex, MotionDatabase, feature_names, feature_spec
+from stylemotion.search import APPROXIMATE_ENGINES, ENGINES, FrameIndex, MotionDatabase, feature_names, feature_spec
 from stylemotion.skeleton import CANONICAL_MIRROR
 
 PARTS = ("table21",)
@@ -46,8 +46,8 @@ def available_engines() -> list[str]:
 
     have = {"ckdtree": True, "pykdtree": importlib.util.find_spec("pykdtree") is not None,
             "faiss": importlib.util.find_spec("faiss") is not None}
-    have["faiss-hnsw"] = have["faiss"]
-    return [e for e in ENGINES if have[e]]
+    have["faiss-hnsw"] = have["faiss-ivf"] = have["faiss"]
+    return [e for e in ENGINES if have.get(e, False)]
 
 
 def load(args: argparse.Namespace) -> TakeSet:
@@ -164,14 +164,15 @@ def _table_row(takeset: TakeSet, args: argparse.Namespace, database: MotionDatab
            "queries": ("random frames of the test takes; database = train + val takes" if args.queries == "heldout"
                        else "random database frames + N(0, jitter) per joint; database = every take"),
            "jitter_m": args.jitter, "features": index.feature_set, "dim": index.dim, "engine": index.engine,
-           "exact": index.engine != "faiss-hnsw", "k": k, "build_s": round(built_s, 3), "workers": args.workers,
+           "exact": index.engine not in APPROXIMATE_ENGINES, "k": k, "build_s": round(built_s, 3),
+           "workers": args.workers,
            "batched_queries": len(queries), "single_queries": len(single_q),
            "ms_per_query_batched": round(batched_ms, 5),
            "ms_per_query_single": round(1000 * single_s / len(single_q), 5),
            "brute_queries": len(brute_q), "brute_ms_per_query": round(brute_ms, 5),
            "speedup_batched_vs_brute": round(brute_ms / max(batched_ms, 1e-12), 2),
            "krueger_ms_per_query": {"E15": {16: 1.11, 256: 4.53}}.get(index.feature_set, {}).get(k)}
-    if index.engine == "faiss-hnsw":
+    if index.engine in APPROXIMATE_ENGINES:
         row["recall"] = round(float(np.mean([len(set(a) & set(b)) / k for a, b in zip(i[:len(brute_q)], bi)])), 5)
     else:
         row["max_abs_distance_error_vs_brute"] = float(np.abs(d[:len(brute_q)] - bd).max())
@@ -204,7 +205,7 @@ def parse(argv: list[str] | None) -> argparse.Namespace:
     parser.add_argument("--root", default=None, help="Bandai folder or data.zip (default: $STYLEMOTION_DATA/...)")
     parser.add_argument("--parts", default=",".join(PARTS), help=f"comma-separated subset of {','.join(PARTS)}")
     parser.add_argument("--features", default=",".join(feature_names()), help="feature sets")
-    parser.add_argument("--engines", default=",".join(ENGINES))
+    parser.add_argument("--engines", default=",".join(e for e in ENGINES if e != "auto"))
     parser.add_argument("--ks", default="16,256", help="neighbours per query")
     parser.add_argument("--copies", default="1,2,3", help="database sizes as copies of the data")
     parser.add_argument("--jitter", type=float, default=0.01, help="σ of the copies' and queries' joint noise, m")
