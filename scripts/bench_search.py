@@ -4,17 +4,18 @@
     python scripts/bench_search.py --features E15 --copies 1,2,3
     python scripts/bench_search.py --smoke --out /tmp/smoke.jsonl            # tiny synthetic run (seconds)
 
-Only timing lives here; it must run alone on an idle machine, and its figures are not in benchmarks/search.md
-until they are re-measured so (the search's quality figures — LNG against DTW, retrieval, other captures,
-rank agreement — come from ``python scripts/benchmarks.py run search``). Table 2.1: ms per query for ``--ks``
-neighbours (16, 256), every feature set, exact engines (``ckdtree``, ``pykdtree``, ``faiss`` flat, when
-installed) single (one query per call) and batched (all queries in one call), the brute-force time of the same
-queries in the same run as the ratio's base, and ``faiss-hnsw`` (approximate) with its recall against the exact
-neighbours. Database sizes: ``--copies`` copies of the dataset: copy 0 is the data, copy 1 its mirror image
-(left and right swapped, x negated), copy c ≥ 2 copy ``c mod 2`` with every joint displaced by seeded Gaussian
+Only timing lives here; it must run alone on an idle machine, and its figures are not in benchmarks/search.md until
+they are re-measured so (the search's quality figures — LNG against DTW, retrieval, other captures, rank agreement —
+come from ``python scripts/benchmarks.py run search``). Table 2.1: ms per query for ``--ks`` neighbours (16, 256),
+every feature set, exact engines (``ckdtree``, ``pykdtree``, ``faiss`` flat, when installed) single (one query per
+call) and batched (all queries in one call), the brute-force time of the same queries in the same run as the ratio's
+base, and ``faiss-hnsw`` / ``faiss-ivf`` (approximate) with their recall against the exact neighbours. The suite
+``engines`` (``python scripts/benchmarks.py run engines``) measures the engines per feature set for
+``engine=auto``'s rule. Database sizes: ``--copies`` copies of the dataset: copy 0 is the data, copy 1 its mirror
+image (left and right swapped, x negated), copy c ≥ 2 copy ``c mod 2`` with every joint displaced by seeded Gaussian
 noise (σ ``--jitter`` m) — rotated copies would not do: the features are invariant under rotation, so they would
-duplicate frames. Query frames (``--queries``): ``heldout`` (default) random frames of the test takes, the
-database built from the train and val takes; ``jitter`` random database frames of copy 0 with the same jitter.
+duplicate frames. Query frames (``--queries``): ``heldout`` (default) random frames of the test takes, the database
+built from the train and val takes; ``jitter`` random database frames of copy 0 with the same jitter.
 
 Everything runs on this process' threads (``--workers`` for cKDTree and faiss); the machine's load is recorded.
 """
