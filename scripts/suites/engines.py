@@ -473,8 +473,9 @@ def _table(r: dict[str, Any]) -> str:
             f"\n\n{r['k']}-NN of {r['clips']} clips × {r['clip_frames']} consecutive frames of the held-out test takes "
             f"against the {r['frames']:,} frames of the train + val takes ({r['takes']:,} takes); batched: one call "
             f"per clip (ms per frame), single: one call per frame ({r['single_per_clip']} frames per clip). Engines "
-            "timed back to back (rotated order); memory: resident set added by the build. Approximate engines at "
-            "their default breadth. Compare timings as ratios.")
+            "timed back to back (rotated order); memory: resident set added by the build; builds at the default "
+            "thread count (faiss' are parallel, the kd-trees' are not). Approximate engines at their default "
+            "breadth. Compare timings as ratios.")
 
 
 def _choice(r: dict[str, Any]) -> str:

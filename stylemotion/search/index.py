@@ -344,7 +344,7 @@ class FrameIndex:
         spec = feature_spec(feature_set)
         if engine not in ENGINES:
             raise ValueError(f"unknown search engine {engine!r}; valid: {list(ENGINES)}")
-        engine = auto_engine(spec.dim) if engine == "auto" else engine
+        requested, engine = engine, auto_engine(spec.dim) if engine == "auto" else engine
         path = _cache_path(Path(cache_dir) if cache_dir is not None else default_cache_dir(), database,
                            feature_set, normalization)
         cached = _read_or_discard(path, database.num_frames, spec.dim) if use_cache and path.exists() else None
@@ -363,6 +363,7 @@ class FrameIndex:
         if use_cache and engine in STORED_ENGINES and not _state_path(path, engine).exists():
             _write_state(_state_path(path, engine), index.engine_state())
         index.cache_path, index.from_cache = (path if use_cache else None), cached is not None
+        index.requested_engine = requested
         return index
 
     def set_breadth(self, breadth: int) -> None:

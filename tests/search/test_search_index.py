@@ -156,6 +156,15 @@ def test_auto_equals_brute_force_with_ties(database, dim):
         _check_exact(index, queries, k, index.engine)
 
 
+@pytest.mark.parametrize("feature_set", ["E15", "E15x5"])
+def test_build_resolves_auto_per_feature_set(takeset, feature_set, tmp_path):
+    index = FrameIndex.build(takeset, feature_set, cache_dir=tmp_path)
+    again = FrameIndex.build(takeset, feature_set, cache_dir=tmp_path)  # from the cache: the same engine
+    dim = {"E15": 15, "E15x5": 75}[feature_set]
+    assert again.from_cache and index.requested_engine == again.requested_engine == "auto"
+    assert index.engine == again.engine == auto_engine(dim) and index.dim == dim
+
+
 def test_auto_rule_and_fallback(monkeypatch):
     limits = [limit for limit, _ in AUTO_ENGINES]
     assert limits == sorted(limits) and limits[-1] == np.inf  # every dimension has an engine
