@@ -127,10 +127,19 @@ def library_rule_engines(dims: Sequence[int]) -> list[str]:
     return [next(engine for limit, engine in AUTO_ENGINES if d <= limit) for d in dims]
 
 
-def rss_mb() -> float:
-    """This process' resident set, MB."""
+def rss_mb(trim: bool = False) -> float:
+    """This process' resident set, MB; ``trim``: first collect garbage and hand freed heap memory back to the OS
+    (glibc's ``malloc_trim``, where there is one), so that a later difference counts what was added since."""
     import psutil
 
+    if trim:
+        gc.collect()
+        try:
+            import ctypes
+
+            ctypes.CDLL("libc.so.6").malloc_trim(0)
+        except (OSError, AttributeError):  # not glibc: the difference may then miss reused memory
+            pass
     return psutil.Process().memory_info().rss / 2**20
 
 
@@ -214,15 +223,19 @@ def clip_features(index: Any, test_takes: Sequence[Any], clips: Sequence[tuple[i
 
 
 def _build(database: Any, feature_set: str, features: np.ndarray, fitted: Any, engine: str,
-           workers: int) -> tuple[Any, float, float]:
-    """An index, its build seconds and the resident memory it added (MB)."""
+           workers: int) -> tuple[Any, float, dict[str, float | None]]:
+    """An index, its build seconds and its memory: ``rss_mb`` the resident set the build added (MB; temporaries it
+    freed but the allocator kept count too), ``index_mb`` a faiss index's serialized size (its vectors, lists and
+    links; None for the kd-trees)."""
     from stylemotion.search import FrameIndex
 
-    gc.collect()
-    before, t0 = rss_mb(), time.perf_counter()
+    before = rss_mb(trim=True)
+    t0 = time.perf_counter()
     index = FrameIndex(database, feature_set, features, fitted, engine=engine, workers=workers)
     seconds = time.perf_counter() - t0
-    return index, seconds, rss_mb() - before
+    added = rss_mb() - before
+    state = index.engine_state()
+    return index, seconds, {"rss_mb": added, "index_mb": None if state is None else state.nbytes / 2**20}
 
 
 def time_queries(indexes: dict[str, Any], clips: Sequence[np.ndarray], k: int, single_per_clip: int,
@@ -273,8 +286,7 @@ def measure_set(database: Any, feature_set: str, test_takes: Sequence[Any], clip
         index, seconds, memory = _build(database, feature_set, features, fitted, engine, 1 if engine == "ckdtree"
                                         else -1)
         indexes[engine] = index
-        row["engines"][engine] = {"build_s": seconds, "memory_mb": memory,
-                                  **_exactness(index, flat_queries, args.k, ref_d)}
+        row["engines"][engine] = {"build_s": seconds, **memory, **_exactness(index, flat_queries, args.k, ref_d)}
     all_cores = dict(indexes)
     if "ckdtree" in indexes:  # cKDTree takes its thread count at construction; not timed or measured
         all_cores["ckdtree"] = FrameIndex(database, feature_set, features, fitted, engine="ckdtree", workers=-1)
@@ -366,7 +378,7 @@ def _scale_engine(database: Any, feature_set: str, features: np.ndarray, fitted:
     flat_queries = queries.reshape(-1, queries.shape[-1])
     if "d" not in ref and engine not in APPROXIMATE_ENGINES:
         ref["d"] = index.query(flat_queries, args.k)[0]
-    entry: dict[str, Any] = {"build_s": seconds, "memory_mb": memory}
+    entry: dict[str, Any] = {"build_s": seconds, **memory}
     if "d" in ref:
         entry.update(_exactness(index, flat_queries, args.k, ref["d"]))
     for threads in THREADS:
@@ -435,6 +447,10 @@ def _ms(stats: dict[str, Any] | None, digits: int = 3) -> str:
     return f"{fmt(stats['p50'], digits)} / {fmt(stats['p95'], digits)}"
 
 
+def _memory(v: dict[str, Any]) -> str:
+    return f"{fmt(v['rss_mb'], 0)} / {fmt(v['index_mb'], 0)}"
+
+
 def _mark(value: float | None, aim: float, below: bool = True) -> str:
     if value is None:
         return ""
@@ -462,18 +478,20 @@ def _table(r: dict[str, Any]) -> str:
             quality = (f"{v['max_distance_error']:.1e}" + ("" if v["recall"] >= 1.0 else " ✗ not exact")
                        if engine in times else f"{v['recall']:.4f}")
             rows.append([f"{row['features']} ({row['dim']})", engine + (" ← auto" if engine == row["auto"] else ""),
-                         fmt(v["build_s"], 2), fmt(v["memory_mb"], 0), _ms(v["1"]["batched"]),
+                         fmt(v["build_s"], 2), _memory(v), _ms(v["1"]["batched"]),
                          _ms(v["all"]["batched"]), _ms(v["1"]["single"]), _ms(v["all"]["single"]),
                          fmt(v["1"]["batched"]["p50"] / fastest, 2) if fastest else "—",
                          quality])
-    header = ["set (dims)", "engine", "build s", "memory MB", "batched ms/query p50 / p95, 1 thread",
-              f"batched, {r['cores']} cores", "single ms p50 / p95, 1 thread", f"single, {r['cores']} cores",
+    header = ["set (dims)", "engine", "build s", "memory MB: RSS added / faiss index",
+              "batched ms/query p50 / p95, 1 thread", f"batched, {r['cores']} cores", "single ms p50 / p95, 1 thread",
+              f"single, {r['cores']} cores",
               "batched 1 thread × fastest exact", "exact: max distance error / approx.: recall@16"]
     return (_quick_note(r) + md_table(header, rows) +
             f"\n\n{r['k']}-NN of {r['clips']} clips × {r['clip_frames']} consecutive frames of the held-out test takes "
             f"against the {r['frames']:,} frames of the train + val takes ({r['takes']:,} takes); batched: one call "
             f"per clip (ms per frame), single: one call per frame ({r['single_per_clip']} frames per clip). Engines "
-            "timed back to back (rotated order); memory: resident set added by the build; builds at the default "
+            "timed back to back (rotated order); memory: resident set the build added (freed memory handed back to the "
+            "OS first) and a faiss index's serialized size; builds at the default "
             "thread count (faiss' are parallel, the kd-trees' are not). Approximate engines at their default "
             "breadth. Compare timings as ratios.")
 
@@ -527,10 +545,10 @@ def _scale(r: dict[str, Any]) -> str:
     rows = []
     for row in s["sets"]:
         for engine, v in row["engines"].items():
-            rows.append([f"{row['features']} ({row['dim']})", engine, fmt(v["build_s"], 1), fmt(v["memory_mb"], 0),
+            rows.append([f"{row['features']} ({row['dim']})", engine, fmt(v["build_s"], 1), _memory(v),
                          _ms(v["1"]["batched"]), _ms(v["all"]["batched"]), _ms(v["1"]["single"]),
                          f"{v['recall']:.4f}" if "recall" in v else "—"])
-    return (_quick_note(r) + md_table(["set (dims)", "engine", "build s", "memory MB",
+    return (_quick_note(r) + md_table(["set (dims)", "engine", "build s", "memory MB: RSS added / faiss index",
                                        "batched ms/query p50 / p95, 1 thread", f"batched, {r['cores']} cores",
                                        "single ms p50 / p95, 1 thread", f"recall@{r['k']}"], rows) +
             f"\n\n{s['frames']:,} frames: {s['copies']} copies of the train + val takes (copy 1 mirrored, copies ≥ 2 "

@@ -84,6 +84,10 @@ def test_a_quick_run_on_synthetic_data_and_its_render(suite):
         for engine, v in row["engines"].items():
             assert v["1"]["batched"]["n"] == r["clips"] and v["1"]["single"]["n"] == r["clips"] * r["single_per_clip"]
             assert v["build_s"] >= 0 and v["1"]["batched"]["p50"] > 0
+            if engine.startswith("faiss"):  # a faiss index holds every vector as float32 (HNSW and IVF add more)
+                assert v["index_mb"] * 2**20 >= r["frames"] * row["dim"] * 4
+            else:
+                assert v["index_mb"] is None
             if engine in EXACT_ENGINES:  # exact: every frame within the exact 16th distance, the same distances
                 assert v["recall"] == 1.0 and v["max_distance_error"] < 1e-4, (row["features"], engine, v)
         ivf = row["breadths"]["faiss-ivf"]  # more cells scanned: a superset of candidates, never less recall
