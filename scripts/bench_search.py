@@ -4,17 +4,18 @@
     python scripts/bench_search.py --features E15 --copies 1,2,3
     python scripts/bench_search.py --smoke --out /tmp/smoke.jsonl            # tiny synthetic run (seconds)
 
-Only timing lives here; it must run alone on an idle machine, and its figures are not in benchmarks/search.md
-until they are re-measured so (the search's quality figures — LNG against DTW, retrieval, other captures,
-rank agreement — come from ``python scripts/benchmarks.py run search``). Table 2.1: ms per query for ``--ks``
-neighbours (16, 256), every feature set, exact engines (``ckdtree``, ``pykdtree``, ``faiss`` flat, when
-installed) single (one query per call) and batched (all queries in one call), the brute-force time of the same
-queries in the same run as the ratio's base, and ``faiss-hnsw`` (approximate) with its recall against the exact
-neighbours. Database sizes: ``--copies`` copies of the dataset: copy 0 is the data, copy 1 its mirror image
-(left and right swapped, x negated), copy c ≥ 2 copy ``c mod 2`` with every joint displaced by seeded Gaussian
+Only timing lives here; it must run alone on an idle machine, and its figures are not in benchmarks/search.md until
+they are re-measured so (the search's quality figures — LNG against DTW, retrieval, other captures, rank agreement —
+come from ``python scripts/benchmarks.py run search``). Table 2.1: ms per query for ``--ks`` neighbours (16, 256),
+every feature set, exact engines (``ckdtree``, ``pykdtree``, ``faiss`` flat, when installed) single (one query per
+call) and batched (all queries in one call), the brute-force time of the same queries in the same run as the ratio's
+base, and ``faiss-hnsw`` / ``faiss-ivf`` (approximate) with their recall against the exact neighbours. The suite
+``engines`` (``python scripts/benchmarks.py run engines``) measures the engines per feature set for
+``engine=auto``'s rule. Database sizes: ``--copies`` copies of the dataset: copy 0 is the data, copy 1 its mirror
+image (left and right swapped, x negated), copy c ≥ 2 copy ``c mod 2`` with every joint displaced by seeded Gaussian
 noise (σ ``--jitter`` m) — rotated copies would not do: the features are invariant under rotation, so they would
-duplicate frames. Query frames (``--queries``): ``heldout`` (default) random frames of the test takes, the
-database built from the train and val takes; ``jitter`` random database frames of copy 0 with the same jitter.
+duplicate frames. Query frames (``--queries``): ``heldout`` (default) random frames of the test takes, the database
+built from the train and val takes; ``jitter`` random database frames of copy 0 with the same jitter.
 
 Everything runs on this process' threads (``--workers`` for cKDTree and faiss); the machine's load is recorded.
 """
@@ -34,7 +35,7 @@ import numpy as np
 
 from stylemotion.datasets import TakeSet, load_dataset
 from stylemotion.datasets.base import Take
-from stylemotion.search import ENGINES, FrameIndex, MotionDatabase, feature_names, feature_spec
+from stylemotion.search import APPROXIMATE_ENGINES, ENGINES, FrameIndex, MotionDatabase, feature_names, feature_spec
 from stylemotion.skeleton import CANONICAL_MIRROR
 
 PARTS = ("table21",)
@@ -46,8 +47,8 @@ def available_engines() -> list[str]:
 
     have = {"ckdtree": True, "pykdtree": importlib.util.find_spec("pykdtree") is not None,
             "faiss": importlib.util.find_spec("faiss") is not None}
-    have["faiss-hnsw"] = have["faiss"]
-    return [e for e in ENGINES if have[e]]
+    have["faiss-hnsw"] = have["faiss-ivf"] = have["faiss"]
+    return [e for e in ENGINES if have.get(e, False)]
 
 
 def load(args: argparse.Namespace) -> TakeSet:
@@ -164,14 +165,15 @@ def _table_row(takeset: TakeSet, args: argparse.Namespace, database: MotionDatab
            "queries": ("random frames of the test takes; database = train + val takes" if args.queries == "heldout"
                        else "random database frames + N(0, jitter) per joint; database = every take"),
            "jitter_m": args.jitter, "features": index.feature_set, "dim": index.dim, "engine": index.engine,
-           "exact": index.engine != "faiss-hnsw", "k": k, "build_s": round(built_s, 3), "workers": args.workers,
+           "exact": index.engine not in APPROXIMATE_ENGINES, "k": k, "build_s": round(built_s, 3),
+           "workers": args.workers,
            "batched_queries": len(queries), "single_queries": len(single_q),
            "ms_per_query_batched": round(batched_ms, 5),
            "ms_per_query_single": round(1000 * single_s / len(single_q), 5),
            "brute_queries": len(brute_q), "brute_ms_per_query": round(brute_ms, 5),
            "speedup_batched_vs_brute": round(brute_ms / max(batched_ms, 1e-12), 2),
            "krueger_ms_per_query": {"E15": {16: 1.11, 256: 4.53}}.get(index.feature_set, {}).get(k)}
-    if index.engine == "faiss-hnsw":
+    if index.engine in APPROXIMATE_ENGINES:
         row["recall"] = round(float(np.mean([len(set(a) & set(b)) / k for a, b in zip(i[:len(brute_q)], bi)])), 5)
     else:
         row["max_abs_distance_error_vs_brute"] = float(np.abs(d[:len(brute_q)] - bd).max())
@@ -204,7 +206,7 @@ def parse(argv: list[str] | None) -> argparse.Namespace:
     parser.add_argument("--root", default=None, help="Bandai folder or data.zip (default: $STYLEMOTION_DATA/...)")
     parser.add_argument("--parts", default=",".join(PARTS), help=f"comma-separated subset of {','.join(PARTS)}")
     parser.add_argument("--features", default=",".join(feature_names()), help="feature sets")
-    parser.add_argument("--engines", default=",".join(ENGINES))
+    parser.add_argument("--engines", default=",".join(e for e in ENGINES if e != "auto"))
     parser.add_argument("--ks", default="16,256", help="neighbours per query")
     parser.add_argument("--copies", default="1,2,3", help="database sizes as copies of the data")
     parser.add_argument("--jitter", type=float, default=0.01, help="σ of the copies' and queries' joint noise, m")

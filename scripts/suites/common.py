@@ -111,6 +111,18 @@ def provenance_line(record: Mapping[str, Any]) -> str:
             f"{', '.join(map(str, record.get('seeds', [])))}, {record.get('seconds', '?')} s).")
 
 
+def bandai_split_settings() -> dict[str, Any]:
+    """``seed``, ``val_fraction`` and ``test_fraction`` of Bandai's take split (``configs/data/bandai.yaml``), as
+    :meth:`~stylemotion.datasets.base.TakeSet.split` takes them."""
+    from omegaconf import OmegaConf
+
+    import stylemotion
+
+    cfg = OmegaConf.load(Path(stylemotion.__file__).parent / "configs" / "data" / "bandai.yaml")
+    return {"seed": int(cfg.split.seed), "val_fraction": float(cfg.split.val_fraction),
+            "test_fraction": float(cfg.split.test_fraction)}
+
+
 def take_split_record(split: Mapping[str, Sequence[Any]], seed: int, val_fraction: float, test_fraction: float,
                       group_by: Sequence[str] = ("content", "style")) -> dict[str, Any]:
     """What a suite records about a :meth:`~stylemotion.datasets.base.TakeSet.split`: the seed, fractions and

@@ -19,12 +19,12 @@ from __future__ import annotations
 import argparse
 import time
 from collections import Counter, defaultdict
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 from suites.common import (
     DATA_ROOT,
+    bandai_split_settings,
     fmt,
     fmt_spread,
     md_table,
@@ -68,16 +68,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--rank-features", nargs="+", default=None, help="feature sets (default: all)")
     parser.add_argument("--turn-features", nargs="+", default=["E15", "EP17", "EP19"],
                         help="feature sets compared on left/right turn queries (Krüger §2.6.2)")
-
-
-def _split_settings() -> dict[str, Any]:
-    from omegaconf import OmegaConf
-
-    import stylemotion
-
-    cfg = OmegaConf.load(Path(stylemotion.__file__).parent / "configs" / "data" / "bandai.yaml")
-    return {"seed": int(cfg.split.seed), "val_fraction": float(cfg.split.val_fraction),
-            "test_fraction": float(cfg.split.test_fraction)}
 
 
 def _choose_k(val: dict[int, list[float]], ks: list[int]) -> tuple[int, str]:
@@ -219,7 +209,7 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
 
     ks = sorted(set(args.ks))
     bandai = load_dataset("bandai", root=str(DATA_ROOT / "bandai-namco-motion-2" / "data.zip"), workers=2)
-    settings = _split_settings()
+    settings = bandai_split_settings()
     split = bandai.split(seed=settings["seed"], val_fraction=settings["val_fraction"],
                          test_fraction=settings["test_fraction"])
     databases = {"val": TakeSet("bandai-train", split["train"], bandai.fps),

@@ -37,7 +37,16 @@ if TYPE_CHECKING:
         physics_terms,
         root_frames,
     )
-    from stylemotion.search.index import ENGINES, EXACT_ENGINES, SEARCH_FORMAT, FrameIndex, database_features
+    from stylemotion.search.index import (
+        APPROXIMATE_ENGINES,
+        AUTO_ENGINES,
+        ENGINES,
+        EXACT_ENGINES,
+        SEARCH_FORMAT,
+        FrameIndex,
+        auto_engine,
+        database_features,
+    )
     from stylemotion.search.matching import (
         DEFAULT_K,
         MATCH_KEYS,
@@ -51,10 +60,11 @@ if TYPE_CHECKING:
 
 
 __all__ = [
-    "E15_JOINTS", "E30_JOINTS", "E39_JOINTS", "ENGINES", "EXACT_ENGINES", "FEATURE_SETS", "NORMALIZATIONS",
+    "APPROXIMATE_ENGINES", "AUTO_ENGINES", "E15_JOINTS", "E30_JOINTS", "E39_JOINTS", "ENGINES", "EXACT_ENGINES",
+    "FEATURE_SETS", "NORMALIZATIONS",
     "SEARCH_FORMAT", "SEGMENTS", "WINDOW_SECONDS", "FeatureSpec", "FittedPCA", "FrameIndex", "FrameLocation",
     "MotionDatabase", "body_frame_positions", "centre_of_mass", "compute_features", "database_features",
-    "feature_names", "feature_spec", "fit_features", "physics_terms", "root_frames",
+    "auto_engine", "feature_names", "feature_spec", "fit_features", "physics_terms", "root_frames",
     "DEFAULT_K", "MATCH_KEYS", "SearchResult", "SegmentMatch", "nearest_outside", "search_features", "search_motion",
     "LogicalResult", "logical_search", "numerical_search",
     "FatGraphClusters", "base_poses", "greedy_bases", "write_clusters",
@@ -84,9 +94,12 @@ __getattr__, __dir__ = lazy_exports(__name__, {
     "fit_features": "features",
     "physics_terms": "features",
     "root_frames": "features",
+    "APPROXIMATE_ENGINES": "index",
+    "AUTO_ENGINES": "index",
     "ENGINES": "index",
     "EXACT_ENGINES": "index",
     "FrameIndex": "index",
+    "auto_engine": "index",
     "SEARCH_FORMAT": "index",
     "database_features": "index",
     "DEFAULT_K": "matching",

@@ -3,11 +3,20 @@
 :class:`FrameIndex` holds one feature set's features of every frame of a :class:`MotionDatabase` and an
 engine that answers k-NN queries on them (Euclidean distance in feature space):
 
-* ``"ckdtree"`` (default, exact): :class:`scipy.spatial.cKDTree`;
+* ``"auto"`` (default, exact): the exact engine :func:`auto_engine` picks for the features' dimension from
+  :data:`AUTO_ENGINES` (a kd-tree for few dimensions, faiss' brute force for many; scipy's cKDTree when faiss
+  is not installed), a rule read off the table ``python scripts/benchmarks.py run engines`` measures;
+* ``"ckdtree"`` (exact): :class:`scipy.spatial.cKDTree`;
 * ``"pykdtree"`` (exact): the ``pykdtree`` package, float32, OpenMP-parallel over queries;
 * ``"faiss"`` (exact): ``faiss.IndexFlatL2`` brute force (optional extra ``search``);
-* ``"faiss-hnsw"`` (approximate, no ε guarantee): ``faiss.IndexHNSWFlat`` — the index type meant for
-  databases past one machine's exact-search budget (tens of millions of frames).
+* ``"faiss-hnsw"`` (approximate, no ε guarantee): ``faiss.IndexHNSWFlat`` graph (:data:`HNSW_M` links per node,
+  ``efSearch`` = :data:`HNSW_EF_SEARCH`);
+* ``"faiss-ivf"`` (approximate, no ε guarantee): ``faiss.IndexIVFFlat``, :func:`ivf_lists` k-means cells of which
+  :data:`IVF_NPROBE` nearest are scanned — the index type whose cells shard across machines (docs/search.md,
+  "Engines and scale").
+
+The approximate engines' search breadth (HNSW's ``efSearch``, IVF's ``nprobe``) trades recall for time:
+:meth:`FrameIndex.set_breadth`.
 
 Queries: exact k nearest, the up-to-k nearest within a fixed radius (missing ones padded with distance
 ``inf`` and index ``-1``), and approximate ε search as in cKDTree (the i-th result is within ``1 + ε``
@@ -17,16 +26,18 @@ Persisting: :meth:`FrameIndex.build` keeps the features and a fitted PCA in
 ``<dataset cache>/search/`` as an ``.npz`` of plain arrays (read with ``allow_pickle=False``), keyed on
 the database's content digest (:attr:`MotionDatabase.digest` — so it is invalidated with the dataset:
 any changed frame, take or label gives a new key), the feature set, the normalization and
-:data:`SEARCH_FORMAT`. kd-trees are rebuilt on load (a cKDTree over 400k frames takes ~0.2 s; pickled
-trees would be arbitrary objects); an HNSW graph (~1 min for 400k frames) is stored beside the features
+:data:`SEARCH_FORMAT`. kd-trees, flat and IVF indexes are rebuilt on load (a cKDTree over 400k frames takes
+~0.2 s; pickled trees would be arbitrary objects); an HNSW graph (~1 min for 400k frames) is stored beside the features
 as faiss' own serialized bytes with a CRC.
 """
 
 from __future__ import annotations
 
 import hashlib
+import importlib.util
 import io
 import json
+import math
 import os
 import warnings
 import zlib
@@ -51,13 +62,30 @@ from stylemotion.search.features import (
 
 #: Bump when the features or the cache layout change, to invalidate cached indexes.
 SEARCH_FORMAT = 2  # 2: physics terms scaled by a 0.3 s interval and a 73 kg body
-#: Engines by name; exact ones first.
-ENGINES = ("ckdtree", "pykdtree", "faiss", "faiss-hnsw")
+#: Engines by name: ``auto``, the exact ones, the approximate ones.
+ENGINES = ("auto", "ckdtree", "pykdtree", "faiss", "faiss-hnsw", "faiss-ivf")
 EXACT_ENGINES = ("ckdtree", "pykdtree", "faiss")
+APPROXIMATE_ENGINES = ("faiss-hnsw", "faiss-ivf")
 #: Engines whose built index is slow enough to build that :meth:`FrameIndex.build` caches it too.
 STORED_ENGINES = ("faiss-hnsw",)
 #: Links per node of the HNSW graph (faiss' ``M``).
 HNSW_M = 32
+#: Default breadth of an HNSW search (faiss' ``efSearch``; raised to k when k is larger).
+HNSW_EF_SEARCH = 64
+#: Default cells an IVF search scans (faiss' ``nprobe``).
+IVF_NPROBE = 32
+#: Training points per IVF cell (k-means on a seeded sample of the database; faiss wants ≥ 39).
+IVF_TRAIN_PER_LIST = 40
+#: ``engine="auto"``: ``(largest feature dimension, exact engine)`` rows in ascending order; features of dimension
+#: ``d`` use the engine of the first row whose dimension is ≥ ``d``. Chosen (provisionally, until the suite
+#: ``engines`` has run alone on all of Bandai and its block ``engines/choice`` in benchmarks/engines.md
+#: confirms or replaces it) on Table 2.1 of ``git show 1c0f1b8:benchmarks/search.md``: 16-NN of 2,000 held-out
+#: Bandai frames against 346,527, one thread, batched — cKDTree 0.04–0.61 ms for every set of ≤ 45 dimensions,
+#: where faiss' brute force took 0.87–2.18 ms; faiss 0.66–0.92 ms for the 75–117-dimensional windowed sets,
+#: where the kd-trees took 1.1–1.9 ms.
+AUTO_ENGINES: tuple[tuple[float, str], ...] = ((45, "ckdtree"), (math.inf, "faiss"))
+#: The exact engine ``auto`` falls back to when the one its rule names is not installed.
+AUTO_FALLBACK = "ckdtree"
 _INSTALL_HINT = {"pykdtree": "pip install pykdtree", "faiss": "pip install 'stylemotion[search]' (faiss-cpu)"}
 
 
@@ -100,38 +128,75 @@ def _import_faiss() -> Any:
     return faiss
 
 
-class _Faiss:
-    """Exact (``IndexFlatL2``) or approximate (``IndexHNSWFlat``, ``hnsw_m`` links per node) faiss index."""
+def ivf_lists(frames: int) -> int:
+    """Cells of an IVF index over ``frames`` vectors: ``round(4·√frames)``, at most ``frames //``
+    :data:`IVF_TRAIN_PER_LIST` (so every cell has its training points), at least 1."""
+    return max(1, min(int(round(4.0 * math.sqrt(frames))), frames // IVF_TRAIN_PER_LIST))
 
-    def __init__(self, data: np.ndarray, workers: int, approximate: bool = False, state: np.ndarray | None = None,
-                 hnsw_m: int = HNSW_M, ef_construction: int = 80, ef_search: int = 64):
+
+class _Faiss:
+    """A faiss index over ``data`` ``(n, d)``: ``kind`` ``"flat"`` (``IndexFlatL2``, exact), ``"hnsw"``
+    (``IndexHNSWFlat``, ``hnsw_m`` links per node) or ``"ivf"`` (``IndexIVFFlat`` over :func:`ivf_lists` cells,
+    k-means trained on a seeded sample of :data:`IVF_TRAIN_PER_LIST` points per cell)."""
+
+    def __init__(self, data: np.ndarray, workers: int, kind: str = "flat", state: np.ndarray | None = None,
+                 hnsw_m: int = HNSW_M, ef_construction: int = 80):
         faiss = _import_faiss()
         if workers > 0:
             faiss.omp_set_num_threads(workers)
-        d = data.shape[1]
+        n, d = data.shape
+        data = np.ascontiguousarray(data, dtype=np.float32)
         if state is not None:  # faiss' own binary format (faiss.serialize_index), not a pickle
             self.index = faiss.deserialize_index(np.ascontiguousarray(state, dtype=np.uint8))
-            if self.index.ntotal != data.shape[0] or self.index.d != d:
+            if self.index.ntotal != n or self.index.d != d:
                 raise ValueError(f"stored faiss index holds {self.index.ntotal}×{self.index.d}, expected {data.shape}")
+        elif kind == "hnsw":
+            self.index = faiss.IndexHNSWFlat(d, hnsw_m)
+            self.index.hnsw.efConstruction = ef_construction
+            self.index.add(data)
+        elif kind == "ivf":
+            lists = ivf_lists(n)
+            self.quantizer = faiss.IndexFlatL2(d)  # the IVF index keeps a pointer to it, not a reference
+            self.index = faiss.IndexIVFFlat(self.quantizer, d, lists)
+            self.index.cp.niter, self.index.cp.seed = 10, 0
+            sample = min(n, IVF_TRAIN_PER_LIST * lists)
+            rows = np.sort(np.random.default_rng(0).choice(n, size=sample, replace=False))
+            self.index.train(data[rows])
+            self.index.add(data)
         else:
-            self.index = faiss.IndexHNSWFlat(d, hnsw_m) if approximate else faiss.IndexFlatL2(d)
-            if approximate:
-                self.index.hnsw.efConstruction = ef_construction
-            self.index.add(np.ascontiguousarray(data, dtype=np.float32))
-        self.approximate = approximate
-        self.ef_search = ef_search
+            self.index = faiss.IndexFlatL2(d)
+            self.index.add(data)
+        self.kind = kind
+        self.breadth = {"hnsw": HNSW_EF_SEARCH, "ivf": IVF_NPROBE}.get(kind, 0)
 
     def state(self) -> np.ndarray:
         """The index as faiss' serialized bytes ``(bytes,)`` uint8."""
         return _import_faiss().serialize_index(self.index)
 
     def query(self, x: np.ndarray, k: int, eps: float, bound: float) -> tuple[np.ndarray, np.ndarray]:
-        if self.approximate:
-            self.index.hnsw.efSearch = max(self.ef_search, k)
+        if self.kind == "hnsw":
+            self.index.hnsw.efSearch = max(self.breadth, k)
+        elif self.kind == "ivf":
+            self.index.nprobe = min(self.breadth, self.index.nlist)
         sq, i = self.index.search(np.ascontiguousarray(x, dtype=np.float32), k)
         d = np.sqrt(np.maximum(sq.astype(np.float64), 0.0))
         d[i < 0] = np.inf
         return d, i.astype(np.int64)
+
+
+def faiss_available() -> bool:
+    """Whether faiss (the optional extra ``search``) is installed."""
+    return importlib.util.find_spec("faiss") is not None
+
+
+def auto_engine(dim: int) -> str:
+    """The exact engine ``engine="auto"`` uses for ``dim``-dimensional features: the first row of
+    :data:`AUTO_ENGINES` whose dimension is ≥ ``dim``; :data:`AUTO_FALLBACK` when that engine is not installed."""
+    if isinstance(dim, bool) or not isinstance(dim, (int, np.integer)) or dim < 1:
+        raise ValueError(f"a feature dimension must be a whole number ≥ 1, got {dim!r}")
+    engine = next(name for limit, name in AUTO_ENGINES if dim <= limit)
+    installed = {"faiss": faiss_available(), "pykdtree": importlib.util.find_spec("pykdtree") is not None}
+    return engine if installed.get(engine, True) else AUTO_FALLBACK
 
 
 def _make_engine(engine: str, data: np.ndarray, workers: int, state: np.ndarray | None = None) -> Any:
@@ -139,8 +204,9 @@ def _make_engine(engine: str, data: np.ndarray, workers: int, state: np.ndarray 
         return _CKDTree(data, workers)
     if engine == "pykdtree":
         return _PyKDTree(data, workers)
-    if engine in ("faiss", "faiss-hnsw"):
-        return _Faiss(data, workers, approximate=engine == "faiss-hnsw", state=state)
+    kinds = {"faiss": "flat", "faiss-hnsw": "hnsw", "faiss-ivf": "ivf"}
+    if engine in kinds:
+        return _Faiss(data, workers, kind=kinds[engine], state=state)
     raise ValueError(f"unknown search engine {engine!r}; valid: {list(ENGINES)}")
 
 
@@ -222,12 +288,14 @@ class FrameIndex:
     Attributes:
         database: the frames and their takes.  feature_set, normalization: how features are made.
         features: ``(frames, d)`` float32.  fitted: the database's PCA for ``pca*`` sets, else None.
-        engine: engine name (:data:`ENGINES`).  cache_path: where :meth:`build` keeps the features
-            (None if built directly).  from_cache: whether :meth:`build` read them from there.
+        engine: the engine that answers (:data:`ENGINES` but never ``"auto"``: what it resolved to).
+        requested_engine: the engine asked for (``"auto"`` by default).
+        cache_path: where :meth:`build` keeps the features (None if built directly).
+        from_cache: whether :meth:`build` read them from there.
     """
 
     def __init__(self, database: MotionDatabase, feature_set: str, features: np.ndarray | None = None,
-                 fitted: FittedPCA | None = None, *, normalization: str = "3d", engine: str = "ckdtree",
+                 fitted: FittedPCA | None = None, *, normalization: str = "3d", engine: str = "auto",
                  workers: int = 1, engine_state: np.ndarray | None = None):
         """Index ``features`` (computed, and a PCA fitted, when None). With ``features`` given, a
         ``feature_set`` that is none of :data:`FEATURE_SETS` names custom features of any width (``features_of``
@@ -235,7 +303,8 @@ class FrameIndex:
 
         ``workers``: threads (cKDTree's ``workers``, -1 = all cores; faiss' OpenMP threads, set process-wide;
         pykdtree follows ``OMP_NUM_THREADS``). ``engine_state``: a faiss index serialized by
-        :meth:`engine_state` for these features (skips the HNSW build).
+        :meth:`engine_state` for these features (skips the HNSW build). ``engine="auto"``: the exact engine
+        :func:`auto_engine` picks for the features' dimension.
         """
         if features is None or feature_set in FEATURE_SETS:
             dim = feature_spec(feature_set).dim
@@ -250,10 +319,12 @@ class FrameIndex:
             raise ValueError(f"features must be ({database.num_frames}, {dim}) for {feature_set}, "
                              f"got {features.shape}")
         self.database, self.feature_set, self.normalization = database, feature_set, normalization
-        self.features, self.fitted, self.engine = features, fitted, engine
+        self.requested_engine = engine
+        self.engine = auto_engine(dim) if engine == "auto" else engine
+        self.features, self.fitted = features, fitted
         self.cache_path: Path | None = None
         self.from_cache = False
-        self._engine = _make_engine(engine, features, workers, engine_state)
+        self._engine = _make_engine(self.engine, features, workers, engine_state)
 
     def engine_state(self) -> np.ndarray | None:
         """The built faiss index as plain bytes ``(bytes,)`` uint8 (None for the kd-tree engines, which are
@@ -262,7 +333,7 @@ class FrameIndex:
 
     @classmethod
     def build(cls, data: TakeSet | MotionDatabase | Mapping[str, Any], feature_set: str = "E15", *,
-              normalization: str = "3d", engine: str = "ckdtree", workers: int = 1,
+              normalization: str = "3d", engine: str = "auto", workers: int = 1,
               cache_dir: str | os.PathLike | None = None, use_cache: bool = True) -> FrameIndex:
         """Index a dataset (a TakeSet, a MotionDatabase, or a ``data`` config as everywhere), reading the
         features (and PCA) from the cache when they are there and writing them there otherwise.
@@ -271,6 +342,9 @@ class FrameIndex:
         """
         database = _as_database(data)
         spec = feature_spec(feature_set)
+        if engine not in ENGINES:
+            raise ValueError(f"unknown search engine {engine!r}; valid: {list(ENGINES)}")
+        requested, engine = engine, auto_engine(spec.dim) if engine == "auto" else engine
         path = _cache_path(Path(cache_dir) if cache_dir is not None else default_cache_dir(), database,
                            feature_set, normalization)
         cached = _read_or_discard(path, database.num_frames, spec.dim) if use_cache and path.exists() else None
@@ -289,7 +363,16 @@ class FrameIndex:
         if use_cache and engine in STORED_ENGINES and not _state_path(path, engine).exists():
             _write_state(_state_path(path, engine), index.engine_state())
         index.cache_path, index.from_cache = (path if use_cache else None), cached is not None
+        index.requested_engine = requested
         return index
+
+    def set_breadth(self, breadth: int) -> None:
+        """How widely an approximate engine searches from now on: HNSW's ``efSearch`` (raised to k when k is
+        larger; default :data:`HNSW_EF_SEARCH`) or IVF's ``nprobe`` (cells scanned, capped at the cells there are;
+        default :data:`IVF_NPROBE`). More breadth, more recall and more time. ValueError for an exact engine."""
+        if self.engine not in APPROXIMATE_ENGINES:
+            raise ValueError(f"engine {self.engine!r} is exact: it has no search breadth")
+        self._engine.breadth = _check_count(breadth, "breadth")
 
     @property
     def dim(self) -> int:

@@ -16,7 +16,16 @@ from stylemotion.datasets.loading import CacheWarning
 from stylemotion.datasets.registry import load_dataset
 from stylemotion.representation import facing_yaw
 from stylemotion.search import FrameIndex, MotionDatabase, compute_features
-from stylemotion.search.index import SEARCH_FORMAT, index_cache_key
+from stylemotion.search.index import (
+    AUTO_ENGINES,
+    AUTO_FALLBACK,
+    EXACT_ENGINES,
+    SEARCH_FORMAT,
+    auto_engine,
+    faiss_available,
+    index_cache_key,
+    ivf_lists,
+)
 
 ENGINES_HERE = ["ckdtree"] + [e for e, module in (("pykdtree", "pykdtree"), ("faiss", "faiss"))
                               if importlib.util.find_spec(module) is not None]
@@ -49,12 +58,14 @@ def _check_exact(index: FrameIndex, queries: np.ndarray, k: int, engine: str) ->
     # Every returned frame really lies at the returned distance (indices agree up to exact ties).
     own = np.linalg.norm(index.features[idx].astype(np.float64) - queries[:, None, :], axis=-1)
     np.testing.assert_allclose(own, dist, rtol=tol, atol=tol)
-    if engine == "ckdtree":  # the same frames, except where several lie at exactly the same distance
-        tied = np.zeros_like(true_d, dtype=bool)
-        tied[:, 1:] |= true_d[:, 1:] == true_d[:, :-1]
-        tied[:, :-1] |= true_d[:, :-1] == true_d[:, 1:]
-        tied[:, -1] |= true_d[:, -1] == after[:, 0]
-        np.testing.assert_array_equal(idx[~tied], true_i[~tied])
+    # The same frames, except where several lie at the same distance (within the engine's arithmetic).
+    band = tol * (1.0 + true_d)
+    tied = np.zeros_like(true_d, dtype=bool)
+    tied[:, 1:] |= true_d[:, 1:] - true_d[:, :-1] <= band[:, 1:]
+    tied[:, :-1] |= true_d[:, 1:] - true_d[:, :-1] <= band[:, :-1]
+    tied[:, -1] |= after[:, 0] - true_d[:, -1] <= band[:, -1]
+    np.testing.assert_array_equal(idx[~tied], true_i[~tied])
+    assert all(len(set(row)) == k for row in idx)  # no frame twice
 
 
 @pytest.mark.parametrize("engine", ENGINES_HERE)
@@ -127,6 +138,84 @@ def test_hnsw_finds_most_true_neighbours(takeset):
     _, got = approx.query(queries, 16)
     recall = np.mean([len(set(a) & set(b)) / 16 for a, b in zip(got, true_i)])
     assert recall > 0.9
+
+
+@pytest.mark.parametrize("dim", [8, 15, 45, 46, 75, 117])
+def test_auto_equals_brute_force_with_ties(database, dim):
+    """``engine="auto"`` answers exactly (numpy float64 brute force), on both sides of its dimension rule, with
+    exact ties in the data: duplicated database rows and queries on database rows."""
+    rng = np.random.default_rng(dim)
+    features = rng.normal(size=(database.num_frames, dim)).astype(np.float32)
+    features[1::7] = features[::7][:len(features[1::7])]  # every 7th row twice: ties at distance > 0 and 0
+    index = FrameIndex(database, "custom", features)
+    assert index.requested_engine == "auto"
+    rule = next(engine for limit, engine in AUTO_ENGINES if dim <= limit)
+    assert index.engine == (rule if importlib.util.find_spec("faiss") or rule != "faiss" else AUTO_FALLBACK)
+    queries = np.concatenate([rng.normal(size=(30, dim)), features[::97][:20] + 0.0]).astype(np.float32)
+    for k in (1, 16):
+        _check_exact(index, queries, k, index.engine)
+
+
+@pytest.mark.parametrize("feature_set", ["E15", "E15x5"])
+def test_build_resolves_auto_per_feature_set(takeset, feature_set, tmp_path):
+    index = FrameIndex.build(takeset, feature_set, cache_dir=tmp_path)
+    again = FrameIndex.build(takeset, feature_set, cache_dir=tmp_path)  # from the cache: the same engine
+    dim = {"E15": 15, "E15x5": 75}[feature_set]
+    assert again.from_cache and index.requested_engine == again.requested_engine == "auto"
+    assert index.engine == again.engine == auto_engine(dim) and index.dim == dim
+
+
+def test_auto_rule_and_fallback(monkeypatch):
+    limits = [limit for limit, _ in AUTO_ENGINES]
+    assert limits == sorted(limits) and limits[-1] == np.inf  # every dimension has an engine
+    assert all(engine in EXACT_ENGINES for _, engine in AUTO_ENGINES) and AUTO_FALLBACK in EXACT_ENGINES
+    if faiss_available():
+        for (limit, engine), (_, above) in zip(AUTO_ENGINES[:-1], AUTO_ENGINES[1:]):  # the rule's edges
+            assert (auto_engine(int(limit)), auto_engine(int(limit) + 1)) == (engine, above)
+    monkeypatch.setattr("stylemotion.search.index.faiss_available", lambda: False)
+    assert "faiss" not in {auto_engine(d) for d in (1, 8, 15, 45, 75, 117, 10_000)}
+    for bad in (0, -3, 2.5, True):
+        with pytest.raises(ValueError, match="feature dimension"):
+            auto_engine(bad)
+
+
+def test_ivf_cells():
+    assert [ivf_lists(n) for n in (1, 39, 40, 1_000, 384_931, 5_000_000)] == [1, 1, 1, 25, 2482, 8944]
+
+
+@pytest.mark.skipif(importlib.util.find_spec("faiss") is None, reason="faiss-cpu not installed (extra 'search')")
+def test_approximate_engines_breadth_and_recall(database):
+    """IVF scanning every cell is exact; HNSW and IVF recall grows with the breadth; exact engines have none."""
+    rng = np.random.default_rng(5)
+    centres = rng.normal(size=(40, 12))
+    features = (centres[rng.integers(0, 40, database.num_frames)]
+                + 0.3 * rng.normal(size=(database.num_frames, 12))).astype(np.float32)
+    queries = (features[rng.choice(len(features), 60, replace=False)] + 0.05 * rng.normal(size=(60, 12))
+               ).astype(np.float32)
+    true_d, _ = brute_force(features, queries, 16)
+
+    def recall(index: FrameIndex) -> float:  # returned frames within the true 16th distance (tie-proof)
+        _, idx = index.query(queries, 16)
+        own = np.linalg.norm(features[idx].astype(np.float64) - queries[:, None, :], axis=-1)
+        return float(np.mean(own <= true_d[:, -1:] * (1 + 1e-5)))
+
+    ivf = FrameIndex(database, "custom", features, engine="faiss-ivf")
+    assert ivf.engine == "faiss-ivf" and ivf._engine.index.nlist == ivf_lists(database.num_frames)
+    ivf.set_breadth(1)
+    narrow = recall(ivf)
+    ivf.set_breadth(10**6)  # capped at the cells there are: every cell scanned, exact
+    assert recall(ivf) == 1.0 > narrow
+    _check_exact(ivf, queries, 16, "faiss-ivf")
+    hnsw = FrameIndex(database, "custom", features, engine="faiss-hnsw")
+    hnsw.set_breadth(1)  # raised to k
+    assert recall(hnsw) > 0.5
+    hnsw.set_breadth(400)
+    assert recall(hnsw) >= 0.99
+    for engine in ENGINES_HERE:
+        with pytest.raises(ValueError, match="is exact: it has no search breadth"):
+            FrameIndex(database, "custom", features, engine=engine).set_breadth(4)
+    with pytest.raises(ValueError, match="breadth must be a whole number"):
+        hnsw.set_breadth(0)
 
 
 @pytest.mark.skipif(importlib.util.find_spec("faiss") is None, reason="faiss-cpu not installed (extra 'search')")
