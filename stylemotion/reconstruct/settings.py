@@ -136,6 +136,7 @@ class DynamicGraphSettings:
     blend_frames: int = 10
     duration_weight: float = 30.0
     facing_weight_m: float = 1.0
+    turn_radius_m: float = 0.0
     retime: bool = True
     clean: bool = True
 
