@@ -128,6 +128,27 @@ def keys_from_motion(positions: np.ndarray, fps: float, every_s: float, start_s:
     return [Keyframe((f - first) / fps, positions[f]) for f in frames]
 
 
+def turn_key(pose: np.ndarray, turn_rad: float, shift_m: np.ndarray | None = None) -> np.ndarray:
+    """A pose ``(21, 3)`` m turned by ``turn_rad`` (radians, a positive turn is to the left) about the vertical
+    through its Hips, then moved by ``shift_m`` ``(3,)`` metres (the ``turn_deg`` / ``shift_m`` of a keyframe
+    file; the turned keys of suite ``moved_keys``)."""
+    pose = np.asarray(pose, dtype=np.float64)
+    hips = pose[HIPS] * np.array([1.0, 0.0, 1.0])
+    moved = rotate_yaw(pose - hips, turn_rad) + hips
+    return moved if shift_m is None else moved + np.asarray(shift_m, dtype=np.float64)
+
+
+def move_key(first: np.ndarray, second: np.ndarray, scale: float, turn_rad: float) -> np.ndarray:
+    """The second of two key poses ``(21, 3)`` m moved as Krüger §4.3 moves a key ("Move second key frame"): its
+    Hips' ground offset from the first key's scaled by ``scale``, then pose and offset turned by ``turn_rad`` about
+    the vertical through the first key's Hips (so the key lies ``scale`` × as far, in another direction, facing
+    as much turned)."""
+    first, second = np.asarray(first, dtype=np.float64), np.asarray(second, dtype=np.float64)
+    origin = first[HIPS] * np.array([1.0, 0.0, 1.0])
+    offset = (second[HIPS] - first[HIPS]) * np.array([1.0, 0.0, 1.0])
+    return rotate_yaw(second - origin + (scale - 1.0) * offset, turn_rad) + origin
+
+
 def placements(positions: np.ndarray, fps: float) -> tuple[np.ndarray, np.ndarray]:
     """Ground points ``(..., 3)`` (y = 0) and yaws ``(...,)`` radians of poses ``(..., frames, 21, 3)``."""
     positions = np.asarray(positions, dtype=np.float64)
