@@ -126,8 +126,9 @@ def pair_outcome(graph: DynamicMotionGraph, first: Keyframe, second: Keyframe, q
     """One key pair joined by ``graph`` (no cleaning): ``joined``, and when joined the ``duration_error_s`` of the
     path (its frames − the keys' frames, / fps; before retiming), ``key_error_cm`` (mean per-joint distance of the
     path's first and last frames to their keys, averaged) and ``frames``; ``seconds`` either way. A pair whose
-    trees do not meet (:class:`NoConnectionError`) is ``joined: False``: a failure, counted, never dropped.
-    ``quality``: also ``skating`` (foot-skating ratio of the joined path, before cleaning:
+    trees do not meet (:class:`NoConnectionError`) is ``joined: False``: a failure, counted, never dropped; a
+    joined one also has ``met_at_iteration`` (the search's first iteration with a connection). ``quality``: also
+    ``skating`` (foot-skating ratio of the joined path, before cleaning:
     :func:`stylemotion.synthesis.quality.skating`) and ``end_gap_cm`` (the path's last Hips to the second key's,
     on the ground)."""
     started = time.perf_counter()
@@ -142,7 +143,8 @@ def pair_outcome(graph: DynamicMotionGraph, first: Keyframe, second: Keyframe, q
     key_error = 0.5 * (np.linalg.norm(path[0] - first.pose, axis=-1).mean()
                        + np.linalg.norm(path[-1] - second.pose, axis=-1).mean()) * 100.0
     record.update(joined=True, frames=int(len(path)), duration_error_s=round((len(path) - target) / graph.fps, 4),
-                  key_error_cm=round(float(key_error), 3), seconds=round(time.perf_counter() - started, 3))
+                  key_error_cm=round(float(key_error), 3), met_at_iteration=pair.figures["met_at_iteration"],
+                  seconds=round(time.perf_counter() - started, 3))
     if quality:
         from stylemotion.synthesis.quality import skating
 
