@@ -12,7 +12,7 @@ takes are the motion database, val takes choose, test takes report. From each ch
   0.5–1.5 × in 0.2 steps, 30° steps), :func:`~stylemotion.reconstruct.keyframes.move_key`.
 
 ``turn_radius_m`` and ``max_iterations`` are chosen on the val takes' turned cases among ``--radii`` × ``--iterations``
-(by default 0.5, 1, 1.5 m × 12, 24; radius 0 — D_node of eq. 4.12 with the facing term — and 12 iterations are the
+(by default 1, 1.5, 2.5 m × 12, 24; radius 0 — D_node of eq. 4.12 with the facing term — and 12 iterations are the
 search before this suite, measured on the test cases as "before"): fewest failures, then the lowest mean |duration
 error| of the joined pairs. Test cases are joined with (0, 12) (**before**) and with
 the seed's choice (**after**): joined / attempted (a pair whose
@@ -50,7 +50,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="moved key: distance from the first key, × the original")
     parser.add_argument("--move-angles", type=float, nargs="+", default=[0.0, 90.0, 180.0],
                         help="moved key: turn about the first key's vertical, degrees")
-    parser.add_argument("--radii", type=float, nargs="+", default=[0.5, 1.0, 1.5],
+    parser.add_argument("--radii", type=float, nargs="+", default=[1.0, 1.5, 2.5],
                         help="candidates of DynamicMotionGraph.turn_radius_m (0: off, the search before)")
     parser.add_argument("--iterations", type=int, nargs="+", default=[12, 24],
                         help="candidates of DynamicMotionGraph.max_iterations (12: the default before)")
