@@ -13,7 +13,11 @@ Between every two consecutive keys ``k_i → k_{i+1}`` (docs/reconstruct.md, "Dy
    edge, its last (O) / first (I) frame a new node. Each iteration expands the ``b`` best unexpanded nodes of
    each tree by ``D_node`` (eq. 4.12: the distance of hands, feet and head, summed, to the nearest node of the
    other tree, eq. 4.13, plus ``facing_weight_m`` × their facing difference — our addition), so the trees grow
-   towards each other; nothing is discarded.
+   towards each other; nothing is discarded. With ``turn_radius_m > 0`` (our addition) the world distance is
+   replaced by the body-frame pose difference plus 5 × the length of the shortest forward walk that turns no
+   tighter than ``turn_radius_m`` from the outgoing node's placement to the incoming one's
+   (:func:`~stylemotion.reconstruct.turning.dubins_length`): a key turned against the direction of travel is then
+   far from the trees that face it, and they grow along a loop rather than stalling face to face.
 3. **Connections.** The Hips of every incoming frame go into a spatial hash of ``voxel_m`` voxels; every
    outgoing frame looks in its 27 neighbouring voxels. A pair connects when the Hips are within ``voxel_m``,
    the facings within ``max_turn_deg``, the body-frame hands/feet/head within ``max_pose_m`` (mean) and the
@@ -246,9 +250,10 @@ class DynamicMotionGraph:
         iteration.  max_iterations: iterations before a pair fails.  voxel_m: spatial hash voxel (thesis 10 cm).
         min_segment_frames, max_segment_s: segment length bounds.  max_turn_deg, max_pose_m, max_velocity_m_s:
         connection tests.  blend_frames: frames blended at a connection.  duration_weight: price of a frame of
-        timing error in median frames of motion (0: the thesis' cost alone).  retime: resample each pair to its
-        keys' times.  clean: texture the intermediate result with the keys pinned.  index: an E15
-        :class:`FrameIndex` of ``database`` (built, cached, when None).  texturer: the cleaning
+        timing error in median frames of motion (0: the thesis' cost alone).  turn_radius_m: turning radius
+        (metres) of D_node's walk length (0: eq. 4.12 with the facing term; module docstring, step 2).
+        retime: resample each pair to its keys' times.  clean: texture the intermediate result with the keys
+        pinned.  index: an E15 :class:`FrameIndex` of ``database`` (built, cached, when None).  texturer: the cleaning
         :class:`MotionTexturer` (built in texture mode when None and ``clean``).
     """
 

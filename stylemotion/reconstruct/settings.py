@@ -120,7 +120,10 @@ class DynamicGraphSettings:
     connection: body-frame root velocities within this; ``blend_frames``: frames blended at a connection;
     ``duration_weight``: price of a frame of timing error, in median frames of motion (0: thesis), chosen on
     Bandai val key pairs (suite reconstruct, docs/reconstruct.md); ``facing_weight_m``: D_node's facing term,
-    metres per radian (0: thesis); ``retime``: resample each key pair to the keys' times; ``clean``: motion
+    metres per radian (0: thesis); ``turn_radius_m``: D_node measures the way from an outgoing node to an incoming
+    one as the shortest forward walk turning no tighter than this radius, metres (0: eq. 4.12, the thesis, with the
+    facing term); chosen with ``max_iterations`` on Bandai val takes' turned keys (suite moved_keys,
+    docs/reconstruct.md); ``retime``: resample each key pair to the keys' times; ``clean``: motion
     texturing of the result with the keys pinned (§4.3.4).
     """
 
