@@ -129,7 +129,7 @@ class DynamicGraphSettings:
 
     k: int = 16
     b: int = 4
-    max_iterations: int = 12
+    max_iterations: int = 24
     voxel_m: float = 0.1
     min_segment_frames: int = 4
     max_segment_s: float = 1.0
@@ -139,7 +139,7 @@ class DynamicGraphSettings:
     blend_frames: int = 10
     duration_weight: float = 30.0
     facing_weight_m: float = 1.0
-    turn_radius_m: float = 0.0
+    turn_radius_m: float = 1.0
     retime: bool = True
     clean: bool = True
 
