@@ -18,7 +18,7 @@ from typing import Any
 import numpy as np
 
 from stylemotion.datasets import Take, TakeSet, load_dataset, spread_over_styles
-from stylemotion.reconstruct.keyframes import DynamicMotionGraph, Keyframe, NoConnectionError
+from stylemotion.reconstruct.keyframes import HIPS, DynamicMotionGraph, Keyframe, NoConnectionError
 from stylemotion.reconstruct.markers import tracks_from_positions
 from stylemotion.search.database import MotionDatabase
 from stylemotion.skeleton import CANONICAL_JOINTS
@@ -121,11 +121,16 @@ def key_pairs(positions: np.ndarray, fps: float, spacing_s: float, start_s: floa
     return list(zip(keys[:-1], keys[1:]))
 
 
-def pair_outcome(graph: DynamicMotionGraph, first: Keyframe, second: Keyframe) -> dict[str, Any]:
+def pair_outcome(graph: DynamicMotionGraph, first: Keyframe, second: Keyframe, quality: bool = False
+                 ) -> dict[str, Any]:
     """One key pair joined by ``graph`` (no cleaning): ``joined``, and when joined the ``duration_error_s`` of the
     path (its frames − the keys' frames, / fps; before retiming), ``key_error_cm`` (mean per-joint distance of the
     path's first and last frames to their keys, averaged) and ``frames``; ``seconds`` either way. A pair whose
-    trees do not meet (:class:`NoConnectionError`) is ``joined: False``: a failure, counted, never dropped."""
+    trees do not meet (:class:`NoConnectionError`) is ``joined: False``: a failure, counted, never dropped; a
+    joined one also has ``met_at_iteration`` (the search's first iteration with a connection). ``quality``: also
+    ``skating`` (foot-skating ratio of the joined path, before cleaning:
+    :func:`stylemotion.synthesis.quality.skating`) and ``end_gap_cm`` (the path's last Hips to the second key's,
+    on the ground)."""
     started = time.perf_counter()
     record: dict[str, Any] = {"spacing_s": round(second.time_s - first.time_s, 6)}
     try:
@@ -138,7 +143,14 @@ def pair_outcome(graph: DynamicMotionGraph, first: Keyframe, second: Keyframe) -
     key_error = 0.5 * (np.linalg.norm(path[0] - first.pose, axis=-1).mean()
                        + np.linalg.norm(path[-1] - second.pose, axis=-1).mean()) * 100.0
     record.update(joined=True, frames=int(len(path)), duration_error_s=round((len(path) - target) / graph.fps, 4),
-                  key_error_cm=round(float(key_error), 3), seconds=round(time.perf_counter() - started, 3))
+                  key_error_cm=round(float(key_error), 3), met_at_iteration=pair.figures["met_at_iteration"],
+                  seconds=round(time.perf_counter() - started, 3))
+    if quality:
+        from stylemotion.synthesis.quality import skating
+
+        gap = (path[-1, HIPS] - np.asarray(second.pose)[HIPS])[[0, 2]]
+        record.update(skating=round(float(skating(path, graph.fps)[0]), 4),
+                      end_gap_cm=round(float(np.linalg.norm(gap)) * 100.0, 3))
     return record
 
 

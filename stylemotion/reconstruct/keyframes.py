@@ -13,7 +13,11 @@ Between every two consecutive keys ``k_i → k_{i+1}`` (docs/reconstruct.md, "Dy
    edge, its last (O) / first (I) frame a new node. Each iteration expands the ``b`` best unexpanded nodes of
    each tree by ``D_node`` (eq. 4.12: the distance of hands, feet and head, summed, to the nearest node of the
    other tree, eq. 4.13, plus ``facing_weight_m`` × their facing difference — our addition), so the trees grow
-   towards each other; nothing is discarded.
+   towards each other; nothing is discarded. With ``turn_radius_m > 0`` (our addition) the world distance is
+   replaced by the body-frame pose difference plus 5 × the length of the shortest forward walk that turns no
+   tighter than ``turn_radius_m`` from the outgoing node's placement to the incoming one's
+   (:func:`~stylemotion.reconstruct.turning.dubins_length`): a key turned against the direction of travel is then
+   far from the trees that face it, and they grow along a loop rather than stalling face to face.
 3. **Connections.** The Hips of every incoming frame go into a spatial hash of ``voxel_m`` voxels; every
    outgoing frame looks in its 27 neighbouring voxels. A pair connects when the Hips are within ``voxel_m``,
    the facings within ``max_turn_deg``, the body-frame hands/feet/head within ``max_pose_m`` (mean) and the
@@ -49,6 +53,7 @@ from stylemotion.io.errors import UserInputError
 from stylemotion.primitives.contacts import foot_contacts
 from stylemotion.reconstruct.settings import DynamicGraphSettings as _G
 from stylemotion.reconstruct.texture import MotionTexturer
+from stylemotion.reconstruct.turning import dubins_length
 from stylemotion.representation import facing_yaw
 from stylemotion.search.database import MotionDatabase
 from stylemotion.search.features import E15_JOINTS
@@ -127,6 +132,27 @@ def keys_from_motion(positions: np.ndarray, fps: float, every_s: float, start_s:
     return [Keyframe((f - first) / fps, positions[f]) for f in frames]
 
 
+def turn_key(pose: np.ndarray, turn_rad: float, shift_m: np.ndarray | None = None) -> np.ndarray:
+    """A pose ``(21, 3)`` m turned by ``turn_rad`` (radians, a positive turn is to the left) about the vertical
+    through its Hips, then moved by ``shift_m`` ``(3,)`` metres (the ``turn_deg`` / ``shift_m`` of a keyframe
+    file; the turned keys of suite ``moved_keys``)."""
+    pose = np.asarray(pose, dtype=np.float64)
+    hips = pose[HIPS] * np.array([1.0, 0.0, 1.0])
+    moved = rotate_yaw(pose - hips, turn_rad) + hips
+    return moved if shift_m is None else moved + np.asarray(shift_m, dtype=np.float64)
+
+
+def move_key(first: np.ndarray, second: np.ndarray, scale: float, turn_rad: float) -> np.ndarray:
+    """The second of two key poses ``(21, 3)`` m moved as Krüger §4.3 moves a key ("Move second key frame"): its
+    Hips' ground offset from the first key's scaled by ``scale``, then pose and offset turned by ``turn_rad`` about
+    the vertical through the first key's Hips (so the key lies ``scale`` × as far, in another direction, facing
+    as much turned)."""
+    first, second = np.asarray(first, dtype=np.float64), np.asarray(second, dtype=np.float64)
+    origin = first[HIPS] * np.array([1.0, 0.0, 1.0])
+    offset = (second[HIPS] - first[HIPS]) * np.array([1.0, 0.0, 1.0])
+    return rotate_yaw(second - origin + (scale - 1.0) * offset, turn_rad) + origin
+
+
 def placements(positions: np.ndarray, fps: float) -> tuple[np.ndarray, np.ndarray]:
     """Ground points ``(..., 3)`` (y = 0) and yaws ``(...,)`` radians of poses ``(..., frames, 21, 3)``."""
     positions = np.asarray(positions, dtype=np.float64)
@@ -161,6 +187,8 @@ class _Tree:
     edge_shift: list[np.ndarray] = field(default_factory=list)  # ground shift after the turn (3,)
     edge_parent: list[int] = field(default_factory=list)  # node it grew from
     edge_child: list[int] = field(default_factory=list)  # node it made
+    best: np.ndarray = field(default_factory=lambda: np.zeros(0))  # D_node of the nodes scored so far
+    seen_other: int = 0  # nodes of the other tree those D_node values have seen
 
     def add_node(self, frame: int, ground: np.ndarray, yaw: float, effectors: np.ndarray, edge: int, frames: int,
                  cost: float, anchor: float = 0.0) -> int:
@@ -222,9 +250,10 @@ class DynamicMotionGraph:
         iteration.  max_iterations: iterations before a pair fails.  voxel_m: spatial hash voxel (thesis 10 cm).
         min_segment_frames, max_segment_s: segment length bounds.  max_turn_deg, max_pose_m, max_velocity_m_s:
         connection tests.  blend_frames: frames blended at a connection.  duration_weight: price of a frame of
-        timing error in median frames of motion (0: the thesis' cost alone).  retime: resample each pair to its
-        keys' times.  clean: texture the intermediate result with the keys pinned.  index: an E15
-        :class:`FrameIndex` of ``database`` (built, cached, when None).  texturer: the cleaning
+        timing error in median frames of motion (0: the thesis' cost alone).  turn_radius_m: turning radius
+        (metres) of D_node's walk length (0: eq. 4.12 with the facing term; module docstring, step 2).
+        retime: resample each pair to its keys' times.  clean: texture the intermediate result with the keys
+        pinned.  index: an E15 :class:`FrameIndex` of ``database`` (built, cached, when None).  texturer: the cleaning
         :class:`MotionTexturer` (built in texture mode when None and ``clean``).
     """
 
@@ -233,7 +262,8 @@ class DynamicMotionGraph:
                  max_segment_s: float = _G.max_segment_s, max_turn_deg: float = _G.max_turn_deg,
                  max_pose_m: float = _G.max_pose_m, max_velocity_m_s: float = _G.max_velocity_m_s,
                  blend_frames: int = _G.blend_frames, duration_weight: float = _G.duration_weight,
-                 facing_weight_m: float = _G.facing_weight_m, key_weight: float = 10.0, extra_iterations: int = 1,
+                 facing_weight_m: float = _G.facing_weight_m, turn_radius_m: float = _G.turn_radius_m,
+                 key_weight: float = 10.0, extra_iterations: int = 1,
                  retime: bool = _G.retime, clean: bool = _G.clean,
                  index: FrameIndex | None = None, texturer: MotionTexturer | None = None):
         for key, value, low in (("k", k, 1), ("b", b, 1), ("max_iterations", max_iterations, 1),
@@ -248,7 +278,7 @@ class DynamicMotionGraph:
                 or extra_iterations < 0:
             raise KeyframeError(f"extra_iterations={extra_iterations} must be a whole number ≥ 0")
         for key, value in (("duration_weight", duration_weight), ("facing_weight_m", facing_weight_m),
-                           ("key_weight", key_weight)):
+                           ("key_weight", key_weight), ("turn_radius_m", turn_radius_m)):
             if not (isinstance(value, (int, float)) and np.isfinite(value) and value >= 0):
                 raise KeyframeError(f"{key}={value} must be a number ≥ 0")
         if database.num_frames < 2:
@@ -261,6 +291,7 @@ class DynamicMotionGraph:
         self.max_pose_m, self.max_velocity_m_s = float(max_pose_m), float(max_velocity_m_s)
         self.blend_frames, self.duration_weight = int(blend_frames), float(duration_weight)
         self.facing_weight_m, self.key_weight = float(facing_weight_m), float(key_weight)
+        self.turn_radius_m = float(turn_radius_m)
         self.extra_iterations = int(extra_iterations)
         self.retime, self.clean = bool(retime), bool(clean)
         self._prepare_database()
@@ -388,24 +419,52 @@ class DynamicMotionGraph:
         return rotate_yaw(np.asarray(self.database.positions[frames], np.float64), tree.edge_turn[edge]) \
             + tree.edge_shift[edge]
 
+    def _pair_distance(self, a: _Tree, rows: np.ndarray, b: _Tree, cols: np.ndarray) -> np.ndarray:
+        """D_node terms ``(len(rows), len(cols))`` between nodes ``rows`` of ``a`` and ``cols`` of ``b``.
+
+        ``turn_radius_m = 0``: eq. 4.13 (hands, feet and head, world, summed, metres) plus ``facing_weight_m`` ×
+        the facing difference (radians). ``turn_radius_m > 0``: the same joints in the body frame (the pose
+        alone) plus their number × the length of the shortest forward walk of that turning radius from the O
+        node's placement to the I node's (:func:`~stylemotion.reconstruct.turning.dubins_length`): a node turned
+        against the way to the other tree is far, so the trees grow along a loop rather than meeting face to face.
+        """
+        ea, eb = np.stack(a.node_effectors)[rows], np.stack(b.node_effectors)[cols]
+        ya, yb = np.asarray(a.node_yaw)[rows], np.asarray(b.node_yaw)[cols]
+        if self.turn_radius_m <= 0:
+            d = np.linalg.norm(ea[:, None] - eb[None], axis=-1).sum(axis=-1)
+            return d + self.facing_weight_m * np.abs(wrap_angle(ya[:, None] - yb[None]))
+        ga, gb = np.stack(a.node_ground)[rows], np.stack(b.node_ground)[cols]
+        la = rotate_yaw(ea - ga[:, None], -ya[:, None])
+        lb = rotate_yaw(eb - gb[:, None], -yb[:, None])
+        pose = np.linalg.norm(la[:, None] - lb[None], axis=-1).sum(axis=-1)
+        xa, xb = ga[:, [0, 2]], gb[:, [0, 2]]
+        if a.forward:
+            walk = dubins_length(xa[:, None], ya[:, None], xb[None], yb[None], self.turn_radius_m)
+        else:
+            walk = dubins_length(xb[None], yb[None], xa[:, None], ya[:, None], self.turn_radius_m)
+        return pose + len(EFFECTORS) * walk
+
     def _node_distance(self, a: _Tree, b: _Tree) -> np.ndarray:
-        """D_node (eq. 4.12) of every node of ``a``: the nearest node of ``b`` by eq. 4.13, plus
-        ``facing_weight_m`` × their facing difference in radians."""
-        ea, eb = np.stack(a.node_effectors), np.stack(b.node_effectors)
-        ya, yb = np.asarray(a.node_yaw), np.asarray(b.node_yaw)
-        best = np.full(len(ea), np.inf)
-        for start in range(0, len(eb), 256):
-            d = np.linalg.norm(ea[:, None] - eb[None, start:start + 256], axis=-1).sum(axis=-1)
-            d += self.facing_weight_m * np.abs(wrap_angle(ya[:, None] - yb[None, start:start + 256]))
-            best = np.minimum(best, d.min(axis=1))
+        """D_node (eq. 4.12) of every node of ``a``: the smallest :meth:`_pair_distance` to a node of ``b``;
+        updated incrementally (only pairs with a node added since the last call are computed)."""
+        n_a, n_b = len(a.node_frame), len(b.node_frame)
+        best = np.full(n_a, np.inf)
+        best[:len(a.best)] = a.best
+        for rows, cols in ((np.arange(len(a.best), n_a), np.arange(n_b)),
+                           (np.arange(len(a.best)), np.arange(a.seen_other, n_b))):
+            for start in range(0, len(cols), 256):
+                if len(rows):
+                    part = self._pair_distance(a, rows, b, cols[start:start + 256])
+                    best[rows] = np.minimum(best[rows], part.min(axis=1))
+        a.best, a.seen_other = best, n_b
         return best
 
     def _select(self, tree: _Tree, other: _Tree) -> list[int]:
+        distance = self._node_distance(tree, other)
         open_nodes = np.flatnonzero(~np.asarray(tree.expanded))
         if not open_nodes.size:
             return []
-        distance = self._node_distance(tree, other)[open_nodes]
-        return [int(v) for v in open_nodes[np.argsort(distance, kind="stable")[:self.b]]]
+        return [int(v) for v in open_nodes[np.argsort(distance[open_nodes], kind="stable")[:self.b]]]
 
     # -- connections ----------------------------------------------------------------------------------------
 
@@ -572,6 +631,7 @@ class DynamicMotionGraph:
                 "max_turn_deg": round(float(np.rad2deg(self.max_turn)), 3), "max_pose_m": self.max_pose_m,
                 "max_velocity_m_s": self.max_velocity_m_s, "blend_frames": self.blend_frames,
                 "duration_weight": self.duration_weight, "facing_weight_m": self.facing_weight_m,
+                "turn_radius_m": self.turn_radius_m,
                 "key_weight": self.key_weight, "extra_iterations": self.extra_iterations,
                 "retime": self.retime, "clean": self.clean,
                 "database": {"name": self.database.name, "takes": self.database.num_takes,

@@ -52,11 +52,12 @@ from stylemotion.reconstruct.keyframes import (
     check_keyframes,
     keys_from_motion,
     placements,
+    turn_key,
 )
 from stylemotion.reconstruct.markers import read_markers
 from stylemotion.reconstruct.output import write_motion_folder
 from stylemotion.reconstruct.settings import KeyframesSettings
-from stylemotion.skeleton import CANONICAL_JOINTS, JOINT_INDEX, NUM_JOINTS
+from stylemotion.skeleton import CANONICAL_JOINTS, NUM_JOINTS
 
 log = logging.getLogger(__name__)
 _D = KeyframesSettings
@@ -95,11 +96,8 @@ def _turned(pose: np.ndarray, entry: Mapping[str, Any], where: str) -> np.ndarra
     shift = np.asarray(entry.get("shift_m", [0.0, 0.0, 0.0]), dtype=np.float64)
     if shift.shape != (3,) or not np.isfinite(shift).all():
         raise KeyframeError(f"{where}: shift_m={entry.get('shift_m')!r} must be [x, y, z] metres")
-    from stylemotion.geometry import rotate_yaw
-
-    hips = pose[JOINT_INDEX["Hips"]] * np.array([1.0, 0.0, 1.0])
     with np.errstate(over="ignore", invalid="ignore"):
-        moved = rotate_yaw(pose - hips, turn) + hips + shift
+        moved = turn_key(pose, turn, shift)
     if not np.isfinite(moved).all() or np.abs(moved).max() > MAX_KEY_DISTANCE_M:
         raise KeyframeError(f"{where}: turn_deg={entry.get('turn_deg', 0.0)!r}, shift_m={entry.get('shift_m')!r} "
                             f"put the pose more than {MAX_KEY_DISTANCE_M:g} m from the origin; give a shift of "

@@ -120,13 +120,16 @@ class DynamicGraphSettings:
     connection: body-frame root velocities within this; ``blend_frames``: frames blended at a connection;
     ``duration_weight``: price of a frame of timing error, in median frames of motion (0: thesis), chosen on
     Bandai val key pairs (suite reconstruct, docs/reconstruct.md); ``facing_weight_m``: D_node's facing term,
-    metres per radian (0: thesis); ``retime``: resample each key pair to the keys' times; ``clean``: motion
+    metres per radian (0: thesis); ``turn_radius_m``: D_node measures the way from an outgoing node to an incoming
+    one as the shortest forward walk turning no tighter than this radius, metres (0: eq. 4.12, the thesis, with the
+    facing term); chosen with ``max_iterations`` on Bandai val takes' turned keys (suite moved_keys,
+    docs/reconstruct.md); ``retime``: resample each key pair to the keys' times; ``clean``: motion
     texturing of the result with the keys pinned (§4.3.4).
     """
 
     k: int = 16
     b: int = 4
-    max_iterations: int = 12
+    max_iterations: int = 24
     voxel_m: float = 0.1
     min_segment_frames: int = 4
     max_segment_s: float = 1.0
@@ -136,6 +139,7 @@ class DynamicGraphSettings:
     blend_frames: int = 10
     duration_weight: float = 30.0
     facing_weight_m: float = 1.0
+    turn_radius_m: float = 1.0
     retime: bool = True
     clean: bool = True
 

@@ -7,18 +7,23 @@ import numpy as np
 import pytest
 from reconstruct_fixtures import synthetic_split
 
+from stylemotion.datasets.base import TakeSet
 from stylemotion.datasets.registry import load_dataset
+from stylemotion.geometry import wrap_angle
 from stylemotion.reconstruct.keyframes import (
     DynamicMotionGraph,
     Keyframe,
     KeyframeError,
     NoConnectionError,
     keys_from_motion,
+    move_key,
     place,
     placements,
     resample,
+    turn_key,
 )
 from stylemotion.reconstruct.texture import MotionTexturer, TextureInputError
+from stylemotion.search.database import MotionDatabase
 from stylemotion.synthesis.quality import skating
 
 FPS = 30.0
@@ -116,3 +121,61 @@ def test_texturing_keeps_pinned_frames(split):
     assert not np.allclose(out[15], coarse[15], atol=1e-4)
     with pytest.raises(TextureInputError, match="pinned frame 60"):
         texturer.apply(coarse, pinned=[60])
+
+
+@pytest.fixture(scope="module")
+def short_turns():
+    """A database of 3 s synthetic walks and ±90° turning walks (turns as tight as Bandai's, ~60°/s at most), and
+    a held-out straight walk whose first two keys 1 s apart the tests turn and move."""
+    ts = load_dataset("synthetic", takes_per_pair=1, duration_s=3.0, contents=["walk", "walk-turn-left",
+                                                                               "walk-turn-right"])
+    held = [t for t in ts.takes if t.content == "walk"][0]
+    database = MotionDatabase.from_takeset(TakeSet("short-turns", [t for t in ts.takes if t is not held], ts.fps))
+    first, second = keys_from_motion(held.positions, FPS, 1.0, 0.2, 1.2)
+    return database, first, second
+
+
+def _end_at(path: np.ndarray, key: Keyframe) -> tuple[float, float]:
+    """Ground gap (cm) of the path's last Hips to the key's and their facing difference (degrees)."""
+    ground, yaw = placements(np.stack([path[-1], key.pose]), FPS)
+    return float(np.linalg.norm(ground[0] - ground[1]) * 100.0), float(np.rad2deg(abs(wrap_angle(yaw[0] - yaw[1]))))
+
+
+def test_turn_and_move_key_transforms(short_turns):
+    _, first, second = short_turns
+    ground, yaw = placements(np.stack([first.pose, second.pose, turn_key(second.pose, np.pi / 2)]), FPS)
+    np.testing.assert_allclose(ground[2], ground[1], atol=1e-12)  # turned about its own vertical
+    assert np.rad2deg(wrap_angle(yaw[2] - yaw[1])) == pytest.approx(90.0)
+    moved = move_key(first.pose, second.pose, 0.5, np.pi)
+    g, y = placements(np.stack([moved]), FPS)
+    # half as far, on the other side of the first key, facing back
+    np.testing.assert_allclose(g[0] - ground[0], -0.5 * (ground[1] - ground[0]), atol=1e-12)
+    assert abs(np.rad2deg(wrap_angle(y[0] - yaw[1]))) == pytest.approx(180.0)
+
+
+def test_key_turned_against_travel_joins_with_the_turning_search(short_turns):
+    database, first, second = short_turns
+    back = Keyframe(second.time_s, turn_key(second.pose, np.pi))
+    # the search before turn_radius_m (D_node of eq. 4.12 only): the trees stall face to face and never meet
+    before = DynamicMotionGraph(database, turn_radius_m=0.0, max_iterations=12, clean=False)
+    with pytest.raises(NoConnectionError, match="did not meet in 12 iterations"):
+        before.connect(first, back)
+    after = DynamicMotionGraph(database, turn_radius_m=1.0, max_iterations=24, clean=False)
+    pair = after.connect(first, back)
+    gap_cm, facing_deg = _end_at(pair.positions, back)
+    # the path ends on the key (its incoming segments are placed onto it) facing its way, after a detour
+    assert gap_cm < 1.0 and facing_deg < 15.0, (gap_cm, facing_deg)
+    assert _end_at(pair.positions[:1], first)[0] < 1.0
+    assert pair.figures["duration_s"] > 2.0  # a 180° turn at ≤ 60°/s cannot fit the keys' 1 s
+
+
+def test_moved_key_path_ends_where_the_key_was_moved(short_turns):
+    database, first, second = short_turns
+    graph = DynamicMotionGraph(database, turn_radius_m=1.0, max_iterations=24, clean=False)
+    for scale in (0.5, 1.5):
+        moved = Keyframe(second.time_s, move_key(first.pose, second.pose, scale, 0.0))
+        path = graph.connect(first, moved).positions
+        gap_cm, facing_deg = _end_at(path, moved)
+        assert gap_cm < 1.0 and facing_deg < 15.0, (scale, gap_cm, facing_deg)
+        # and not where the key was before it moved (0.5 × or 1.5 × the walk's ~1 m apart)
+        assert _end_at(path, second)[0] > 20.0
