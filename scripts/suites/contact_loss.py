@@ -28,7 +28,8 @@ the val (``val/mpjpe`` at the best epoch, logged by training) and test clips (po
 **Rule** (per model, on seed ``--seeds[0]``'s validation figures): among the candidates whose val reconstruction
 error is at most ``1 + --tolerance`` times that of weight 0 and whose recognition is at least weight 0's minus
 ``--recognition-drop`` (VAE: share recognized as neutral; autoencoders: the reconstruction error only), the one
-with the lowest val sample-skating ratio (autoencoders: reconstruction skating); ties: the smaller weight. No test
+with the lowest val sample-skating ratio (autoencoders: reconstruction skating); ties: the smaller weight; samples
+without any contact foot-frame are not eligible (their feet never plant), and when no candidate is, weight 0. No test
 clip is read before the choice; the test figures of the other candidates of seed ``--seeds[0]`` are shown but
 choose nothing.
 """
@@ -91,11 +92,12 @@ def train_job(container: dict[str, Any], folder: str) -> dict[str, Any]:
 
     path = Path(folder)
     t0 = time.perf_counter()
-    if not (path / "metrics.json").is_file():
+    reused = (path / "metrics.json").is_file()
+    if not reused:
         train_run(OmegaConf.create(container))
     metrics = read_json_object(path / "metrics.json", "a contact_loss training's metrics", f"delete {path}")
     return {"val": dict(metrics.get("val") or {}), "epochs": metrics.get("epoch"),
-            "seconds": round(time.perf_counter() - t0, 1)}
+            "seconds": round(time.perf_counter() - t0, 1), "reused": reused}
 
 
 def run_jobs(jobs: dict[Any, tuple[dict[str, Any], str]], workers: int) -> dict[Any, dict[str, Any]]:
@@ -242,9 +244,11 @@ def choose_weight(figures: dict[float, dict[str, Any]], tolerance: float, recogn
     eligible = []
     for w, f in sorted(figures.items()):
         ratio = f["val"]["samples"]["ratio"]
-        if not (f.get("val_mpjpe") is not None and math.isfinite(f["val_mpjpe"]) and ratio is not None
-                and math.isfinite(ratio)):
+        if f.get("val_mpjpe") is None or not math.isfinite(f["val_mpjpe"]):
             why[f"{w:g}"] = "failed"
+            continue
+        if ratio is None or not math.isfinite(ratio):
+            why[f"{w:g}"] = "no contact foot-frame in the samples"
             continue
         if f["val_mpjpe"] > (1 + tolerance) * base["val_mpjpe"]:
             why[f"{w:g}"] = f"val reconstruction error {f['val_mpjpe'] / base['val_mpjpe']:.2f}× weight 0's"
@@ -254,6 +258,8 @@ def choose_weight(figures: dict[float, dict[str, Any]], tolerance: float, recogn
             continue
         why[f"{w:g}"] = "eligible"
         eligible.append(w)
+    if not eligible:  # nothing qualifies: keep the default
+        return 0.0, why
     chosen = min(eligible, key=lambda w: (figures[w]["val"]["samples"]["ratio"], w))
     return chosen, why
 
@@ -398,6 +404,14 @@ def _pct(v: float | None) -> str:
     return "—" if v is None or not math.isfinite(v) else f"{100 * v:.1f} %"
 
 
+def _pm(sp: dict[str, Any], scale: float = 100, digits: int = 1, unit: str = "") -> str:
+    """``mean ± sd`` of a :func:`~suites.common.spread` times ``scale``; ``—`` (with the count missing) for none."""
+    if not sp.get("n"):
+        return f"— ({sp.get('missing', 0)} missing)"
+    text = f"{fmt(scale * sp['mean'], digits)} ± {fmt(scale * sp['sd'], digits)}{unit}"
+    return text + (f", {sp['missing']} missing" if sp.get("missing") else "")
+
+
 def render(record: dict[str, Any]) -> dict[str, str]:
     r = record["results"]
     prov = provenance_line(record)
@@ -408,6 +422,7 @@ def render(record: dict[str, Any]) -> dict[str, str]:
             chosen = float(w) == r["choice"][kind]["chosen"]
             rows.append([NAMES[kind], f"**{w}**" if chosen else w,
                          f"{_pct(f['val']['samples']['ratio'])} / {_pct(f['val']['real']['ratio'])}",
+                         f"{_pct(f['val']['samples']['contact_share'])} / {_pct(f['val']['real']['contact_share'])}",
                          fmt(f["val_contact"], 3), "—" if kind == "autoencoder" else _pct(f["val"]["recognition"]),
                          fmt(100 * f["val_mpjpe"], 2) if f.get("val_mpjpe") is not None else "—",
                          r["choice"][kind]["why"].get(w, ""),
@@ -421,7 +436,8 @@ def render(record: dict[str, Any]) -> dict[str, str]:
            "contact foot-frames whose planted point moves > 0.2 m/s (samples / real clips of the model's style in "
            "that split; autoencoder: the primitive's clips of every style through it / as recorded). Rule: "
            f"{r['rule']}.\n\n"
-           + md_table(["model", "contact_weight", "val skating (model / real)", "val contact (m²/s²)",
+           + md_table(["model", "contact_weight", "val skating (model / real)", "val contact share (model / real)",
+                       "val contact loss (m²/s²)",
                        "val recognition", "val MPJPE (cm)", "eligible", "test skating (model / real)"], rows)
            + "\n\nChosen (bold): " + ", ".join(f"{NAMES[k]} {c['chosen']:g}" for k, c in r["choice"].items())
            + (f". **At the edge of the grid** for {', '.join(edges)}: a larger weight was not tried." if edges else ".")
@@ -430,13 +446,10 @@ def render(record: dict[str, Any]) -> dict[str, str]:
     trows = []
     for kind in MODELS:
         for w, s in r["summary"][kind].items():
-            def pm(sp: dict[str, Any], scale: float = 100, digits: int = 1) -> str:
-                if not sp.get("n"):
-                    return "—"
-                return f"{fmt(scale * sp['mean'], digits)} ± {fmt(scale * sp['sd'], digits)}"
             trows.append([NAMES[kind], f"**{w}**" if float(w) == r["choice"][kind]["chosen"] else w,
-                          pm(s["test_samples"]) + " %", pm(s["test_real"]) + " %", pm(s["test_ratio_to_real"], 1, 2),
-                          pm(s["test_recognition"]) + " %", pm(s["test_mpjpe"], 100, 2),
+                          _pm(s["test_samples"], unit=" %"), _pm(s["test_real"], unit=" %"),
+                          _pm(s["test_ratio_to_real"], 1, 2), _pm(s["test_recognition"], unit=" %"),
+                          _pm(s["test_mpjpe"], 100, 2),
                           f"{s['test_samples']['n']}"])
     test = (f"**Test** figures of weight 0 and the chosen weight (bold), mean ± sd over {seeds} seed(s) of the feature "
             f"models (one autoencoder), {r['data']} {r['primitive']}: raw skating of {r['samples']} samples drawn "
