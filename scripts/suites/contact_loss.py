@@ -61,7 +61,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--runs", type=Path, default=ROOT / "runs" / "benchmarks" / "contact_loss",
                         help="folder of the trainings (reused when the suite runs again)")
     parser.add_argument("--primitive", default="walk_leftStance", help="the stance primitive")
-    parser.add_argument("--style", default="angry", help="the style of the CVAE and of the zero-shot samples")
+    parser.add_argument("--style", default="elderly", help="the style of the CVAE and of the zero-shot samples")
     parser.add_argument("--weights", type=float, nargs="+", default=[0.0, 10.0, 100.0, 1000.0],
                         help="candidate contact_weight of the feature models (0 = off, always included)")
     parser.add_argument("--ae-weights", type=float, nargs="*", default=[0.0, 0.1, 1.0],
