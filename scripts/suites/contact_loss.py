@@ -457,4 +457,19 @@ def render(record: dict[str, Any]) -> dict[str, str]:
             f"classifier fitted on the train clips of every style, and the reconstruction error of the test clips.\n\n"
             + md_table(["model", "contact_weight", "sample skating", "real skating", "samples ÷ real",
                         "recognition", "test MPJPE (cm)", "seeds"], trows) + f"\n\n{prov}")
-    return {"validation": val, "test": test}
+    parts = []
+    for kind in MODELS:
+        chosen = r["choice"][kind]["chosen"]
+        s0, sc = r["summary"][kind]["0"], r["summary"][kind][f"{chosen:g}"]
+        text = f"{NAMES[kind]} {_pm(s0['test_samples'], unit=' %')}"
+        if chosen:
+            text += f" → {_pm(sc['test_samples'], unit=' %')} at weight {chosen:g}"
+        else:
+            text += " (weight 0 chosen)"
+        parts.append(text + f" (real {_pm(s0['test_real'], unit=' %')})")
+    headline = (f"Raw foot skating of samples (share of contact foot-frames sliding > 0.2 m/s, {r['data']} "
+                f"{r['primitive']}, CVAE and zero-shot style {r['style']}; **test** clips, {seeds} seed(s)), without "
+                "and with the foot-contact velocity loss at the weight chosen on validation clips: "
+                + "; ".join(parts) + ". Autoencoder: weight "
+                + f"{r['choice']['autoencoder']['chosen']:g} chosen. Details: benchmarks/evaluation.md. {prov}")
+    return {"headline": headline, "validation": val, "test": test}
