@@ -94,10 +94,11 @@ def test_the_planted_point_is_the_slower_of_heel_and_ball() -> None:
     heel, ball = FOOT_POINTS[0]
     t = torch.arange(frames.shape[1], dtype=frames.dtype) / FPS
     frames[0, :, 3 * heel] += 0.4 * t  # the heel rises off and moves: the ball holds the ground
-    assert torch.allclose(planted_speed_squared(frames, FPS)[..., 0], torch.zeros(1, frames.shape[1] - 1, dtype=frames.dtype),
+    steps = frames.shape[1] - 1
+    assert torch.allclose(planted_speed_squared(frames, FPS)[..., 0], torch.zeros(1, steps, dtype=frames.dtype),
                           atol=1e-12)
     frames[0, :, 3 * ball] += 0.3 * t
-    assert torch.allclose(planted_speed_squared(frames, FPS)[..., 0], torch.full((1, frames.shape[1] - 1), 0.09, dtype=frames.dtype))
+    assert torch.allclose(planted_speed_squared(frames, FPS)[..., 0], torch.full((1, steps), 0.09, dtype=frames.dtype))
 
 
 def test_contacts_are_those_of_the_detector_carried_to_the_timeline() -> None:
