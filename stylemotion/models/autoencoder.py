@@ -8,8 +8,9 @@ After Holden et al. 2016, one 1D convolution over time:
 
 :class:`ConvAutoencoder` is the plain network (with its normalization buffers);
 :class:`MotionAutoencoder` is the Lightning module that trains it by reconstruction: MSE in the
-normalized space, optionally with input dropout (denoising) and an L1 penalty on the hidden units,
-and logs MPJPE in metres on positions recovered through the inverse representation.
+normalized space, optionally with input dropout (denoising), an L1 penalty on the hidden units and
+the foot-contact velocity loss (:mod:`stylemotion.models.contact_loss`, ``contact_weight``), and logs
+MPJPE in metres on positions recovered through the inverse representation.
 
 Shapes (``T`` frames at the model's fps, ``H`` hidden units):
 
@@ -32,6 +33,7 @@ import torch.nn.functional as F
 from torch import nn
 
 from stylemotion.io.errors import UserInputError
+from stylemotion.models.contact_loss import contact_velocity_loss, window_contacts
 from stylemotion.models.normalization import Normalizer
 from stylemotion.representation import FRAME_DIM, JOINT_DIMS, REPRESENTATION, frames_to_positions
 from stylemotion.skeleton import CANONICAL_JOINTS, CANONICAL_PARENTS, NUM_JOINTS
@@ -153,7 +155,10 @@ class MotionAutoencoder(pl.LightningModule):
     Batches are raw frames ``(batch, T, 66)``. Logged per split (``train``/``val``/``test``):
     ``mse`` (normalized space), ``mpjpe`` (metres, positions integrated from the origin, see
     :func:`mpjpe`), ``mpjpe_local`` (metres, root-local pose only, see :func:`local_mpjpe`), and
-    ``train/loss`` (MSE + sparsity term).
+    ``train/loss`` (MSE + sparsity term + contact term), and ``contact`` (m²/s²: the reconstruction's
+    squared planted-foot speed on the input's contact foot-frames,
+    :func:`~stylemotion.models.contact_loss.contact_velocity_loss`; on val/test always, on train when
+    ``contact_weight`` > 0).
 
     The normalization statistics are taken from the datamodule's train split at the first
     ``setup`` (``datamodule.normalization``) unless already set (e.g. loaded from a checkpoint).
@@ -161,6 +166,8 @@ class MotionAutoencoder(pl.LightningModule):
     Args:
         hidden_units, kernel_size, pooling, input_dropout: see :class:`ConvAutoencoder`.
         sparsity: weight of the L1 penalty ``mean(|features|)`` on the hidden units (0 = off).
+        contact_weight: weight of the foot-contact velocity loss (m²/s², see
+            :mod:`stylemotion.models.contact_loss`; 0 = off): contacts detected on each input window.
         lr: Adam learning rate. weight_decay: Adam's L2 weight decay.
         lr_gamma: the learning rate is multiplied by this after every epoch (1 = constant).
         fps: frame rate of the frames the model is trained on (velocities are per second).
@@ -179,6 +186,7 @@ class MotionAutoencoder(pl.LightningModule):
         pooling: str = "avg",
         input_dropout: float = 0.0,
         sparsity: float = 0.0,
+        contact_weight: float = 0.0,
         lr: float = 1e-3,
         weight_decay: float = 0.0,
         lr_gamma: float = 1.0,
@@ -200,12 +208,15 @@ class MotionAutoencoder(pl.LightningModule):
                 f"this model was built for a skeleton with joints {list(joint_names)} (parents "
                 f"{list(joint_parents)}), not the canonical 21-joint skeleton {list(CANONICAL_JOINTS)}"
             )
+        if not contact_weight >= 0:
+            raise ValueError(f"contact_weight must be ≥ 0, got {contact_weight}")
         if not sparsity >= 0 or not lr > 0 or not weight_decay >= 0 or not fps > 0 or not 0 < lr_gamma <= 1:
             raise ValueError(f"need sparsity ≥ 0, lr > 0, weight_decay ≥ 0, 0 < lr_gamma ≤ 1, fps > 0; got "
                              f"{sparsity}, {lr}, {weight_decay}, {lr_gamma}, {fps}")
         self.save_hyperparameters({
             "hidden_units": int(hidden_units), "kernel_size": int(kernel_size), "pooling": str(pooling),
-            "input_dropout": float(input_dropout), "sparsity": float(sparsity), "lr": float(lr),
+            "input_dropout": float(input_dropout), "sparsity": float(sparsity),
+            "contact_weight": float(contact_weight), "lr": float(lr),
             "weight_decay": float(weight_decay), "lr_gamma": float(lr_gamma), "fps": float(fps),
             "frame_dim": int(frame_dim),
             "representation": str(representation), "joint_names": [str(j) for j in joint_names],
@@ -274,6 +285,13 @@ class MotionAutoencoder(pl.LightningModule):
         recon = net.decode_normalized(features, frames.shape[-2])
         mse = F.mse_loss(recon, z)
         loss = mse + self.hparams.sparsity * features.abs().mean() if self.hparams.sparsity else mse
+        weight = float(self.hparams.get("contact_weight", 0.0))
+        contact = None
+        if weight > 0 or split != "train":
+            raw_recon = net.normalizer.denormalize(recon.float())  # float32 also under bf16 autocast
+            contact = contact_velocity_loss(raw_recon, window_contacts(frames, self.hparams.fps), self.hparams.fps)
+            if weight > 0:
+                loss = loss + weight * contact
         if split == "train" and not torch.isfinite(loss):
             raise NonFiniteLossError(
                 f"training loss is {loss.item()} at epoch {self.current_epoch}, batch {batch_idx} (global step "
@@ -291,6 +309,9 @@ class MotionAutoencoder(pl.LightningModule):
                  prog_bar=not train)
         self.log(f"{split}/mpjpe_local", local_error, batch_size=size, sync_dist=True, on_epoch=True,
                  on_step=train)
+        if contact is not None:
+            self.log(f"{split}/contact", contact.detach(), batch_size=size, sync_dist=True, on_epoch=True,
+                     on_step=train)
         return loss
 
     def training_step(self, batch: torch.Tensor, batch_idx: int) -> torch.Tensor:

@@ -8,7 +8,11 @@ giving the mean and log-variance of a 32-dim latent, decoder ``32 → 128 → 25
     recon = 1/(2NL) Σ_i Σ_l ‖decoder(z_il) − y_i‖²_w,   z_il = μ(y_i) + σ(y_i) ε_l     (eq. 5.7)
     KL    = 1/N Σ_i ½ (μᵀμ + tr Σ − k − log det Σ)                                   (eq. 5.8)
 
-with ``L = samples_per_item`` reparameterized samples per item (10 in the thesis).
+with ``L = samples_per_item`` reparameterized samples per item (10 in the thesis). With ``contact_weight`` > 0
+the loss gains ``contact_weight · contact``, the foot-contact velocity loss
+(:mod:`stylemotion.models.contact_loss`, m²/s²) of the first of each item's ``L`` reconstructions, decoded
+through the frozen autoencoder at the item's real duration, on the recorded clip's contact foot-frames;
+the CVAE and the zero-shot network inherit it.
 
 What the VAE models, ``y`` (``D = channels · steps + 1`` values): the clip's autoencoder features
 ``(channels, steps)`` z-scored per channel (statistics of the train split), flattened, plus its
@@ -51,6 +55,7 @@ from stylemotion.models.checkpoints import (
     load_autoencoder,
     resolve_autoencoder,
 )
+from stylemotion.models.contact_loss import contact_velocity_loss, timeline_contacts
 from stylemotion.models.sampling import DEFAULT_CHUNK, MotionSamples, decode_features, masked_mpjpe
 
 log = logging.getLogger(__name__)
@@ -147,7 +152,8 @@ class PrimitiveVAE(pl.LightningModule):
     """Generative model of one motion primitive (a VAE on its clips' autoencoder features).
 
     Batches come from :class:`~stylemotion.datamodules.features.FeatureDataModule`. Logged per split:
-    ``loss``, ``recon``, ``kl``; on val/test also ``mpjpe`` (metres: posterior-mean reconstruction
+    ``loss``, ``recon``, ``kl`` (and ``contact`` when ``contact_weight`` > 0); on val/test also ``contact`` (m²/s²,
+    see :meth:`contact_term`), ``mpjpe`` (metres: posterior-mean reconstruction
     decoded through the autoencoder at the clip's real duration, against the recorded clip, both
     integrated from the origin at the data's fps) and ``duration_error`` (seconds, mean absolute).
 
@@ -157,6 +163,7 @@ class PrimitiveVAE(pl.LightningModule):
         samples_per_item: ``L``, reparameterized samples per item per step (10).
         kl_weight: weight of the KL term (1).
         duration_weight: weight of the standardized log-duration in the reconstruction term.
+        contact_weight: weight of the foot-contact velocity loss (m²/s², :meth:`contact_term`; 0 = off).
         lr, weight_decay: Adam settings.
         duration_range: sampled durations are clamped to ``[lo · shortest, hi · longest]`` training
             duration.
@@ -170,6 +177,7 @@ class PrimitiveVAE(pl.LightningModule):
         samples_per_item: int = 10,
         kl_weight: float = 1.0,
         duration_weight: float = 100.0,
+        contact_weight: float = 0.0,
         lr: float = 1e-3,
         weight_decay: float = 0.0,
         duration_range: Sequence[float] = (0.75, 1.5),
@@ -179,13 +187,16 @@ class PrimitiveVAE(pl.LightningModule):
         if samples_per_item < 1 or not kl_weight >= 0 or not duration_weight >= 0 or not lr > 0:
             raise ValueError(f"need samples_per_item ≥ 1, kl_weight ≥ 0, duration_weight ≥ 0, lr > 0; got "
                              f"{samples_per_item}, {kl_weight}, {duration_weight}, {lr}")
+        if not contact_weight >= 0:
+            raise ValueError(f"contact_weight must be ≥ 0, got {contact_weight}")
         lo, hi = (float(v) for v in duration_range)
         if not 0 < lo <= 1 <= hi:
             raise ValueError(f"duration_range must be (lo, hi) with 0 < lo ≤ 1 ≤ hi, got {list(duration_range)}")
         self.save_hyperparameters({
             "latent_dim": int(latent_dim), "hidden": [int(h) for h in hidden],
             "samples_per_item": int(samples_per_item), "kl_weight": float(kl_weight),
-            "duration_weight": float(duration_weight), "lr": float(lr), "weight_decay": float(weight_decay),
+            "duration_weight": float(duration_weight), "contact_weight": float(contact_weight),
+            "lr": float(lr), "weight_decay": float(weight_decay),
             "duration_range": [lo, hi], "spec": None if spec is None else dict(spec),
         })
         self.net: MLPVAE | None = None
@@ -354,8 +365,45 @@ class PrimitiveVAE(pl.LightningModule):
         for name, (value, weight) in self._extra_losses(recon, generator).items():
             out[name] = value
             total = total + weight * value
-        out["loss"] = total
+        out["loss"] = self._add_contact_term(out, total, recon, batch)
         return out
+
+    # -- the foot-contact velocity loss (stylemotion.models.contact_loss)
+
+    def _add_contact_term(self, out: dict[str, torch.Tensor], total: torch.Tensor, recon: torch.Tensor,
+                          batch: dict[str, torch.Tensor]) -> torch.Tensor:
+        """``total`` plus ``contact_weight · contact`` (recorded in ``out``): computed when the weight is > 0,
+        and in evaluation whenever the batch holds the recorded clips (``positions``, ``num_frames``)."""
+        weight = float(self.hparams.get("contact_weight", 0.0))
+        if weight > 0 or (not self.training and "positions" in batch and "num_frames" in batch):
+            out["contact"] = self.contact_term(recon[0], batch)
+            if weight > 0:
+                total = total + weight * out["contact"]
+        return total
+
+    def contact_term(self, y: torch.Tensor, batch: dict[str, torch.Tensor]) -> torch.Tensor:
+        """The foot-contact velocity loss of model-space reconstructions of a batch's clips.
+
+        Args:
+            y: ``(batch, D)`` model-space values (e.g. one reparameterized reconstruction per item), decoded
+                through the frozen autoencoder (gradient to ``y``, not to the autoencoder) on the canonical
+                timeline at each clip's real duration ``batch["duration_s"]``.
+            batch: with ``positions`` ``(batch, frames, 21, 3)`` and ``num_frames`` ``(batch,)``: the recorded
+                clips, whose contacts (:func:`~stylemotion.models.contact_loss.timeline_contacts`) say where
+                the decoded feet must stay still.
+
+        Returns:
+            Scalar, m²/s² (:func:`~stylemotion.models.contact_loss.contact_velocity_loss`).
+        """
+        if "positions" not in batch or "num_frames" not in batch:
+            raise ValueError("the contact term needs the recorded clips in the batch (positions, num_frames): "
+                             "train on a FeatureDataModule or MultiStyleDataModule")
+        length = self.timeline_frames
+        features, _ = self.denormalize(y, clamp=False)
+        frames = self.autoencoder.decode(features, length).float()  # (batch, L, 66)
+        contacts = timeline_contacts(batch["positions"], batch["num_frames"], self.fps, length).to(frames.device)
+        rate = (length - 1) / batch["duration_s"].to(frames)  # playback fps of the canonical timeline
+        return contact_velocity_loss(frames, contacts, rate)
 
     def training_step(self, batch: dict[str, torch.Tensor], batch_idx: int) -> torch.Tensor:
         terms = self.losses(batch)

@@ -1,0 +1,201 @@
+"""The foot-contact velocity loss (:mod:`stylemotion.models.contact_loss`): zero for planted feet and the
+squared sliding speed otherwise, root motion included; contacts carried to the canonical timeline; its gradient
+reaches the decoders (not the frozen autoencoder); each model's ``contact_weight`` comes from its Hydra config;
+and a tiny seeded training with weight > 0 decodes slower contact feet than with weight 0."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import lightning.pytorch as pl
+import numpy as np
+import pytest
+import torch
+from hydra import compose, initialize_config_dir
+from hydra.utils import instantiate
+from vae_fixtures import TINY_DATA, feature_module, fit, tiny_autoencoder_ckpt, tiny_takeset, validate
+
+from stylemotion.config import config_dir
+from stylemotion.datamodules import MotionWindowDataModule
+from stylemotion.models.autoencoder import ConvAutoencoder, MotionAutoencoder
+from stylemotion.models.contact_loss import (
+    contact_velocity_loss,
+    planted_speed_squared,
+    timeline_contacts,
+    window_contacts,
+)
+from stylemotion.models.vae import PrimitiveVAE
+from stylemotion.primitives.contacts import foot_contacts
+from stylemotion.representation import FRAME_DIM, VELOCITY_DIMS, frames_to_positions, positions_to_frames
+from stylemotion.skeleton import FOOT_POINTS
+
+torch.set_num_threads(1)
+FPS = 30.0
+
+
+@pytest.fixture(scope="session")
+def ae_ckpt(tmp_path_factory) -> Path:
+    return tiny_autoencoder_ckpt(tmp_path_factory.mktemp("contact_ae"))
+
+
+def standing(frames: int = 12) -> torch.Tensor:
+    """``(1, frames, 66)``: one pose held still (a real synthetic pose), root and heading fixed."""
+    take = tiny_takeset().takes[0]
+    pose, _, _ = positions_to_frames(take.positions[:2], FPS)
+    out = torch.zeros(1, frames, FRAME_DIM, dtype=torch.float64)
+    out[0, :, :63] = torch.as_tensor(pose[0, :63], dtype=torch.float64)
+    return out
+
+
+def slide_left_foot(frames: torch.Tensor, speed: float) -> torch.Tensor:
+    """``frames`` with the left heel and ball moving along +X at ``speed`` m/s (root-local, no turning)."""
+    out = frames.clone()
+    t = torch.arange(frames.shape[1], dtype=frames.dtype) / FPS
+    for joint in FOOT_POINTS[0]:
+        out[0, :, 3 * joint] += speed * t
+    return out
+
+
+def test_still_feet_cost_nothing_and_sliding_feet_cost_their_squared_speed() -> None:
+    frames = standing()
+    contacts = torch.ones(1, frames.shape[1], 2, dtype=torch.bool)
+    assert float(contact_velocity_loss(frames, contacts, FPS)) == pytest.approx(0.0, abs=1e-12)
+    slid = slide_left_foot(frames, 0.5)
+    speeds = planted_speed_squared(slid, FPS)
+    assert torch.allclose(speeds[..., 0], torch.full_like(speeds[..., 0], 0.25))
+    assert torch.allclose(speeds[..., 1], torch.zeros_like(speeds[..., 1]), atol=1e-12)
+    # both feet in contact: the mean over contact foot-frames is half the left foot's 0.25 m²/s²
+    assert float(contact_velocity_loss(slid, contacts, FPS)) == pytest.approx(0.125)
+    # only the right (still) foot in contact: the sliding left foot is free
+    right = contacts.clone()
+    right[..., 0] = False
+    assert float(contact_velocity_loss(slid, right, FPS)) == pytest.approx(0.0, abs=1e-12)
+    # no contact at all: zero, not NaN
+    assert float(contact_velocity_loss(slid, torch.zeros_like(contacts), FPS)) == 0.0
+
+
+def test_a_foot_carried_by_the_moving_root_slides_in_world_space() -> None:
+    frames = standing()
+    frames[0, :, VELOCITY_DIMS.start + 1] = 1.0  # the root walks forward at 1 m/s, the pose held
+    contacts = torch.ones(1, frames.shape[1], 2, dtype=torch.bool)
+    assert float(contact_velocity_loss(frames, contacts, FPS)) == pytest.approx(1.0)
+    # per-motion rates (a time-normalized clip's playback rate): the root's velocity channels are per second,
+    # so the root's speed does not depend on the rate, but a root-local slide of so many metres per frame does
+    rate = torch.tensor([FPS / 2])
+    assert float(contact_velocity_loss(frames, contacts, rate)) == pytest.approx(1.0)
+    slid = slide_left_foot(standing(), 0.5)
+    left = contacts.clone()
+    left[..., 1] = False
+    assert float(contact_velocity_loss(slid, left, rate)) == pytest.approx(0.25 / 4)
+
+
+def test_the_planted_point_is_the_slower_of_heel_and_ball() -> None:
+    frames = standing()
+    heel, ball = FOOT_POINTS[0]
+    t = torch.arange(frames.shape[1], dtype=frames.dtype) / FPS
+    frames[0, :, 3 * heel] += 0.4 * t  # the heel rises off and moves: the ball holds the ground
+    steps = frames.shape[1] - 1
+    assert torch.allclose(planted_speed_squared(frames, FPS)[..., 0], torch.zeros(1, steps, dtype=frames.dtype),
+                          atol=1e-12)
+    frames[0, :, 3 * ball] += 0.3 * t
+    assert torch.allclose(planted_speed_squared(frames, FPS)[..., 0], torch.full((1, steps), 0.09, dtype=frames.dtype))
+
+
+def test_contacts_are_those_of_the_detector_carried_to_the_timeline() -> None:
+    positions = tiny_takeset().takes[0].positions[:40]
+    expected = foot_contacts(positions, FPS)
+    p = torch.as_tensor(positions[None], dtype=torch.float32)
+    same = timeline_contacts(p, torch.tensor([40]), FPS, 40)
+    assert same.shape == (1, 40, 2) and bool(same.any()) and bool((~same).any())
+    assert np.array_equal(same[0].numpy(), expected)
+    # 40 recorded frames on a 14-frame timeline: frame j takes recorded frame round(j · 39 / 13) = 3 j
+    short = timeline_contacts(p, torch.tensor([40]), FPS, 14)
+    assert np.array_equal(short[0].numpy(), expected[np.arange(14) * 3])
+    # padding past num_frames is ignored: the first 25 frames alone give the same contacts
+    padded = timeline_contacts(p, torch.tensor([25]), FPS, 25)
+    assert np.array_equal(padded[0].numpy(), foot_contacts(positions[:25], FPS))
+    # window contacts go through the inverse representation: frames of the same take, the same decision
+    frames, _, _ = positions_to_frames(positions, FPS)
+    back = frames_to_positions(frames, FPS)
+    assert np.array_equal(window_contacts(torch.as_tensor(frames[None]), FPS)[0].numpy(), foot_contacts(back, FPS))
+
+
+def test_the_gradient_reaches_the_decoder_not_only_the_output() -> None:
+    torch.manual_seed(0)
+    net = ConvAutoencoder(hidden_units=8)
+    net.normalizer.set_stats(torch.zeros(FRAME_DIM), torch.ones(FRAME_DIM))
+    frames = slide_left_foot(standing(16), 0.5).float()
+    loss = contact_velocity_loss(net(frames), torch.ones(1, 16, 2, dtype=torch.bool), FPS)
+    loss.backward()
+    assert float(loss.detach()) > 0 and float(net.decoder.weight.grad.abs().sum()) > 0
+
+
+def test_the_vae_contact_term_reaches_its_decoder_and_leaves_the_autoencoder_frozen(ae_ckpt) -> None:
+    dm = feature_module(ae_ckpt)
+    pl.seed_everything(0, verbose=False)
+    model = PrimitiveVAE(samples_per_item=2, contact_weight=5.0)
+    fit(model, dm, steps=1)  # builds the network from the data and attaches the autoencoder
+    model.train()
+    batch = next(iter(dm.train_dataloader()))
+    model.zero_grad()
+    terms = model.losses(batch)
+    assert float(terms["contact"]) > 0
+    grad, = torch.autograd.grad(terms["contact"], model.net.decoder[-1].weight, retain_graph=True)
+    assert float(grad.abs().sum()) > 0
+    terms["loss"].backward()
+    assert all(p.grad is None for p in model.autoencoder.parameters())
+    # the weight multiplies the logged term: the same batch and noise without it differ by exactly w · contact
+    generator = torch.Generator().manual_seed(3)
+    with_term = model.losses(batch, generator)
+    model.hparams.contact_weight = 0.0
+    generator = torch.Generator().manual_seed(3)
+    without = model.losses(batch, generator)
+    assert "contact" not in without  # not computed while training without it
+    assert float(with_term["loss"] - without["loss"]) == pytest.approx(5.0 * float(with_term["contact"]), rel=1e-4)
+
+
+@pytest.mark.parametrize(("experiment", "target"), [("autoencoder", "MotionAutoencoder"),
+                                                    ("primitive_vae", "PrimitiveVAE"),
+                                                    ("style_cvae", "StyleCVAE"), ("zero_shot", "ZeroShotStyleVAE")])
+def test_contact_weight_flows_from_each_models_config(experiment: str, target: str) -> None:
+    base = [f"experiment={experiment}"] + ([] if experiment == "autoencoder" else ["autoencoder_ckpt=x"])
+    with initialize_config_dir(config_dir(), version_base="1.3"):
+        default = compose("train", overrides=base)
+        set_ = compose("train", overrides=[*base, "model.contact_weight=7"])
+    assert default.model.contact_weight == 0.0
+    model = instantiate(set_.model, _convert_="all")
+    assert type(model).__name__ == target and model.hparams.contact_weight == 7.0
+
+
+def decoded_contact_speed_vae(ae_ckpt: Path, weight: float, folder: Path) -> float:
+    """val/contact (m²/s²) of a VAE trained for a few epochs on the tiny data with ``contact_weight`` = weight."""
+    dm = feature_module(ae_ckpt)
+    pl.seed_everything(0, verbose=False)
+    model = PrimitiveVAE(samples_per_item=2, contact_weight=weight)
+    fit(model, dm, steps=150)
+    return validate(model, dm)["val/contact"]
+
+
+def test_training_with_the_contact_weight_slows_the_decoded_contact_feet_vae(ae_ckpt, tmp_path) -> None:
+    plain = decoded_contact_speed_vae(ae_ckpt, 0.0, tmp_path / "w0")
+    held = decoded_contact_speed_vae(ae_ckpt, 200.0, tmp_path / "w200")
+    assert held < 0.7 * plain, (plain, held)
+
+
+def decoded_contact_speed_autoencoder(weight: float) -> float:
+    """val/contact (m²/s²) of a tiny autoencoder trained for 80 steps with ``contact_weight`` = weight."""
+    pl.seed_everything(0, verbose=False)
+    dm = MotionWindowDataModule(takeset=tiny_takeset(), window_frames=30, stride=15, batch_size=32,
+                                split=TINY_DATA["split"])
+    model = MotionAutoencoder(hidden_units=16, lr=3e-3, contact_weight=weight)
+    trainer = pl.Trainer(accelerator="cpu", max_steps=80, logger=False, enable_checkpointing=False,
+                         enable_progress_bar=False, enable_model_summary=False, num_sanity_val_steps=0,
+                         limit_val_batches=0)
+    trainer.fit(model, datamodule=dm)
+    return validate(model, dm)["val/contact"]
+
+
+def test_training_with_the_contact_weight_slows_the_decoded_contact_feet_autoencoder() -> None:
+    plain = decoded_contact_speed_autoencoder(0.0)
+    held = decoded_contact_speed_autoencoder(1.0)
+    assert held < 0.7 * plain, (plain, held)
