@@ -54,7 +54,7 @@ class ReconstructSettings(MotionFileKeys):
     markers: str = MISSING
     joints: list[str] | None = None
     features: str = "E15"
-    k: int = 128
+    k: int = 512
     noise_mm: float = 0.0
     seed: int = 0
     exclude_markers_take: bool = True
