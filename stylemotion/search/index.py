@@ -77,13 +77,13 @@ IVF_NPROBE = 32
 #: Training points per IVF cell (k-means on a seeded sample of the database; faiss wants ≥ 39).
 IVF_TRAIN_PER_LIST = 40
 #: ``engine="auto"``: ``(largest feature dimension, exact engine)`` rows in ascending order; features of dimension
-#: ``d`` use the engine of the first row whose dimension is ≥ ``d``. Chosen (provisionally, until the suite
-#: ``engines`` has run alone on all of Bandai and its block ``engines/choice`` in benchmarks/engines.md
-#: confirms or replaces it) on Table 2.1 of ``git show 1c0f1b8:benchmarks/search.md``: 16-NN of 2,000 held-out
-#: Bandai frames against 346,527, one thread, batched — cKDTree 0.04–0.61 ms for every set of ≤ 45 dimensions,
-#: where faiss' brute force took 0.87–2.18 ms; faiss 0.66–0.92 ms for the 75–117-dimensional windowed sets,
-#: where the kd-trees took 1.1–1.9 ms.
-AUTO_ENGINES: tuple[tuple[float, str], ...] = ((45, "ckdtree"), (math.inf, "faiss"))
+#: ``d`` use the engine of the first row whose dimension is ≥ ``d``. Chosen by ``python scripts/benchmarks.py run
+#: engines --scale-frames 0`` (alone, all of Bandai: 16-NN of held-out test frames against the 346,527 train + val
+#: frames, batched, one thread; benchmarks/engines.md, block ``engines/choice``): a kd-tree for every set; faiss'
+#: brute force was 24–76× slower at every dimension (up to 117). The table's fastest kd-tree is pykdtree (1.00–1.15×
+#: the fastest exact engine) but it returns float32 distances, which put an LNG path's cost below exact DTW's on
+#: Bandai (tests/search/test_search_bandai_slice.py); cKDTree (float64, 1.00–1.84×) is the fastest that keeps it.
+AUTO_ENGINES: tuple[tuple[float, str], ...] = ((math.inf, "ckdtree"),)
 #: The exact engine ``auto`` falls back to when the one its rule names is not installed.
 AUTO_FALLBACK = "ckdtree"
 _INSTALL_HINT = {"pykdtree": "pip install pykdtree", "faiss": "pip install 'stylemotion[search]' (faiss-cpu)"}
