@@ -37,7 +37,7 @@ import logging
 import math
 import time
 import warnings
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 import torch
@@ -185,6 +185,48 @@ def _end_state(frames: np.ndarray, fps: float, start_xz: np.ndarray, start_yaw: 
     return root[-1].numpy(), float(yaw[-1])
 
 
+def _append_decoded(motion: np.ndarray | None, decoded, blend_frames: int, fps: float, place_xz: np.ndarray,
+                    place_yaw: float) -> tuple[np.ndarray, int, int, float, np.ndarray, float]:
+    """Append one decoded clip (a batch of one) to ``motion`` ``(frames, 66)`` (or start it), the walk's root at
+    ``(place_xz, place_yaw)`` before it. Returns the motion, the clip's first frame in it, the junction, the clip's
+    mean ground speed (m/s) and where the root ends ``(xz, yaw)``."""
+    clip = decoded.frames[0, : int(decoded.num_frames[0])].numpy().astype(np.float64)
+    before = 0 if motion is None else len(motion) - 1
+    motion, junction = append_clip(motion, clip, blend_frames)
+    placed = motion[before:]
+    speed = float(np.linalg.norm(placed[:-1, VELOCITY_DIMS], axis=-1).mean())
+    end_xz, end_yaw = _end_state(placed, fps, place_xz, place_yaw)
+    return motion, before, junction, speed, end_xz, end_yaw
+
+
+def restitch(walk: SynthesizedMotion, decoders: list, latents: list[np.ndarray], settings: FollowSettings,
+             start_yaw: float | None = None) -> SynthesizedMotion:
+    """``walk`` with its steps' codes replaced by ``latents`` (one ``(d_i,)`` per step), each decoded by
+    ``decoders[i]`` (``(1, d_i)`` codes → motion samples) and stitched as :func:`follow_path` stitches: the same
+    primitives, targets and path, new clips, junctions and step ends (each step's costs are kept as searched)."""
+    if len(decoders) != len(walk.steps) or len(latents) != len(walk.steps):
+        raise ValueError(f"restitch needs one decoder and one code per step ({len(walk.steps)}), got "
+                         f"{len(decoders)} and {len(latents)}")
+    began = time.perf_counter()
+    heading = float(walk.path.heading_at(0.0)) if start_yaw is None else float(start_yaw)
+    start_xz = walk.path.start
+    place_xz, place_yaw = start_xz.copy(), heading
+    motion, junctions, steps = None, [], []
+    for record, decode, latent in zip(walk.steps, decoders, latents):
+        code = torch.as_tensor(np.asarray(latent, dtype=np.float32))
+        decoded = decode(code[None])
+        motion, before, junction, _, place_xz, place_yaw = _append_decoded(
+            motion, decoded, settings.blend_frames, walk.fps, place_xz, place_yaw)
+        if steps:
+            junctions.append(junction)
+        steps.append(replace(record, start_frame=before, end_xz=[float(v) for v in place_xz],
+                             end_yaw=float(place_yaw), duration_s=float(decoded.duration_s[0]),
+                             latent=[float(v) for v in code]))
+    positions = frames_to_positions(motion, walk.fps, start_xz, heading)
+    return replace(walk, frames=motion.astype(np.float32), positions=positions.astype(np.float32),
+                   junctions=junctions, steps=steps, seconds=walk.seconds + time.perf_counter() - began)
+
+
 def _path_target(path: GroundPath, s: float) -> tuple[np.ndarray, float]:
     """The path's point (m) and heading (rad) ``s`` metres along it."""
     return path.point_at(s), float(path.heading_at(min(s, path.length - 1e-9)))
@@ -256,14 +298,10 @@ def follow_path(graph: MotionGraph, path: GroundPath, seed: int = 0, settings: F
         z, start_cost, final_cost, terms = (own_search(goal, settings, generator) if own_search
                                             else _search(model, goal, settings, generator))
         decoded = model.decode_latent(z[None])
-        clip = decoded.frames[0, : int(decoded.num_frames[0])].numpy().astype(np.float64)
-        before = 0 if motion is None else len(motion) - 1
-        motion, junction = append_clip(motion, clip, settings.blend_frames)
+        motion, before, junction, previous_speed, place_xz, place_yaw = _append_decoded(
+            motion, decoded, settings.blend_frames, fps, place_xz, place_yaw)
         if steps:
             junctions.append(junction)
-        placed = motion[before:]
-        previous_speed = float(np.linalg.norm(placed[:-1, VELOCITY_DIMS], axis=-1).mean())
-        place_xz, place_yaw = _end_state(placed, fps, place_xz, place_yaw)
         steps.append(StepRecord(
             primitive=primitive, start_frame=before, target_xz=[float(v) for v in target_xz],
             target_yaw=float(target_yaw), end_xz=[float(v) for v in place_xz], end_yaw=float(place_yaw),

@@ -10,14 +10,20 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from pathlib import Path
+from typing import Any
+
+import numpy as np
 
 from stylemotion.config import ConfigError
+from stylemotion.geometry import wrap_angle
 from stylemotion.morphable.model import MorphableModel
 from stylemotion.morphable.synthesis import MapSettings, MorphablePrimitive
-from stylemotion.synthesis.controller import LOOKAHEAD_TARGETS
+from stylemotion.synthesis.controller import LOOKAHEAD_TARGETS, SynthesizedMotion, restitch
 from stylemotion.synthesis.graph import TRANSITIONS, MotionGraph, short_primitive
+from stylemotion.synthesis.joint_walk import JointStep, optimize_steps
+from stylemotion.synthesis.settings import FollowSettings
 
-__all__ = ["MapSettings", "link_graph", "load_morphable_graph"]
+__all__ = ["MapSettings", "link_graph", "load_morphable_graph", "optimize_walk", "target_error"]
 
 
 def link_graph(graph) -> None:
@@ -68,3 +74,46 @@ def load_morphable_graph(models: Mapping[str, str | Path | Sequence[str | Path]]
     graph = MotionGraph(action=action, style="/".join(sorted(str(s) for s in styles)), models=loaded, sources=sources)
     link_graph(graph)
     return graph
+
+
+def target_error(walk: SynthesizedMotion, follow: FollowSettings) -> float:
+    """How far a walk's stitched steps end from their targets: ``Σ_i ‖p_i − p*_i‖² / σ_p² + wrap(θ_i − θ*_i)² / σ_θ²``
+    over its steps (``p_i, θ_i``: where step ``i`` ends in the stitched motion; the scales ``follow.*``)."""
+    total = 0.0
+    for step in walk.steps:
+        gap = np.asarray(step.end_xz) - np.asarray(step.target_xz)
+        total += float(gap @ gap) / follow.position_scale_m ** 2
+        total += float(wrap_angle(step.end_yaw - step.target_yaw)) ** 2 / follow.heading_scale_rad ** 2
+    return total
+
+
+def optimize_walk(graph: MotionGraph, walk: SynthesizedMotion, follow: FollowSettings,
+                  max_evaluations: int) -> tuple[SynthesizedMotion, dict[str, Any]]:
+    """Algorithm 1, line 9 (Du): the codes of all of ``walk``'s steps optimized together after the graph walk
+    (:func:`stylemotion.synthesis.joint_walk.optimize_steps`: each step keeps its primitive, variant and target),
+    then the walk re-stitched from them (:func:`~stylemotion.synthesis.controller.restitch`); ``walk`` itself when LM
+    found no lower objective. Returns the walk and what happened: ``objective_before``/``_after`` (the joint
+    objective), ``target_error_before``/``_after`` (:func:`target_error` of the stitched walks), ``kept``,
+    ``evaluations`` and ``seconds``."""
+    import time
+
+    began = time.perf_counter()
+    models = []
+    for step in walk.steps:
+        node = graph.models[step.primitive]
+        if not isinstance(node, MorphablePrimitive):
+            raise ValueError(f"optimize_walk needs Morphable Graph steps; step {step.primitive} is a "
+                             f"{type(node).__name__}")
+        models.append(node.variants.get(step.variant, node.model))
+    steps = [JointStep(m, np.asarray(s.latent, dtype=np.float64), np.asarray(s.target_xz, dtype=np.float64),
+                       float(s.target_yaw)) for m, s in zip(models, walk.steps)]
+    result = optimize_steps(steps, walk.path.start, float(walk.path.heading_at(0.0)), follow, max_evaluations)
+    before = target_error(walk, follow)
+    record = {"objective_before": result.start_cost, "objective_after": result.cost,
+              "target_error_before": before, "target_error_after": before, "kept": result.improved,
+              "evaluations": result.evaluations}
+    if result.improved:
+        walk = restitch(walk, [m.decode_latent for m in models], result.latents, follow)
+        record["target_error_after"] = target_error(walk, follow)
+    record["seconds"] = time.perf_counter() - began
+    return walk, record
