@@ -81,6 +81,9 @@ class MapSettings:
             residuals over their ``follow.*`` scales, without the prior) is at most this is kept without LM
             (the authors' implementation's ``start_error_threshold``); 0: every start is refined (chosen with
             ``prior_centre`` on a validation path, a corner, by suite ``morphable_variation``).
+        joint_evaluations: after the walk, Algorithm 1's line 9: LM on the codes of all steps together
+            (:mod:`stylemotion.synthesis.joint_walk`), at most this many objective evaluations; 0: off (the walk as
+            searched step by step).
         prior_centre: where LM's prior residual ``√λ L_k⁻¹ (s − c)`` is centred: ``mixture`` (``c = μ_k``, eq. 4.9,
             the thesis') or ``start`` (``c`` = the drawn start: LM meets the step and keeps the draw where the step
             leaves the code free, a perturb-and-MAP draw; the prior still counts in the costs compared).
@@ -96,6 +99,7 @@ class MapSettings:
     random_starts: int = 100
     accept_cost: float = 0.0
     prior_centre: str = "mixture"
+    joint_evaluations: int = 0
 
     def __post_init__(self) -> None:
         if self.candidates < 1 or self.tree_evaluations < 1 or self.max_evaluations < 1 or self.lookahead_steps < 1:
@@ -103,6 +107,8 @@ class MapSettings:
                              f"≥ 1; got {self}")
         if self.prior_centre not in ("mixture", "start"):
             raise ValueError(f"MapSettings.prior_centre is 'mixture' or 'start', got {self.prior_centre!r}")
+        if self.joint_evaluations < 0:
+            raise ValueError(f"MapSettings need joint_evaluations ≥ 0 (0: off); got {self.joint_evaluations}")
         if self.random_starts < 0 or not self.accept_cost >= 0:
             raise ValueError(f"MapSettings need random_starts ≥ 0 (0: the tree's candidate) and accept_cost ≥ 0; "
                              f"got {self}")

@@ -213,7 +213,7 @@ def restitch(walk: SynthesizedMotion, decoders: list, latents: list[np.ndarray],
     place_xz, place_yaw = start_xz.copy(), heading
     motion, junctions, steps = None, [], []
     for record, decode, latent in zip(walk.steps, decoders, latents):
-        code = torch.as_tensor(np.asarray(latent, dtype=np.float32))
+        code = torch.from_numpy(np.array(latent))  # its own precision (the Morphable Graph's codes: float64)
         decoded = decode(code[None])
         motion, before, junction, _, place_xz, place_yaw = _append_decoded(
             motion, decoded, settings.blend_frames, walk.fps, place_xz, place_yaw)

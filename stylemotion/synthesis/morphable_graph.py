@@ -23,7 +23,7 @@ from stylemotion.synthesis.graph import TRANSITIONS, MotionGraph, short_primitiv
 from stylemotion.synthesis.joint_walk import JointStep, optimize_steps
 from stylemotion.synthesis.settings import FollowSettings
 
-__all__ = ["MapSettings", "link_graph", "load_morphable_graph", "optimize_walk", "target_error"]
+__all__ = ["MapSettings", "finish_walk", "link_graph", "load_morphable_graph", "optimize_walk", "target_error"]
 
 
 def link_graph(graph) -> None:
@@ -117,3 +117,15 @@ def optimize_walk(graph: MotionGraph, walk: SynthesizedMotion, follow: FollowSet
         record["target_error_after"] = target_error(walk, follow)
     record["seconds"] = time.perf_counter() - began
     return walk, record
+
+
+def finish_walk(graph: MotionGraph, walk: SynthesizedMotion, follow: FollowSettings
+                ) -> tuple[SynthesizedMotion, dict[str, Any] | None]:
+    """``walk`` after Algorithm 1's line 9 (:func:`optimize_walk`) where its nodes' settings ask for it
+    (``MapSettings.joint_evaluations`` > 0), with what that did; else ``(walk, None)``."""
+    budgets = {node.settings.joint_evaluations for node in graph.models.values()
+               if isinstance(node, MorphablePrimitive)}
+    budget = max(budgets, default=0)
+    if budget < 1:
+        return walk, None
+    return optimize_walk(graph, walk, follow, budget)
