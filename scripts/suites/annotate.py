@@ -3,10 +3,13 @@ of a motion from its class motion tensor (§3.3, §4.1), plus a document of othe
 
 Annotation: templates from ``--per-class`` train takes per content (drawn with the seed). Documents: every
 val (or test) take exactly once, in an order drawn with the seed, joined by ``--blend`` unlabelled frames into
-documents of at least ``--seconds`` (:func:`stylemotion.annotate.documents.partition_documents`). τ,
-``min_run`` and the key-frame tolerance are chosen on the val documents (objective: mean over seeds of
-(F1 + F2) / 2, pooled over a seed's documents), and reported on the test documents. Other captures: the
-walks of ``other-skeletons`` read as ``stylemotion-annotate`` reads a user's file, joined into one document.
+documents of at least ``--seconds`` (:func:`stylemotion.annotate.documents.partition_documents`), and
+documents of **cuts**: each take's middle 2–3 s (a seeded length, as long as a user's short recording; the other
+captures' walks are 2.1–2.7 s) joined the same way. τ, ``min_run``, the key-frame tolerance and ``sub_frames``
+(whole templates or windows of them, §3.3's sub-templates) are chosen on the val documents of both kinds
+(objective: mean over seeds and the two kinds of (F1 + F2) / 2, pooled over a seed's documents), and reported on
+the test documents of both kinds. Other captures: the walks of ``other-skeletons`` read as
+``stylemotion-annotate`` reads a user's file, joined into one document.
 
 Tensors: the walk tensor from ``r`` train takes per style (drawn with the seed); ``r`` chosen by the style
 accuracy on val walk takes, reported on test walk takes, beside the evaluation package's StyleClassifier.
@@ -30,8 +33,11 @@ DEFAULT_SEEDS = (0, 1, 2)
 TAUS = (0.01, 0.015, 0.02, 0.025, 0.03, 0.04, 0.05, 0.08, 0.13)
 MIN_RUNS = (0, 10, 20, 30, 45, 60)
 KEYFRAME_TOLERANCES = (None, 0.0, 0.1, 0.2)      # None: no key-frame preselection
+SUB_FRAMES = (0, 30, 45, 60, 90)                # 0: whole templates; else windows of that many frames (key frames off)
+CUT_FRAMES = (60, 90)                           # a cut's length, drawn per take (2–3 s at 30 fps)
+KINDS = ("takes", "cuts")                       # the two kinds of documents
 REPETITIONS = (2, 3, 5, 8, 10, None)                  # None: as many as every style has
-OLD_DEFAULT = {"tau": 0.02, "keyframes": 0.1, "min_run": 30}   # the defaults before this suite chose them
+OLD_DEFAULT = {"tau": 0.02, "keyframes": 0.1, "min_run": 30, "sub_frames": 0}   # the defaults before any choice
 OTHER_CAPTURES = ("walk_21joint_60fps.bvh", "female-walk_21joint_60fps.bvh", "xia_neutral_01_000_31joint_120fps.bvh")
 SCORES = ("P1", "R1", "F1", "P2", "R2", "F2")
 
@@ -44,8 +50,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="share of the val and test takes each seed uses (a seeded draw; 1 = all)")
 
 
-def _key(tau: float, tol: float | None, min_run: int) -> str:
-    return f"tau={tau:g} keyframes={'off' if tol is None else f'{tol:g}'} min_run={min_run}"
+def _key(tau: float, tol: float | None, min_run: int, sub: int = 0) -> str:
+    return f"tau={tau:g} keyframes={'off' if tol is None else f'{tol:g}'} min_run={min_run} sub_frames={sub}"
 
 
 def _pooled(documents, predictions) -> dict[str, float]:
@@ -64,41 +70,54 @@ def _names(labels: np.ndarray, classes: tuple[str, ...]) -> list[str]:
 
 
 class _Annotated:
-    """A seed's documents with their features and subsequence-DTW distances, re-thresholded cheaply."""
+    """A seed's documents with their features and subsequence-DTW distances (per ``sub_frames``, computed when
+    first asked for), re-thresholded cheaply."""
 
     def __init__(self, documents, model):
-        from stylemotion.annotate.annotation import AnnotationSettings, class_distances
         from stylemotion.annotate.features import relational_features
 
         self.documents, self.model = documents, model
         t0 = time.perf_counter()
         self.features = [relational_features(d.positions, d.fps) for d in documents]
         self.features_s = time.perf_counter() - t0
-        t0 = time.perf_counter()
-        plain = AnnotationSettings(keyframes=False)
-        self.base = [class_distances(f, model.templates, plain) for f in self.features]
-        self.distances_s = time.perf_counter() - t0
-        self._variants: dict[float | None, list] = {None: self.base}
+        self.distances_s = 0.0
+        self._variants: dict[tuple[float | None, int], list] = {}
+        self.base(0)
 
-    def distances(self, tol: float | None):
+    def base(self, sub: int) -> list:
+        from stylemotion.annotate.annotation import AnnotationSettings, class_distances
+
+        if (None, sub) not in self._variants:
+            t0 = time.perf_counter()
+            plain = AnnotationSettings(keyframes=False, sub_frames=sub)
+            self._variants[None, sub] = [class_distances(f, self.model.templates, plain) for f in self.features]
+            if sub == 0:
+                self.distances_s = time.perf_counter() - t0
+        return self._variants[None, sub]
+
+    def distances(self, tol: float | None, sub: int = 0):
         from stylemotion.annotate.annotation import with_keyframes
 
-        if tol not in self._variants:
-            self._variants[tol] = [with_keyframes(d, f, self.model.templates, 3, tol)
-                                   for d, f in zip(self.base, self.features)]
-        return self._variants[tol]
+        if tol is None:
+            return self.base(sub)
+        if sub:
+            raise ValueError("key-frame preselection is compared with whole templates only")
+        if (tol, 0) not in self._variants:
+            self._variants[tol, 0] = [with_keyframes(d, f, self.model.templates, 3, tol)
+                                      for d, f in zip(self.base(0), self.features)]
+        return self._variants[tol, 0]
 
-    def raw_labels(self, tau: float, tol: float | None) -> list[np.ndarray]:
+    def raw_labels(self, tau: float, tol: float | None, sub: int = 0) -> list[np.ndarray]:
         """Per document the frame labels before ``min_run`` (int, -1 = none)."""
         from stylemotion.annotate.annotation import annotate_distances
 
-        return [annotate_distances(d, tau, tol is not None, 0).labels for d in self.distances(tol)]
+        return [annotate_distances(d, tau, tol is not None, 0).labels for d in self.distances(tol, sub)]
 
-    def labels(self, tau: float, tol: float | None, min_run: int) -> list[list[str]]:
+    def labels(self, tau: float, tol: float | None, min_run: int, sub: int = 0) -> list[list[str]]:
         from stylemotion.annotate.annotation import drop_short_runs
 
         classes = self.model.classes
-        return [_names(drop_short_runs(raw, min_run), classes) for raw in self.raw_labels(tau, tol)]
+        return [_names(drop_short_runs(raw, min_run), classes) for raw in self.raw_labels(tau, tol, sub)]
 
 
 def _load_bandai():
@@ -120,6 +139,17 @@ def _pool(takes, fraction: float, rng: np.random.Generator):
         keep = sorted(rng.permutation(len(takes))[:max(1, int(round(fraction * len(takes))))])
         takes = [takes[i] for i in keep]
     return [(t.name, t.content, t.style, t.positions) for t in takes]
+
+
+def _cuts(pool, rng: np.random.Generator):
+    """Each take of ``pool`` cut to its middle ``n`` frames, ``n`` drawn from :data:`CUT_FRAMES` (a whole take when
+    shorter): short single-action recordings, as a user's file often is."""
+    out = []
+    for name, content, style, positions in pool:
+        n = int(rng.integers(CUT_FRAMES[0], CUT_FRAMES[1] + 1))
+        a = max(0, (len(positions) - n) // 2)
+        out.append((name, content, style, positions[a:a + n]))
+    return out
 
 
 def _other_captures_document(seed: int, fps: float, blend: int):
@@ -183,14 +213,14 @@ def _truncation(tensor, theta: np.ndarray) -> list[dict[str, Any]]:
 
 
 def _walk_segment_styles(annotated: _Annotated, tensor, tau: float, tol: float | None,
-                         min_run: int) -> tuple[int, int]:
+                         min_run: int, sub: int = 0) -> tuple[int, int]:
     """Walk segments the annotation finds in the documents, and how many the tensor gives the style of the
     walk take they overlap most."""
     right = total = 0
     walk = annotated.model.classes.index("walk")
     from stylemotion.annotate.annotation import drop_short_runs
 
-    for doc, raw in zip(annotated.documents, annotated.raw_labels(tau, tol)):
+    for doc, raw in zip(annotated.documents, annotated.raw_labels(tau, tol, sub)):
         labels = drop_short_runs(raw, min_run)
         edges = np.flatnonzero(np.diff(np.r_[-2, labels, -2]) != 0)
         for s, e in zip(edges[:-1], edges[1:]):
@@ -223,37 +253,51 @@ def _run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
 
     takeset, split, split_cfg = _load_bandai()
     fps = float(takeset.fps)
-    candidates = [(tau, tol, mr) for tol in KEYFRAME_TOLERANCES for tau in TAUS for mr in MIN_RUNS]
-    val_scores: dict[str, list[dict[str, float]]] = {_key(*c): [] for c in candidates}
+    candidates = [(tau, tol, mr, sub) for sub in SUB_FRAMES for tol in (KEYFRAME_TOLERANCES if sub == 0 else (None,))
+                  for tau in TAUS for mr in MIN_RUNS]
+    val_scores: dict[str, dict[str, list[dict[str, float]]]] = {k: {_key(*c): [] for c in candidates} for k in KINDS}
     per_seed: dict[int, dict[str, Any]] = {}
     for seed in seeds:
         model = learn_model(split["train"], fps, args.per_class, seed, tensors=False)
         rng = np.random.default_rng([seed, 1])
         docs = {part: partition_documents(_pool(split[part], args.take_fraction, rng), fps, args.seconds, rng,
                                           args.blend) for part in ("val", "test")}
+        cut_rng = np.random.default_rng([seed, 3])
+        docs.update({f"{part}_cuts": partition_documents(_cuts(_pool(split[part], args.take_fraction, rng), cut_rng),
+                                                         fps, args.seconds, rng, args.blend)
+                     for part in ("val", "test")})
         annotated = {part: _Annotated(d, model) for part, d in docs.items()}
-        for tol in KEYFRAME_TOLERANCES:
-            for tau in TAUS:
-                raws = annotated["val"].raw_labels(tau, tol)
-                for mr in MIN_RUNS:
-                    preds = [_names(drop_short_runs(raw, mr), model.classes) for raw in raws]
-                    val_scores[_key(tau, tol, mr)].append(_pooled(docs["val"], preds))
-        annotated["val"]._variants.clear()                       # free memory: val is done
-        per_seed[seed] = {"model": model, "annotated": annotated["test"], "docs": docs}
+        for kind, part in zip(KINDS, ("val", "val_cuts")):
+            for sub in SUB_FRAMES:
+                for tol in KEYFRAME_TOLERANCES if sub == 0 else (None,):
+                    for tau in TAUS:
+                        raws = annotated[part].raw_labels(tau, tol, sub)
+                        for mr in MIN_RUNS:
+                            preds = [_names(drop_short_runs(raw, mr), model.classes) for raw in raws]
+                            val_scores[kind][_key(tau, tol, mr, sub)].append(_pooled(docs[part], preds))
+            annotated[part]._variants.clear()                    # free memory: val is done
+        per_seed[seed] = {"model": model, "annotated": annotated["test"], "annotated_cuts": annotated["test_cuts"],
+                          "docs": docs}
 
-    def objective(key: str) -> float:
-        return float(np.mean([(s["F1"] + s["F2"]) / 2 for s in val_scores[key]]))
+    def objective(key: str, kinds: tuple[str, ...] = KINDS) -> float:
+        return float(np.mean([(s["F1"] + s["F2"]) / 2 for k in kinds for s in val_scores[k][key]]))
 
-    # the best objective; among equals the first in candidate order (key frames off before on, then the
-    # smaller τ, then the smaller min_run)
+    # the best objective; among equals the first in candidate order (whole templates before windows, key frames
+    # off before on, then the smaller τ, then the smaller min_run)
     best = max(candidates, key=lambda c: objective(_key(*c)))
-    tau, tol, min_run = best
-    chosen = {"tau": tau, "keyframes": tol, "min_run": min_run}
-    reported = {"chosen": best, "old default": (OLD_DEFAULT["tau"], OLD_DEFAULT["keyframes"], OLD_DEFAULT["min_run"]),
-                ("chosen, no key frames" if tol is not None else "chosen, key frames on (tolerance 0.1)"):
-                    (tau, None if tol is not None else 0.1, min_run),
-                "thesis' procedure (chosen τ, no min_run)": (tau, tol, 0)}
+    tau, tol, min_run, sub = best
+    chosen = {"tau": tau, "keyframes": tol, "min_run": min_run, "sub_frames": sub}
+    whole = max((c for c in candidates if c[3] == 0), key=lambda c: objective(_key(*c)))
+    reported = {"chosen": best,
+                "old default": (OLD_DEFAULT["tau"], OLD_DEFAULT["keyframes"], OLD_DEFAULT["min_run"], 0)}
+    if sub:
+        reported["whole templates (best on val among sub_frames = 0)"] = whole
+    else:
+        reported["chosen, no key frames" if tol is not None else "chosen, key frames on (tolerance 0.1)"] = \
+            (tau, None if tol is not None else 0.1, min_run, 0)
+    reported["thesis' procedure (chosen τ, no min_run)"] = (tau, tol, 0, sub)
     test_rows: dict[str, dict[str, Any]] = {}
+    cut_rows: dict[str, dict[str, Any]] = {}
     per_class: dict[str, dict[str, list[float]]] = {}
     parts_failures: list[dict[str, Any]] = []
     cross: list[dict[str, Any]] = []
@@ -264,6 +308,9 @@ def _run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
             preds = annotated.labels(*setting)
             scores = _pooled(docs["test"], preds)
             test_rows.setdefault(name, {"setting": _key(*setting), "seeds": []})["seeds"].append(scores)
+            cut_preds = per_seed[seed]["annotated_cuts"].labels(*setting)
+            cut_rows.setdefault(name, {"setting": _key(*setting), "seeds": []})["seeds"].append(
+                _pooled(docs["test_cuts"], cut_preds))
             if name == "chosen":
                 parts = [p for doc, pred in zip(docs["test"], preds) for p in part_scores(doc, pred)]
                 recalls = np.array([p["recall"] for p in parts])
@@ -287,9 +334,12 @@ def _run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
         other = _Annotated([doc], annotated.model)
         labels = other.labels(*best)[0]
         walk_frames = [lab for lab, want in zip(labels, doc.labels) if want]
+        whole_frames = [lab for lab, want in zip(other.labels(*whole)[0], doc.labels) if want]
         cross.append({"frames": len(doc.labels), "walk_frames": len(walk_frames), "files_frames": lengths,
                       "labelled": float(np.mean([lab != "" for lab in walk_frames])),
                       "labelled_walk": float(np.mean([lab == "walk" for lab in walk_frames])),
+                      "whole_templates": {"labelled": float(np.mean([lab != "" for lab in whole_frames])),
+                                          "labelled_walk": float(np.mean([lab == "walk" for lab in whole_frames]))},
                       "labels": {c: int(sum(lab == c for lab in labels)) for c in sorted(set(labels) - {""})},
                       "walk_template_frames": next(t.num_frames for t in annotated.model.templates
                                                    if t.label == "walk"),
@@ -339,8 +389,9 @@ def _run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
     return {
         "splits": {
             "takes": take_split_record(split, split_cfg["seed"], split_cfg["val_fraction"], split_cfg["test_fraction"]),
-            "annotation": "templates from train takes (drawn with the seed); τ, min_run and key-frame tolerance "
-                          "chosen on documents of val takes; figures on documents of test takes",
+            "annotation": "templates from train takes (drawn with the seed); τ, min_run, key-frame tolerance and "
+                          "sub_frames chosen on documents of val takes (whole takes and 2–3 s cuts); figures on "
+                          "documents of test takes (both kinds)",
             "tensors": "walk tensor from train walk takes (repetitions drawn with the seed); repetitions chosen "
                        "on val walk takes; figures on test walk takes",
             "other captures": "the other-skeletons walks (other actors, studios, skeletons) as one document, "
@@ -348,20 +399,29 @@ def _run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
         },
         "settings": {"seconds": args.seconds, "blend": args.blend, "per_class": args.per_class,
                      "take_fraction": args.take_fraction, "keyframe_count": 3,
-                     "objective": "mean over seeds of (F1 + F2) / 2 on the val documents"},
+                     "cut_frames": list(CUT_FRAMES), "sub_frames": list(SUB_FRAMES),
+                     "objective": "mean over seeds and the two kinds of val documents (whole takes, cuts) of "
+                                  "(F1 + F2) / 2"},
         "documents": {part: [{"documents": len(per_seed[s]["docs"][part]),
                               "frames": sum(len(d.labels) for d in per_seed[s]["docs"][part]),
                               "takes": sum(len(d.parts) for d in per_seed[s]["docs"][part])} for s in seeds]
-                      for part in ("val", "test")},
+                      for part in ("val", "test", "val_cuts", "test_cuts")},
         "templates": {t.label: t.num_frames for t in per_seed[seeds[0]]["model"].templates},
-        "candidates": [{"tau": c[0], "keyframes": c[1], "min_run": c[2], "objective": objective(_key(*c)),
-                        **{k: spread(s[k] for s in val_scores[_key(*c)]) for k in SCORES}} for c in candidates],
+        "candidates": [{"tau": c[0], "keyframes": c[1], "min_run": c[2], "sub_frames": c[3],
+                        "objective": objective(_key(*c)),
+                        **{f"objective_{k}": objective(_key(*c), (k,)) for k in KINDS},
+                        **{k: spread(s[k] for s in val_scores["takes"][_key(*c)]) for k in SCORES}}
+                       for c in candidates],
         "chosen": chosen, "old_default": OLD_DEFAULT,
         "test": {name: {"setting": row["setting"], **{k: spread(s[k] for s in row["seeds"]) for k in SCORES},
                         "unlabelled": spread(s["unlabelled1"] / s["relevant1"] for s in row["seeds"]),
                         "confused": spread(s["confused1"] / s["relevant1"] for s in row["seeds"]),
                         "spurious_frames": spread(s["spurious1"] for s in row["seeds"]),
                         "per_seed": row["seeds"]} for name, row in test_rows.items()},
+        "test_cuts": {name: {"setting": row["setting"], **{k: spread(s[k] for s in row["seeds"]) for k in SCORES},
+                             "unlabelled": spread(s["unlabelled1"] / s["relevant1"] for s in row["seeds"]),
+                             "confused": spread(s["confused1"] / s["relevant1"] for s in row["seeds"])}
+                      for name, row in cut_rows.items()},
         "test_takes": parts_failures,
         "per_class": {c: {k: spread(v) for k, v in e.items()} for c, e in per_class.items()},
         "other_captures": cross,
@@ -377,8 +437,9 @@ def _run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
 
 # ---------------------------------------------------------------------------------------------------- render
 
-def _setting(tau: float, tol: float | None, min_run: int) -> str:
-    return f"τ = {tau:g}, key frames {'off' if tol is None else f'on (tolerance {tol:g})'}, min_run = {min_run}"
+def _setting(tau: float, tol: float | None, min_run: int, sub: int = 0) -> str:
+    return (f"τ = {tau:g}, key frames {'off' if tol is None else f'on (tolerance {tol:g})'}, min_run = {min_run}, "
+            + ("whole templates" if not sub else f"sub-templates of {sub} frames"))
 
 
 def _counts(rows: list[dict[str, Any]], key: str, total: str) -> str:
@@ -391,7 +452,8 @@ def render(record: dict[str, Any]) -> dict[str, str]:
     prov = provenance_line(record)
     seeds = len(record.get("seeds", []))
     c = r["chosen"]
-    chosen_text = _setting(c["tau"], c["keyframes"], c["min_run"])
+    chosen_text = _setting(c["tau"], c["keyframes"], c["min_run"], c["sub_frames"])
+    cuts = r["test_cuts"]["chosen"]
     test = r["test"]["chosen"]
     t = r["tensor"]
     n_test_docs = spread(d["documents"] for d in r["documents"]["test"])
@@ -409,9 +471,14 @@ def render(record: dict[str, Any]) -> dict[str, str]:
         ["segment P2 / R2 / F2 (same documents)", " / ".join(fmt_spread(test[k], 3) for k in ("P2", "R2", "F2"))],
         ["class frames left unlabelled / given another class",
          f"{fmt_spread(test['unlabelled'], 3)} / {fmt_spread(test['confused'], 3)}"],
+        ["frame F1 / segment F2 on documents of 2–3 s cuts of the test takes (like a user's short recordings)",
+         f"{fmt_spread(cuts['F1'], 3)} / {fmt_spread(cuts['F2'], 3)}"],
         ["test takes with no frame labelled right / under half",
          f"{_counts(failures, 'missed', 'takes')} / {_counts(failures, 'under_half', 'takes')}"],
-        ["**other captures**: 3 walks of other actors and skeletons, one document: labelled / labelled walk",
+        ["**other captures**: 3 walks of other actors and skeletons, one document: labelled / labelled walk "
+         "(whole templates at their best val setting → the choice)",
+         f"{fmt_spread(spread(x['whole_templates']['labelled'] for x in cross), 3)} / "
+         f"{fmt_spread(spread(x['whole_templates']['labelled_walk'] for x in cross), 3)} → "
          f"{fmt_spread(spread(x['labelled'] for x in cross), 3)} / "
          f"{fmt_spread(spread(x['labelled_walk'] for x in cross), 3)}"],
         ["same-length cuts of Bandai test walks joined the same way (control): labelled / labelled walk",
@@ -429,25 +496,33 @@ def render(record: dict[str, Any]) -> dict[str, str]:
     # choice: the best val candidates, the old default and the choice
     cands = sorted(r["candidates"], key=lambda x: -x["objective"])
     show = cands[:8]
-    for want in (r["old_default"],
-                 {"tau": c["tau"], "keyframes": None if c["keyframes"] is not None else 0.1, "min_run": c["min_run"]},
-                 {"tau": c["tau"], "keyframes": c["keyframes"], "min_run": 0}):
-        match = [x for x in cands if (x["tau"], x["keyframes"], x["min_run"]) ==
-                 (want["tau"], want["keyframes"], want["min_run"])]
+    names = ("tau", "keyframes", "min_run", "sub_frames")
+
+    def same(x: dict[str, Any], y: dict[str, Any]) -> bool:
+        return all(x[k] == y[k] for k in names)
+
+    whole = max((x for x in cands if x["sub_frames"] == 0), key=lambda x: x["objective"])
+    for want in (r["old_default"], whole,
+                 {"tau": c["tau"], "keyframes": None if c["keyframes"] is not None else 0.1, "min_run": c["min_run"],
+                  "sub_frames": 0},
+                 {**c, "min_run": 0}):
+        match = [x for x in cands if same(x, want)]
         if match and match[0] not in show:
             show.append(match[0])
     choice_rows = []
     for x in show:
-        mark = " **(chosen)**" if (x["tau"], x["keyframes"], x["min_run"]) == (c["tau"], c["keyframes"], c["min_run"]) \
-            else (" (old default)" if (x["tau"], x["keyframes"], x["min_run"]) ==
-                  (r["old_default"]["tau"], r["old_default"]["keyframes"], r["old_default"]["min_run"]) else "")
+        mark = " **(chosen)**" if same(x, c) else (" (old default)" if same(x, r["old_default"]) else "")
         choice_rows.append([f"{x['tau']:g}", "off" if x["keyframes"] is None else f"{x['keyframes']:g}",
-                            str(x["min_run"]) + mark, fmt(x["objective"], 3),
+                            str(x["min_run"]), ("whole" if not x["sub_frames"] else str(x["sub_frames"])) + mark,
+                            fmt(x["objective"], 3), fmt(x["objective_takes"], 3), fmt(x["objective_cuts"], 3),
                             *[fmt_spread(x[k], 3) for k in SCORES]])
-    choice = (md_table(["τ", "key-frame tolerance", "min_run", "objective", *SCORES], choice_rows)
-              + f"\n\n{len(r['candidates'])} candidates (τ × key frames × min_run); the {min(8, len(cands))} best "
-              f"by objective (among equals the first of: key frames off before on, smaller τ, smaller min_run), "
-              f"then the old default and the choice with the key frames switched / without min_run. Val "
+    choice = (md_table(["τ", "key-frame tolerance", "min_run", "sub-templates", "objective", "on whole takes",
+                        "on cuts", *[f"{k} (whole takes)" for k in SCORES]], choice_rows)
+              + f"\n\n{len(r['candidates'])} candidates (τ × key frames × min_run × sub-template frames; key frames "
+              f"with whole templates only); the {min(8, len(cands))} best by objective (the mean of (F1 + F2) / 2 on "
+              "val documents of whole takes and on val documents of 2–3 s cuts; among equals the first of: whole "
+              "templates before windows, key frames off before on, smaller τ, smaller min_run), then the old default, "
+              "the best with whole templates, the choice with the key frames switched and without min_run. Val "
               f"documents per seed: {fmt(spread(d['documents'] for d in r['documents']['val']).get('mean'), 0)} "
               f"({fmt(spread(d['frames'] for d in r['documents']['val']).get('mean'), 0)} frames){sub}. {prov}")
 
@@ -455,6 +530,10 @@ def render(record: dict[str, Any]) -> dict[str, str]:
                        [[f"{name}: {row['setting']}", *[fmt_spread(row[k], 3) for k in SCORES],
                          fmt_spread(row["unlabelled"], 3), fmt_spread(row["confused"], 3),
                          fmt_spread(row["spurious_frames"], 0)] for name, row in r["test"].items()])
+    table32 += "\n\nThe same settings on documents of 2–3 s cuts of the test takes:\n\n" + md_table(
+        ["setting", *SCORES, "unlabelled", "other class"],
+        [[f"{name}: {row['setting']}", *[fmt_spread(row[k], 3) for k in SCORES], fmt_spread(row["unlabelled"], 3),
+          fmt_spread(row["confused"], 3)] for name, row in r["test_cuts"].items()])
     table32 += (f"\n\nTest documents per seed: {fmt(n_test_docs.get('mean'), 0)} "
                 f"({fmt(spread(d['frames'] for d in r['documents']['test']).get('mean'), 0)} frames, "
                 f"{fmt(spread(d['takes'] for d in r['documents']['test']).get('mean'), 0)} takes){sub}; {easier}. "
@@ -467,14 +546,17 @@ def render(record: dict[str, Any]) -> dict[str, str]:
                            fmt_spread(e["unlabelled"], 3)] for name, e in r["per_class"].items()]) + f"\n\n{prov}"
 
     x0 = cross[0]
-    other = md_table(["seed", "order", "frames (walk)", "labelled", "labelled walk", "labels given (frames)",
-                      "Bandai control: labelled / walk"],
-                     [[str(s), " + ".join(x["order"]), f"{x['frames']} ({x['walk_frames']})", fmt(x["labelled"], 3),
+    other = md_table(["seed", "order", "frames (walk)", "whole templates: labelled / walk", "labelled",
+                      "labelled walk", "labels given (frames)", "Bandai control: labelled / walk"],
+                     [[str(s), " + ".join(x["order"]), f"{x['frames']} ({x['walk_frames']})",
+                       f"{fmt(x['whole_templates']['labelled'], 3)} / {fmt(x['whole_templates']['labelled_walk'], 3)}",
+                       fmt(x["labelled"], 3),
                        fmt(x["labelled_walk"], 3), ", ".join(f"{k} {v}" for k, v in x["labels"].items()) or "none",
                        f"{fmt(x['bandai_control']['labelled'], 3)} / {fmt(x['bandai_control']['labelled_walk'], 3)}"]
                       for s, x in zip(record.get("seeds", []), cross)])
     other += (f"\n\nFrames per file at 30 fps: {', '.join(f'{k} {v}' for k, v in x0['files_frames'].items())}; "
-              f"the walk template has {x0['walk_template_frames']} frames (a match needs at least half of them). "
+              f"the walk template has {x0['walk_template_frames']} frames (a match of the whole template needs at "
+              f"least half of them; the choice: {_setting(c['tau'], c['keyframes'], c['min_run'], c['sub_frames'])}). "
               f"{prov}")
 
     tensor_choice = md_table(["repetitions per style", "val accuracy"],

@@ -8,6 +8,11 @@ Each frame then gets the class of the smallest ``Δ̄_p^τ`` (eqs. 3.1–3.2), o
 
 Beyond the thesis, labelled runs shorter than ``min_run`` frames are left unlabelled afterwards.
 
+Sub-templates (§3.3's ``M_p``): with ``sub_frames`` > 0 each class template is cut into windows of that many frames
+(:func:`~.templates.sub_templates`, half overlapping) and ``Δ_p(ℓ)`` is the least over the class's windows of their
+subsequence DTW costs, with that window's start. A document part shorter than half a whole template (a 2-s walk
+against a 7-s walk template) can then still be matched, and one window of a class's cycle stands for the class.
+
 Key-frame preselection: a class's key frames are a few columns of its quantized template (spread over its
 length, each the column with most consistent entries in its neighbourhood). A hit survives only when the
 document has frames matching its key frames (at most ``keyframe_tolerance`` of their consistent entries
@@ -23,7 +28,7 @@ import numpy as np
 
 from stylemotion.annotate.settings import AnnotateSettings, KeyframeSettings
 from stylemotion.annotate.subsequence import subsequence_dtw
-from stylemotion.annotate.templates import MotionTemplate, local_cost
+from stylemotion.annotate.templates import MotionTemplate, local_cost, sub_templates
 from stylemotion.io.errors import UserInputError
 
 #: Matching threshold τ: ``stylemotion-annotate``'s ``tau`` (:class:`AnnotateSettings`, where it is set and why).
@@ -137,15 +142,18 @@ class AnnotationSettings:
     contradict; ``min_run``: shortest labelled run kept, frames (shorter slivers, where one class's hit
     overlays another's, are left unlabelled; 30 = 1 s at 30 fps; 0 disables it).
 
-    ``tau``, ``keyframes``, ``keyframe_tolerance`` and ``min_run`` were chosen on documents of Bandai val takes
-    (suite ``annotate``: key frames off ties with the best tolerance, 0.2, and the simpler setting wins);
-    ``keyframe_count`` is not tuned. The defaults are ``stylemotion-annotate``'s (:class:`AnnotateSettings`)."""
+    ``sub_frames``: frames of the sub-templates cut from each class template (module doc; 0: whole templates).
+
+    ``tau``, ``keyframes``, ``keyframe_tolerance``, ``min_run`` and ``sub_frames`` were chosen on documents of
+    Bandai val takes (suite ``annotate``); ``keyframe_count`` is not tuned. The defaults are
+    ``stylemotion-annotate``'s (:class:`AnnotateSettings`)."""
 
     tau: float = DEFAULT_TAU
     keyframes: bool = KeyframeSettings.use
     keyframe_count: int = KeyframeSettings.count
     keyframe_tolerance: float = KeyframeSettings.tolerance
     min_run: int = AnnotateSettings.min_run
+    sub_frames: int = AnnotateSettings.sub_frames
 
 
 @dataclass(frozen=True)
@@ -173,22 +181,32 @@ def class_distances(document: np.ndarray, templates: Sequence[MotionTemplate],
     if doc.ndim != 2 or any(t.values.shape[1] != doc.shape[1] for t in templates):
         raise AnnotationInputError(f"document features {doc.shape} do not fit the templates' "
                                    f"{sorted({t.values.shape[1] for t in templates})} features")
-    shortest = min(templates, key=lambda t: t.num_frames)
+    if settings.sub_frames < 0:
+        raise AnnotationInputError(f"sub_frames={settings.sub_frames} must be ≥ 0 (0: whole templates)")
+    windows = [sub_templates(t, settings.sub_frames) for t in templates]
+    shortest = min((w for ws in windows for w in ws), key=lambda t: t.num_frames)
     if doc.shape[0] < (shortest.num_frames + 1) // 2:
         raise AnnotationInputError(f"the document has {doc.shape[0]} frames, shorter than any template can match "
                                    f"(the shortest, {shortest.label!r}, has {shortest.num_frames} frames and needs "
                                    f"≥ {(shortest.num_frames + 1) // 2})")
     deltas, starts, keeps = [], [], []
-    for template in templates:
-        d, s = subsequence_dtw(local_cost(template, doc))
-        keep = np.ones(doc.shape[0], dtype=bool)
-        if settings.keyframes:
-            keys = keyframe_columns(template, settings.keyframe_count)
-            matches = keyframe_matches(template, doc, keys, settings.keyframe_tolerance)
-            keep = keys_in_order(matches, s) & np.isfinite(d)
-        deltas.append(d)
-        starts.append(s)
-        keeps.append(keep)
+    for parts in windows:
+        best_d = np.full(doc.shape[0], np.inf)
+        best_s = np.full(doc.shape[0], -1, dtype=np.int64)
+        best_keep = np.ones(doc.shape[0], dtype=bool)
+        for template in parts:
+            d, s = subsequence_dtw(local_cost(template, doc))
+            keep = np.ones(doc.shape[0], dtype=bool)
+            if settings.keyframes:
+                keys = keyframe_columns(template, settings.keyframe_count)
+                matches = keyframe_matches(template, doc, keys, settings.keyframe_tolerance)
+                keep = keys_in_order(matches, s) & np.isfinite(d)
+            better = d < best_d
+            best_d, best_s, best_keep = (np.where(better, d, best_d), np.where(better, s, best_s),
+                                         np.where(better, keep, best_keep))
+        deltas.append(best_d)
+        starts.append(best_s)
+        keeps.append(best_keep)
     return ClassDistances(tuple(t.label for t in templates), np.stack(deltas), np.stack(starts), np.stack(keeps))
 
 

@@ -138,9 +138,10 @@ def annotate(document: str, templates: str | os.PathLike, out: str | os.PathLike
         raise AnnotateInputError(str(exc)) from None
     positions, record = load_document(document, model.fps, conversion)
     shortest = min(model.templates, key=lambda t: t.num_frames)
-    if positions.shape[0] < shortest.num_frames:
+    least = shortest.num_frames if settings.sub_frames <= 0 else min(settings.sub_frames, shortest.num_frames)
+    if positions.shape[0] < least:
         raise AnnotateInputError(f"document={document}: {positions.shape[0]} frames at {model.fps:g} fps is shorter "
-                                 f"than every template (the shortest, {shortest.label!r}, has {shortest.num_frames})")
+                                 f"than every template (the shortest, {shortest.label!r}, matches with {least})")
     try:
         labels, records = annotate_positions(positions, model, settings)
     except AnnotationInputError as exc:
@@ -149,7 +150,8 @@ def annotate(document: str, templates: str | os.PathLike, out: str | os.PathLike
               "classes": list(model.classes), "tensors": sorted(model.tensors),
               "settings": {"tau": settings.tau, "keyframes": settings.keyframes,
                            "keyframe_count": settings.keyframe_count,
-                           "keyframe_tolerance": settings.keyframe_tolerance, "min_run": settings.min_run},
+                           "keyframe_tolerance": settings.keyframe_tolerance, "min_run": settings.min_run,
+                           "sub_frames": settings.sub_frames},
               "labelled_fraction": round(float(np.mean([lab != "" for lab in labels])), 4),
               "segments": records, "provenance": provenance(command or None)}
     with atomic_folder(out, on_exists=lambda: check_new_output(out, force)) as tmp:
@@ -178,6 +180,7 @@ def annotate_from_config(cfg: DictConfig, command: str = "") -> Any:
                                  "data=<dataset> out=<folder>)")
     settings = AnnotationSettings(tau=s.tau, keyframes=s.keyframes.use,
                                   keyframe_count=positive_int(s.keyframes.count, "keyframes.count"),
-                                  keyframe_tolerance=s.keyframes.tolerance, min_run=s.min_run)
+                                  keyframe_tolerance=s.keyframes.tolerance, min_run=s.min_run,
+                                  sub_frames=s.sub_frames)
     return annotate(str(s.document), s.templates, s.out, settings=settings, conversion=conversion_keys(vars(s)),
                     force=s.force, command=command)

@@ -44,7 +44,9 @@ class AnnotateSettings(MotionFileKeys):
     val takes by ``python scripts/benchmarks.py run annotate``; benchmarks/annotate.md has the test figures):
     ``tau``: matching threshold τ of the masked template distance (the thesis used 0.13 with its features; our
     masked costs are smaller); ``keyframes``: :class:`KeyframeSettings`; ``min_run``: labelled runs shorter than
-    this (frames) are left unlabelled, 0 = the thesis as is.
+    this (frames) are left unlabelled, 0 = the thesis as is; ``sub_frames``: each class template is matched as
+    half-overlapping windows of this many frames (§3.3's sub-templates), so parts shorter than half a template
+    (a 2-s walk) can be found; 0 = whole templates.
 
     ``joint_map``, ``unit_scale``, ``up_axis``: the document's (:class:`~stylemotion.config.MotionFileKeys`).
     ``out``: a new folder (an existing one is refused unless ``force``).
@@ -59,5 +61,6 @@ class AnnotateSettings(MotionFileKeys):
     tau: float = 0.025
     keyframes: KeyframeSettings = field(default_factory=KeyframeSettings)
     min_run: int = 30
+    sub_frames: int = 0
     out: str = "runs/annotate/${now:%Y-%m-%d_%H-%M-%S}"
     force: bool = False

@@ -106,6 +106,20 @@ def learn_template(label: str, examples: Sequence[np.ndarray], iterations: int =
     return MotionTemplate(label, np.clip(template, 0.0, 1.0), len(xs), delta)
 
 
+def sub_templates(template: MotionTemplate, frames: int) -> list[MotionTemplate]:
+    """Windows of ``frames`` template frames cut from ``template`` (§3.3's sub-templates ``M_p``), each a template
+    of the same class: one every ``frames // 2`` frames from the first, and the last ending at the template's last
+    frame. ``frames`` ≤ 0 or at least the template's length: the template itself."""
+    n = template.num_frames
+    if frames <= 0 or frames >= n:
+        return [template]
+    starts = list(range(0, n - frames + 1, max(frames // 2, 1)))
+    if starts[-1] != n - frames:
+        starts.append(n - frames)
+    return [MotionTemplate(template.label, template.values[a:a + frames], template.examples, template.delta)
+            for a in starts]
+
+
 def local_cost(template: MotionTemplate, document: np.ndarray) -> np.ndarray:
     """Masked distance ``c(i, j)`` between template frame ``i`` and document frame ``j``: the fraction of the
     consistent entries of column ``i`` that the document's features contradict (0 where none is consistent).

@@ -155,3 +155,25 @@ def test_document_shorter_than_the_templates():
     t = MotionTemplate("long", np.zeros((40, 3)), 2)
     with pytest.raises(AnnotationInputError, match="shorter than any template"):
         annotate_features(np.zeros((10, 3), dtype=bool), [t], AnnotationSettings())
+
+
+def test_sub_templates_find_a_part_shorter_than_half_the_template():
+    """A document holding a third of a class's pattern: the whole template cannot match it (tempo at most 2×),
+    windows of the template can, and they label the planted frames with the class."""
+    rng = np.random.default_rng(3)
+    pattern = rng.random((60, 8)) > 0.5
+    template = MotionTemplate("walk", pattern.astype(float), 9)
+    noise = ~pattern[::-1][:40]                            # frames contradicting the pattern everywhere near
+    document = np.concatenate([noise, pattern[20:40], noise])
+    whole = annotate_features(document, [template], AnnotationSettings(tau=0.05, min_run=0))
+    assert (whole.labels < 0).all()
+    parts = annotate_features(document, [template], AnnotationSettings(tau=0.05, min_run=0, sub_frames=20))
+    planted = parts.labels[40:60]
+    assert (planted == 0).mean() >= 0.9
+    assert (parts.labels[:30] < 0).all() and (parts.labels[70:] < 0).all()
+
+
+def test_negative_sub_frames_are_refused():
+    t = MotionTemplate("walk", np.zeros((40, 3)), 2)
+    with pytest.raises(AnnotationInputError, match="sub_frames=-1"):
+        annotate_features(np.zeros((60, 3), dtype=bool), [t], AnnotationSettings(sub_frames=-1))

@@ -2,7 +2,13 @@ import numpy as np
 import pytest
 
 from stylemotion.annotate.subsequence import subsequence_dtw
-from stylemotion.annotate.templates import MotionTemplate, TemplateInputError, learn_template, local_cost
+from stylemotion.annotate.templates import (
+    MotionTemplate,
+    TemplateInputError,
+    learn_template,
+    local_cost,
+    sub_templates,
+)
 
 
 def test_identical_examples_give_a_consistent_template():
@@ -43,3 +49,14 @@ def test_subsequence_dtw_finds_a_planted_segment():
     end = int(np.argmin(delta))
     assert delta[end] == 0.0 and 20 <= start[end] and end <= 31
     assert np.isinf(delta[:2]).all()                       # a 6-frame template needs ≥ 3 document frames
+
+
+def test_sub_templates_cover_the_template_half_overlapping():
+    values = np.random.default_rng(1).random((50, 4))
+    parts = sub_templates(MotionTemplate("walk", values, 9), 20)
+    assert [p.num_frames for p in parts] == [20] * 4 and all(p.label == "walk" and p.examples == 9 for p in parts)
+    starts = [int(np.flatnonzero((values == p.values[0]).all(1))[0]) for p in parts]
+    assert starts == [0, 10, 20, 30]                      # every 10 frames, the last ending at frame 49
+    assert np.array_equal(parts[-1].values, values[30:])
+    assert sub_templates(MotionTemplate("walk", values, 9), 0)[0].values is values
+    assert len(sub_templates(MotionTemplate("walk", values, 9), 50)) == 1
