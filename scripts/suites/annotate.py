@@ -33,11 +33,16 @@ DEFAULT_SEEDS = (0, 1, 2)
 TAUS = (0.01, 0.015, 0.02, 0.025, 0.03, 0.04, 0.05, 0.08, 0.13)
 MIN_RUNS = (0, 10, 20, 30, 45, 60)
 KEYFRAME_TOLERANCES = (None, 0.0, 0.1, 0.2)      # None: no key-frame preselection
-SUB_FRAMES = (0, 30, 45, 60, 90)                # 0: whole templates; else windows of that many frames (key frames off)
+SUB_FRAMES = (0, 45, 90)                        # 0: whole templates; else windows of that many frames (key frames off)
+#: The turning layer (z: classes whose mean turning rates lie z × (sd + sd) apart compete; seconds per piece);
+#: (0, 0): off. A first smoke run (one seed, 30 % of the
+#: takes) also tried sub-templates of 30 and 60 frames: every one scored below 45 and 90 on val.
+TURNING = ((0.0, 0.0),) + tuple((z, w) for z in (1.0, 2.0, 3.0) for w in (0.0, 2.0, 4.0))
 CUT_FRAMES = (60, 90)                           # a cut's length, drawn per take (2–3 s at 30 fps)
 KINDS = ("takes", "cuts")                       # the two kinds of documents
 REPETITIONS = (2, 3, 5, 8, 10, None)                  # None: as many as every style has
-OLD_DEFAULT = {"tau": 0.02, "keyframes": 0.1, "min_run": 30, "sub_frames": 0}   # the defaults before any choice
+OLD_DEFAULT = {"tau": 0.02, "keyframes": 0.1, "min_run": 30, "sub_frames": 0, "turning_z": 0.0,  # before any choice
+               "turning_window_s": 0.0}
 OTHER_CAPTURES = ("walk_21joint_60fps.bvh", "female-walk_21joint_60fps.bvh", "xia_neutral_01_000_31joint_120fps.bvh")
 SCORES = ("P1", "R1", "F1", "P2", "R2", "F2")
 
@@ -50,8 +55,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="share of the val and test takes each seed uses (a seeded draw; 1 = all)")
 
 
-def _key(tau: float, tol: float | None, min_run: int, sub: int = 0) -> str:
-    return f"tau={tau:g} keyframes={'off' if tol is None else f'{tol:g}'} min_run={min_run} sub_frames={sub}"
+def _key(tau: float, tol: float | None, min_run: int, sub: int = 0, z: float = 0.0, w: float = 0.0) -> str:
+    return (f"tau={tau:g} keyframes={'off' if tol is None else f'{tol:g}'} min_run={min_run} sub_frames={sub} "
+            f"turning_z={z:g} turning_window_s={w:g}")
 
 
 def _pooled(documents, predictions) -> dict[str, float]:
@@ -82,7 +88,26 @@ class _Annotated:
         self.features_s = time.perf_counter() - t0
         self.distances_s = 0.0
         self._variants: dict[tuple[float | None, int], list] = {}
+        self._families: dict[float, dict[str, set[str]]] = {}
+        self.yaw = None
         self.base(0)
+
+    def refined(self, labels: list[np.ndarray], tau: float, tol: float | None, sub: int, z: float, w: float = 0.0
+                ) -> list[np.ndarray]:
+        """``labels`` (one int array per document) after the turning layer at ``z`` sd in pieces of ``w`` s (``z``
+        0: as they are)."""
+        from stylemotion.annotate.turning import document_yaw, refine_by_turning, template_families
+
+        statistics = self.model.record.get("turning")
+        if z <= 0 or not statistics:
+            return labels
+        if self.yaw is None:
+            self.yaw = [document_yaw(d.positions, d.fps) for d in self.documents]
+        if tau not in self._families:
+            self._families[tau] = template_families(self.model.templates, tau)
+        return [refine_by_turning(lab, d.classes, d.delta, yaw, doc.fps, statistics, self._families[tau], z,
+                                  int(round(w * doc.fps)))
+                for lab, d, yaw, doc in zip(labels, self.distances(tol, sub), self.yaw, self.documents)]
 
     def base(self, sub: int) -> list:
         from stylemotion.annotate.annotation import AnnotationSettings, class_distances
@@ -113,11 +138,17 @@ class _Annotated:
 
         return [annotate_distances(d, tau, tol is not None, 0).labels for d in self.distances(tol, sub)]
 
-    def labels(self, tau: float, tol: float | None, min_run: int, sub: int = 0) -> list[list[str]]:
+    def indices(self, tau: float, tol: float | None, min_run: int, sub: int = 0, z: float = 0.0,
+                w: float = 0.0) -> list[np.ndarray]:
+        """Per document the frame labels (int, -1 = none) after ``min_run`` and the turning layer."""
         from stylemotion.annotate.annotation import drop_short_runs
 
-        classes = self.model.classes
-        return [_names(drop_short_runs(raw, min_run), classes) for raw in self.raw_labels(tau, tol, sub)]
+        return self.refined([drop_short_runs(raw, min_run) for raw in self.raw_labels(tau, tol, sub)], tau, tol,
+                            sub, z, w)
+
+    def labels(self, tau: float, tol: float | None, min_run: int, sub: int = 0, z: float = 0.0,
+               w: float = 0.0) -> list[list[str]]:
+        return [_names(lab, self.model.classes) for lab in self.indices(tau, tol, min_run, sub, z, w)]
 
 
 def _load_bandai():
@@ -213,15 +244,12 @@ def _truncation(tensor, theta: np.ndarray) -> list[dict[str, Any]]:
 
 
 def _walk_segment_styles(annotated: _Annotated, tensor, tau: float, tol: float | None,
-                         min_run: int, sub: int = 0) -> tuple[int, int]:
+                         min_run: int, sub: int = 0, z: float = 0.0, w: float = 0.0) -> tuple[int, int]:
     """Walk segments the annotation finds in the documents, and how many the tensor gives the style of the
     walk take they overlap most."""
     right = total = 0
     walk = annotated.model.classes.index("walk")
-    from stylemotion.annotate.annotation import drop_short_runs
-
-    for doc, raw in zip(annotated.documents, annotated.raw_labels(tau, tol, sub)):
-        labels = drop_short_runs(raw, min_run)
+    for doc, labels in zip(annotated.documents, annotated.indices(tau, tol, min_run, sub, z, w)):
         edges = np.flatnonzero(np.diff(np.r_[-2, labels, -2]) != 0)
         for s, e in zip(edges[:-1], edges[1:]):
             if labels[s] != walk or e - s < 2:
@@ -253,8 +281,8 @@ def _run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
 
     takeset, split, split_cfg = _load_bandai()
     fps = float(takeset.fps)
-    candidates = [(tau, tol, mr, sub) for sub in SUB_FRAMES for tol in (KEYFRAME_TOLERANCES if sub == 0 else (None,))
-                  for tau in TAUS for mr in MIN_RUNS]
+    candidates = [(tau, tol, mr, sub, z, w) for z, w in TURNING for sub in SUB_FRAMES
+                  for tol in (KEYFRAME_TOLERANCES if sub == 0 else (None,)) for tau in TAUS for mr in MIN_RUNS]
     val_scores: dict[str, dict[str, list[dict[str, float]]]] = {k: {_key(*c): [] for c in candidates} for k in KINDS}
     per_seed: dict[int, dict[str, Any]] = {}
     for seed in seeds:
@@ -273,8 +301,11 @@ def _run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
                     for tau in TAUS:
                         raws = annotated[part].raw_labels(tau, tol, sub)
                         for mr in MIN_RUNS:
-                            preds = [_names(drop_short_runs(raw, mr), model.classes) for raw in raws]
-                            val_scores[kind][_key(tau, tol, mr, sub)].append(_pooled(docs[part], preds))
+                            short = [drop_short_runs(raw, mr) for raw in raws]
+                            for z, w in TURNING:
+                                preds = [_names(lab, model.classes)
+                                         for lab in annotated[part].refined(short, tau, tol, sub, z, w)]
+                                val_scores[kind][_key(tau, tol, mr, sub, z, w)].append(_pooled(docs[part], preds))
             annotated[part]._variants.clear()                    # free memory: val is done
         per_seed[seed] = {"model": model, "annotated": annotated["test"], "annotated_cuts": annotated["test_cuts"],
                           "docs": docs}
@@ -285,17 +316,18 @@ def _run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
     # the best objective; among equals the first in candidate order (whole templates before windows, key frames
     # off before on, then the smaller τ, then the smaller min_run)
     best = max(candidates, key=lambda c: objective(_key(*c)))
-    tau, tol, min_run, sub = best
-    chosen = {"tau": tau, "keyframes": tol, "min_run": min_run, "sub_frames": sub}
-    whole = max((c for c in candidates if c[3] == 0), key=lambda c: objective(_key(*c)))
+    tau, tol, min_run, sub, z, w = best
+    chosen = {"tau": tau, "keyframes": tol, "min_run": min_run, "sub_frames": sub, "turning_z": z,
+              "turning_window_s": w}
+    whole = max((c for c in candidates if c[3] == 0 and c[4] == 0), key=lambda c: objective(_key(*c)))
     reported = {"chosen": best,
-                "old default": (OLD_DEFAULT["tau"], OLD_DEFAULT["keyframes"], OLD_DEFAULT["min_run"], 0)}
-    if sub:
-        reported["whole templates (best on val among sub_frames = 0)"] = whole
-    else:
+                "old default": (OLD_DEFAULT["tau"], OLD_DEFAULT["keyframes"], OLD_DEFAULT["min_run"], 0, 0.0, 0.0)}
+    if sub or z:
+        reported["whole templates alone (best on val without sub-templates or turning layer)"] = whole
+    if not sub:
         reported["chosen, no key frames" if tol is not None else "chosen, key frames on (tolerance 0.1)"] = \
-            (tau, None if tol is not None else 0.1, min_run, 0)
-    reported["thesis' procedure (chosen τ, no min_run)"] = (tau, tol, 0, sub)
+            (tau, None if tol is not None else 0.1, min_run, 0, z, w)
+    reported["thesis' procedure (chosen τ, no min_run)"] = (tau, tol, 0, sub, z, w)
     test_rows: dict[str, dict[str, Any]] = {}
     cut_rows: dict[str, dict[str, Any]] = {}
     per_class: dict[str, dict[str, list[float]]] = {}
@@ -400,6 +432,7 @@ def _run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
         "settings": {"seconds": args.seconds, "blend": args.blend, "per_class": args.per_class,
                      "take_fraction": args.take_fraction, "keyframe_count": 3,
                      "cut_frames": list(CUT_FRAMES), "sub_frames": list(SUB_FRAMES),
+                     "turning": [list(t) for t in TURNING],
                      "objective": "mean over seeds and the two kinds of val documents (whole takes, cuts) of "
                                   "(F1 + F2) / 2"},
         "documents": {part: [{"documents": len(per_seed[s]["docs"][part]),
@@ -407,7 +440,8 @@ def _run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
                               "takes": sum(len(d.parts) for d in per_seed[s]["docs"][part])} for s in seeds]
                       for part in ("val", "test", "val_cuts", "test_cuts")},
         "templates": {t.label: t.num_frames for t in per_seed[seeds[0]]["model"].templates},
-        "candidates": [{"tau": c[0], "keyframes": c[1], "min_run": c[2], "sub_frames": c[3],
+        "candidates": [{"tau": c[0], "keyframes": c[1], "min_run": c[2], "sub_frames": c[3], "turning_z": c[4],
+                        "turning_window_s": c[5],
                         "objective": objective(_key(*c)),
                         **{f"objective_{k}": objective(_key(*c), (k,)) for k in KINDS},
                         **{k: spread(s[k] for s in val_scores["takes"][_key(*c)]) for k in SCORES}}
@@ -437,9 +471,14 @@ def _run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
 
 # ---------------------------------------------------------------------------------------------------- render
 
-def _setting(tau: float, tol: float | None, min_run: int, sub: int = 0) -> str:
+def _turning(z: float, w: float) -> str:
+    return "off" if not z else f"z = {z:g}, " + ("whole runs" if not w else f"{w:g} s pieces")
+
+
+def _setting(tau: float, tol: float | None, min_run: int, sub: int = 0, z: float = 0.0, w: float = 0.0) -> str:
     return (f"τ = {tau:g}, key frames {'off' if tol is None else f'on (tolerance {tol:g})'}, min_run = {min_run}, "
-            + ("whole templates" if not sub else f"sub-templates of {sub} frames"))
+            + ("whole templates" if not sub else f"sub-templates of {sub} frames") + ", turning layer "
+            + _turning(z, w))
 
 
 def _counts(rows: list[dict[str, Any]], key: str, total: str) -> str:
@@ -452,7 +491,8 @@ def render(record: dict[str, Any]) -> dict[str, str]:
     prov = provenance_line(record)
     seeds = len(record.get("seeds", []))
     c = r["chosen"]
-    chosen_text = _setting(c["tau"], c["keyframes"], c["min_run"], c["sub_frames"])
+    chosen_text = _setting(*(c[k] for k in ("tau", "keyframes", "min_run", "sub_frames", "turning_z",
+                                            "turning_window_s")))
     cuts = r["test_cuts"]["chosen"]
     test = r["test"]["chosen"]
     t = r["tensor"]
@@ -476,7 +516,7 @@ def render(record: dict[str, Any]) -> dict[str, str]:
         ["test takes with no frame labelled right / under half",
          f"{_counts(failures, 'missed', 'takes')} / {_counts(failures, 'under_half', 'takes')}"],
         ["**other captures**: 3 walks of other actors and skeletons, one document: labelled / labelled walk "
-         "(whole templates at their best val setting → the choice)",
+         "(the templates alone at their best val setting → the choice)",
          f"{fmt_spread(spread(x['whole_templates']['labelled'] for x in cross), 3)} / "
          f"{fmt_spread(spread(x['whole_templates']['labelled_walk'] for x in cross), 3)} → "
          f"{fmt_spread(spread(x['labelled'] for x in cross), 3)} / "
@@ -496,15 +536,14 @@ def render(record: dict[str, Any]) -> dict[str, str]:
     # choice: the best val candidates, the old default and the choice
     cands = sorted(r["candidates"], key=lambda x: -x["objective"])
     show = cands[:8]
-    names = ("tau", "keyframes", "min_run", "sub_frames")
+    names = ("tau", "keyframes", "min_run", "sub_frames", "turning_z", "turning_window_s")
 
     def same(x: dict[str, Any], y: dict[str, Any]) -> bool:
         return all(x[k] == y[k] for k in names)
 
-    whole = max((x for x in cands if x["sub_frames"] == 0), key=lambda x: x["objective"])
-    for want in (r["old_default"], whole,
-                 {"tau": c["tau"], "keyframes": None if c["keyframes"] is not None else 0.1, "min_run": c["min_run"],
-                  "sub_frames": 0},
+    whole = max((x for x in cands if x["sub_frames"] == 0 and x["turning_z"] == 0), key=lambda x: x["objective"])
+    for want in (r["old_default"], whole, {**c, "turning_z": 0.0, "turning_window_s": 0.0},
+                 {**c, "keyframes": None if c["keyframes"] is not None else 0.1, "sub_frames": 0},
                  {**c, "min_run": 0}):
         match = [x for x in cands if same(x, want)]
         if match and match[0] not in show:
@@ -513,16 +552,20 @@ def render(record: dict[str, Any]) -> dict[str, str]:
     for x in show:
         mark = " **(chosen)**" if same(x, c) else (" (old default)" if same(x, r["old_default"]) else "")
         choice_rows.append([f"{x['tau']:g}", "off" if x["keyframes"] is None else f"{x['keyframes']:g}",
-                            str(x["min_run"]), ("whole" if not x["sub_frames"] else str(x["sub_frames"])) + mark,
+                            str(x["min_run"]), "whole" if not x["sub_frames"] else str(x["sub_frames"]),
+                            _turning(x["turning_z"], x["turning_window_s"]) + mark,
                             fmt(x["objective"], 3), fmt(x["objective_takes"], 3), fmt(x["objective_cuts"], 3),
                             *[fmt_spread(x[k], 3) for k in SCORES]])
-    choice = (md_table(["τ", "key-frame tolerance", "min_run", "sub-templates", "objective", "on whole takes",
+    choice = (md_table(["τ", "key-frame tolerance", "min_run", "sub-templates", "turning layer", "objective",
+                        "on whole takes",
                         "on cuts", *[f"{k} (whole takes)" for k in SCORES]], choice_rows)
-              + f"\n\n{len(r['candidates'])} candidates (τ × key frames × min_run × sub-template frames; key frames "
-              f"with whole templates only); the {min(8, len(cands))} best by objective (the mean of (F1 + F2) / 2 on "
-              "val documents of whole takes and on val documents of 2–3 s cuts; among equals the first of: whole "
-              "templates before windows, key frames off before on, smaller τ, smaller min_run), then the old default, "
-              "the best with whole templates, the choice with the key frames switched and without min_run. Val "
+              + f"\n\n{len(r['candidates'])} candidates (τ × key frames × min_run × sub-template frames × turning "
+              f"layer; key frames with whole templates only); the {min(8, len(cands))} best by objective (the mean of "
+              "(F1 + F2) / 2 on "
+              "val documents of whole takes and on val documents of 2–3 s cuts; among equals the first of: turning "
+              "layer off before on, whole templates before windows, key frames off before on, smaller τ, smaller "
+              "min_run), then the old default, the best of the templates alone, the choice without the turning "
+              "layer, with the key frames switched and without min_run. Val "
               f"documents per seed: {fmt(spread(d['documents'] for d in r['documents']['val']).get('mean'), 0)} "
               f"({fmt(spread(d['frames'] for d in r['documents']['val']).get('mean'), 0)} frames){sub}. {prov}")
 
@@ -556,7 +599,7 @@ def render(record: dict[str, Any]) -> dict[str, str]:
                       for s, x in zip(record.get("seeds", []), cross)])
     other += (f"\n\nFrames per file at 30 fps: {', '.join(f'{k} {v}' for k, v in x0['files_frames'].items())}; "
               f"the walk template has {x0['walk_template_frames']} frames (a match of the whole template needs at "
-              f"least half of them; the choice: {_setting(c['tau'], c['keyframes'], c['min_run'], c['sub_frames'])}). "
+              f"least half of them; the choice: {chosen_text}). "
               f"{prov}")
 
     tensor_choice = md_table(["repetitions per style", "val accuracy"],

@@ -143,6 +143,9 @@ class AnnotationSettings:
     overlays another's, are left unlabelled; 30 = 1 s at 30 fps; 0 disables it).
 
     ``sub_frames``: frames of the sub-templates cut from each class template (module doc; 0: whole templates).
+    ``turning_z``: how far apart two classes' turning rates must be for the turning layer to choose between them
+    (:mod:`.turning`; 0: off); ``turning_window_s``: the
+    seconds of the pieces it decides runs in (0: whole runs).
 
     ``tau``, ``keyframes``, ``keyframe_tolerance``, ``min_run`` and ``sub_frames`` were chosen on documents of
     Bandai val takes (suite ``annotate``); ``keyframe_count`` is not tuned. The defaults are
@@ -154,6 +157,8 @@ class AnnotationSettings:
     keyframe_tolerance: float = KeyframeSettings.tolerance
     min_run: int = AnnotateSettings.min_run
     sub_frames: int = AnnotateSettings.sub_frames
+    turning_z: float = AnnotateSettings.turning_z
+    turning_window_s: float = AnnotateSettings.turning_window_s
 
 
 @dataclass(frozen=True)

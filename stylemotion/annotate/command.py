@@ -27,7 +27,13 @@ from typing import Any
 import numpy as np
 from omegaconf import DictConfig
 
-from stylemotion.annotate.annotation import AnnotationInputError, AnnotationSettings, annotate_features, segments
+from stylemotion.annotate.annotation import (
+    AnnotationInputError,
+    AnnotationSettings,
+    annotate_distances,
+    class_distances,
+    segments,
+)
 from stylemotion.annotate.features import relational_features
 from stylemotion.annotate.model import AnnotationModel, ModelFolderError, learn_model, load_model, save_model
 from stylemotion.annotate.settings import AnnotateSettings
@@ -103,8 +109,14 @@ def load_document(document: str, fps: float, conversion: Mapping[str, Any] | Non
 def annotate_positions(positions: np.ndarray, model: AnnotationModel,
                        settings: AnnotationSettings | None = None) -> tuple[list[str], list[dict[str, Any]]]:
     """Frame labels (``""`` where none) and segment records (with sub-class fits where a tensor exists)."""
+    from stylemotion.annotate.turning import refine_annotation
+
     settings = settings or AnnotationSettings()
-    annotation = annotate_features(relational_features(positions, model.fps), model.templates, settings)
+    distances = class_distances(relational_features(positions, model.fps), model.templates, settings)
+    annotation = annotate_distances(distances, settings.tau, settings.keyframes, settings.min_run)
+    annotation = refine_annotation(annotation, distances, positions, model.fps, model.templates,
+                                   model.record.get("turning"), settings.tau, settings.turning_z,
+                                   settings.turning_window_s)
     labels = annotation.label_names()
     records = []
     for start, end, label in segments(labels):
@@ -128,6 +140,10 @@ def annotate(document: str, templates: str | os.PathLike, out: str | os.PathLike
     out = check_new_output(out, force)
     if not (isinstance(settings.tau, (int, float)) and settings.tau > 0):
         raise AnnotateInputError(f"tau={settings.tau} must be a positive number (the thesis used 0.13)")
+    for key in ("turning_z", "turning_window_s", "sub_frames"):
+        value = getattr(settings, key)
+        if not (isinstance(value, (int, float)) and value >= 0):
+            raise AnnotateInputError(f"{key}={value} must be a number ≥ 0 (0: off)")
     tolerance = settings.keyframe_tolerance
     if not (isinstance(tolerance, (int, float)) and 0 <= tolerance <= 1):
         raise AnnotateInputError(f"keyframes.tolerance={tolerance} must be a fraction in [0, 1] (of a key frame's "
@@ -151,7 +167,9 @@ def annotate(document: str, templates: str | os.PathLike, out: str | os.PathLike
               "settings": {"tau": settings.tau, "keyframes": settings.keyframes,
                            "keyframe_count": settings.keyframe_count,
                            "keyframe_tolerance": settings.keyframe_tolerance, "min_run": settings.min_run,
-                           "sub_frames": settings.sub_frames},
+                           "sub_frames": settings.sub_frames, "turning_z": settings.turning_z,
+                           "turning_window_s": settings.turning_window_s,
+                           "turning_layer": bool(settings.turning_z > 0 and model.record.get("turning"))},
               "labelled_fraction": round(float(np.mean([lab != "" for lab in labels])), 4),
               "segments": records, "provenance": provenance(command or None)}
     with atomic_folder(out, on_exists=lambda: check_new_output(out, force)) as tmp:
@@ -181,6 +199,7 @@ def annotate_from_config(cfg: DictConfig, command: str = "") -> Any:
     settings = AnnotationSettings(tau=s.tau, keyframes=s.keyframes.use,
                                   keyframe_count=positive_int(s.keyframes.count, "keyframes.count"),
                                   keyframe_tolerance=s.keyframes.tolerance, min_run=s.min_run,
-                                  sub_frames=s.sub_frames)
+                                  sub_frames=s.sub_frames, turning_z=s.turning_z,
+                                  turning_window_s=s.turning_window_s)
     return annotate(str(s.document), s.templates, s.out, settings=settings, conversion=conversion_keys(vars(s)),
                     force=s.force, command=command)

@@ -46,7 +46,11 @@ class AnnotateSettings(MotionFileKeys):
     masked costs are smaller); ``keyframes``: :class:`KeyframeSettings`; ``min_run``: labelled runs shorter than
     this (frames) are left unlabelled, 0 = the thesis as is; ``sub_frames``: each class template is matched as
     half-overlapping windows of this many frames (§3.3's sub-templates), so parts shorter than half a template
-    (a 2-s walk) can be found; 0 = whole templates.
+    (a 2-s walk) can be found; 0 = whole templates; ``turning_z``: the turning layer (``stylemotion.annotate.turning``):
+    a run goes to the class of its template family whose train takes' mean turning rate is nearest its own, among
+    the classes whose mean rates lie at least ``turning_z`` × (sd + sd) from its class's (a straight walk labelled
+    ``walk-turn-left`` becomes ``walk``); 0 = off; ``turning_window_s``: the layer decides runs in pieces of about
+    this many seconds (0: whole runs).
 
     ``joint_map``, ``unit_scale``, ``up_axis``: the document's (:class:`~stylemotion.config.MotionFileKeys`).
     ``out``: a new folder (an existing one is refused unless ``force``).
@@ -62,5 +66,7 @@ class AnnotateSettings(MotionFileKeys):
     keyframes: KeyframeSettings = field(default_factory=KeyframeSettings)
     min_run: int = 30
     sub_frames: int = 0
+    turning_z: float = 0.0
+    turning_window_s: float = 0.0
     out: str = "runs/annotate/${now:%Y-%m-%d_%H-%M-%S}"
     force: bool = False
