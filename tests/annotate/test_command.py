@@ -73,3 +73,30 @@ def test_a_keyframe_tolerance_outside_zero_to_one_is_refused(tmp_path):
         annotate("walk.bvh", tmp_path / "templates", tmp_path / "out",
                  settings=AnnotationSettings(keyframes=True, keyframe_tolerance=5))
     assert not (tmp_path / "out").exists()
+
+
+def test_the_templates_folder_holds_each_class_turning_and_the_report_says_whether_the_layer_ran(
+        templates_dir, synthetic_split, tmp_path):
+    from stylemotion.annotate.annotation import AnnotationSettings
+    from stylemotion.annotate.turning import turning_rate
+
+    meta = json.loads((templates_dir / "model.json").read_text())
+    turning = meta["turning"]
+    assert set(turning) == set(meta_classes(meta))
+    walks = [t.positions for t in synthetic_split["train"] if t.content == "walk"]
+    assert turning["walk"]["takes"] == len(walks)
+    assert turning["walk"]["mean"] == pytest.approx(sum(turning_rate(p, 30.0) for p in walks) / len(walks))
+    take = synthetic_split["test"][0]
+    write_motion_bvh(take.positions, tmp_path / "doc.bvh", 30.0)
+    on = annotate(str(tmp_path / "doc.bvh"), templates_dir, tmp_path / "on", settings=AnnotationSettings(turning_z=1))
+    off = annotate(str(tmp_path / "doc.bvh"), templates_dir, tmp_path / "off", settings=AnnotationSettings(turning_z=0))
+    assert on["settings"]["turning_layer"] is True and off["settings"]["turning_layer"] is False
+
+
+@pytest.mark.parametrize("key", ["turning_z", "turning_window_s", "sub_frames"])
+def test_negative_layer_settings_are_refused(key, tmp_path):
+    from stylemotion.annotate.annotation import AnnotationSettings
+
+    with pytest.raises(AnnotateInputError, match=rf"{key}=-1 must be a number ≥ 0"):
+        annotate("walk.bvh", tmp_path / "templates", tmp_path / "out", settings=AnnotationSettings(**{key: -1}))
+    assert not (tmp_path / "out").exists()
