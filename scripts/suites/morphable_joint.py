@@ -27,7 +27,7 @@ from dataclasses import replace
 from typing import Any
 
 import numpy as np
-from suites.common import DATA_ROOT, fmt, fmt_spread, md_table, provenance_line, spread, take_split_record
+from suites.common import fmt, fmt_spread, md_table, provenance_line, spread, take_split_record
 
 DESCRIPTION = ("Morphable Graph walks with every step optimized together after the walk (Du Algorithm 1, line 9): "
                "LM budget chosen on validation paths, before/after on the S-curve, double S and corner")
@@ -88,14 +88,11 @@ def choose(rows: dict[int, list[dict[str, Any]]]) -> tuple[int, dict[int, dict[s
 
 def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
     import torch
-    from suites.morphable import _clips, _fit
-    from suites.morphable_variation import CONTENTS, STANCES
+    from suites.morphable_variation import CONTENTS, STANCES, fit_stances
     from suites.synthesis import PATHS
 
-    from stylemotion.datasets.registry import load_dataset
     from stylemotion.morphable.model import refit_mixture
     from stylemotion.morphable.synthesis import MapSettings, MorphablePrimitive
-    from stylemotion.primitives.segmentation import parse_primitive
     from stylemotion.synthesis.controller import follow_path
     from stylemotion.synthesis.generate import path_from_config
     from stylemotion.synthesis.graph import MotionGraph
@@ -104,14 +101,7 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
     from stylemotion.synthesis.variation import walk_variation
 
     torch.set_num_threads(1)
-    split_cfg = {"seed": 0, "val_fraction": 0.1, "test_fraction": 0.1}
-    takeset = load_dataset("bandai", root=str(DATA_ROOT / "bandai-namco-motion-2" / "data.zip"), contents=CONTENTS)
-    split = takeset.split(**split_cfg)
-    clips, fitted = {}, {}
-    for name in STANCES:
-        action, primitive = parse_primitive(name)
-        clips[name] = _clips(takeset, split_cfg, action, primitive)
-        fitted[name], _ = _fit(clips[name], {"data": "bandai", "variant": "all"})
+    split, split_cfg, clips, fitted = fit_stances()
     follow, settings = FollowSettings(), MapSettings()
     length = fitted[STANCES[0]].length
 

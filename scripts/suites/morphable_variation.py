@@ -89,14 +89,30 @@ def _summary(rows: list[dict[str, Any]]) -> dict[str, Any]:
             "walks": len(rows)}
 
 
-def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
-    import torch
+def fit_stances() -> tuple[dict[str, list], dict[str, Any], dict[str, dict[str, list]], dict[str, Any]]:
+    """Bandai's take split (seed 0, 10 % val, 10 % test, :data:`CONTENTS`), each stance's normal clips per part and
+    its model fitted on the train clips (suite morphable's settings): ``(split, split settings, clips, models)``."""
     from suites.morphable import _clips, _fit
 
     from stylemotion.datasets.registry import load_dataset
+    from stylemotion.primitives.segmentation import parse_primitive
+
+    split_cfg = {"seed": 0, "val_fraction": 0.1, "test_fraction": 0.1}
+    takeset = load_dataset("bandai", root=str(DATA_ROOT / "bandai-namco-motion-2" / "data.zip"), contents=CONTENTS)
+    split = takeset.split(**split_cfg)
+    clips, fitted = {}, {}
+    for name in STANCES:
+        action, primitive = parse_primitive(name)
+        clips[name] = _clips(takeset, split_cfg, action, primitive)
+        fitted[name], _ = _fit(clips[name], {"data": "bandai", "variant": "all"})
+    return split, split_cfg, clips, fitted
+
+
+def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
+    import torch
+
     from stylemotion.morphable.model import refit_mixture
     from stylemotion.morphable.synthesis import MapSettings
-    from stylemotion.primitives.segmentation import parse_primitive
     from stylemotion.synthesis.variation import clip_variation, walk_variation
 
     torch.set_num_threads(1)
@@ -108,14 +124,7 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
         clock = time.perf_counter()
         print(f"morphable_variation: {part} done ({laps[part]} s)", flush=True)
 
-    split_cfg = {"seed": 0, "val_fraction": 0.1, "test_fraction": 0.1}
-    takeset = load_dataset("bandai", root=str(DATA_ROOT / "bandai-namco-motion-2" / "data.zip"), contents=CONTENTS)
-    split = takeset.split(**split_cfg)
-    clips, fitted = {}, {}
-    for name in STANCES:
-        action, primitive = parse_primitive(name)
-        clips[name] = _clips(takeset, split_cfg, action, primitive)
-        fitted[name], _ = _fit(clips[name], {"data": "bandai", "variant": "all"})
+    split, split_cfg, clips, fitted = fit_stances()
     models = {s: {n: (fitted[n] if s == 0 else refit_mixture(fitted[n], clips[n]["train"], s)) for n in STANCES}
               for s in seeds}
     length = fitted[STANCES[0]].length
