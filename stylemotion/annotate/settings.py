@@ -40,8 +40,9 @@ class AnnotateSettings(MotionFileKeys):
     ``repetitions``: train takes per style in a tensor (drawn with ``seed``), None = as many as every style has
     (chosen on Bandai val walk takes by ``python scripts/benchmarks.py run annotate``).
 
-    Annotating (``tau``, ``keyframes.use``/``tolerance`` and ``min_run`` chosen together on documents of Bandai
-    val takes by ``python scripts/benchmarks.py run annotate``; benchmarks/annotate.md has the test figures):
+    Annotating (``tau``, ``keyframes.use``/``tolerance``, ``min_run``, ``sub_frames``, ``turning_z`` and
+    ``turning_window_s`` chosen together on documents of Bandai val takes, whole and cut to 2–3 s, by
+    ``python scripts/benchmarks.py run annotate``; benchmarks/annotate.md has the test figures):
     ``tau``: matching threshold τ of the masked template distance (the thesis used 0.13 with its features; our
     masked costs are smaller); ``keyframes``: :class:`KeyframeSettings`; ``min_run``: labelled runs shorter than
     this (frames) are left unlabelled, 0 = the thesis as is; ``sub_frames``: each class template is matched as
@@ -62,11 +63,11 @@ class AnnotateSettings(MotionFileKeys):
     seed: int = 0
     tensors: bool = True
     repetitions: int | None = None
-    tau: float = 0.025
+    tau: float = 0.08
     keyframes: KeyframeSettings = field(default_factory=KeyframeSettings)
     min_run: int = 30
     sub_frames: int = 0
-    turning_z: float = 0.0
-    turning_window_s: float = 0.0
+    turning_z: float = 1.0
+    turning_window_s: float = 4.0
     out: str = "runs/annotate/${now:%Y-%m-%d_%H-%M-%S}"
     force: bool = False
