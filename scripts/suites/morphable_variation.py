@@ -3,7 +3,9 @@
 The stance models are those of suite ``morphable`` (Bandai's ``normal`` walk stances, fitted on the train takes of
 the same seeded split). Each path step starts from the cheapest of ``morphable.random_starts`` codes drawn from the
 mixture by the walk's seed; a start meeting the step within ``accept_cost`` is kept as drawn, else LM refines it
-(:mod:`stylemotion.morphable.synthesis`). Parts:
+(:mod:`stylemotion.morphable.synthesis`); then, as ``stylemotion-generate`` does, all steps optimized together
+(Algorithm 1, line 9) within ``morphable.joint_evaluations`` (the default, in every part, the tree's-candidate rows
+included). Parts:
 
 * **choice** — ``accept_cost`` and ``prior_centre`` chosen on a validation path (suite ``morphable``'s corner, not a
   reported path), model seed 0, :data:`VALIDATION_WALKS` walk seeds: of the candidates whose walks' mean deviation
@@ -63,7 +65,9 @@ def _walk(models: dict, path_cfg: dict, seed: int, settings) -> tuple[Any, dict[
     from stylemotion.synthesis.controller import follow_path
     from stylemotion.synthesis.generate import path_from_config, rigid_bones
     from stylemotion.synthesis.graph import MotionGraph
+    from stylemotion.synthesis.morphable_graph import finish_walk
     from stylemotion.synthesis.quality import walk_figures
+    from stylemotion.synthesis.settings import FollowSettings
 
     graph = MotionGraph("walk", "normal", {name.replace("walk_", ""): MorphablePrimitive(m, settings)
                                            for name, m in models.items()})
@@ -71,6 +75,7 @@ def _walk(models: dict, path_cfg: dict, seed: int, settings) -> tuple[Any, dict[
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         walk = follow_path(graph, path_from_config(path_cfg), seed=seed)
+    walk, _ = finish_walk(graph, walk, FollowSettings())  # Algorithm 1's line 9 where settings ask, as generate does
     seconds = time.perf_counter() - began
     shown = walk.positions  # as stylemotion-generate writes it: rigid bones, then the foot clean-up
     shown = clean_foot_skating(rigid_bones(shown)[0], walk.fps).astype(np.float32)
@@ -143,7 +148,7 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
         "variation": "reported on the 10 m S-curve and an 8 m straight line; real spread: the test takes' normal "
                      "stance clips"},
         "defaults": {"random_starts": defaults.random_starts, "accept_cost": defaults.accept_cost,
-                     "prior_centre": defaults.prior_centre},
+                     "prior_centre": defaults.prior_centre, "joint_evaluations": defaults.joint_evaluations},
         "real": real, "reach_m": REACH_M, "aim_m": AIM_M}
 
     # -- the choice of accept_cost and prior_centre on the validation path
@@ -242,7 +247,10 @@ def render(record: dict[str, Any]) -> dict[str, str]:
              fmt(c["refined_share"]["mean"] * 100, 0) + " %"] for c in ch["candidates"]]
     first = ch["first_run"]
     block = (md_table(header, rows)
-             + f"\n\nRandom starts: {seeds} model seeds (the mixture's EM) × {walks} walk seeds per path; spreads are "
+             + f"\n\nRandom starts: {seeds} model seeds (the mixture's EM) × {walks} walk seeds per path"
+             + (f", each walk then optimized as a whole (Algorithm 1, line 9, {defaults['joint_evaluations']} "
+                "evaluations, as `stylemotion-generate` does)" if defaults.get("joint_evaluations") else "")
+             + "; spreads are "
              "across the walks of one model seed at aligned steps, averaged over steps, then mean ± sd over model "
              "seeds; deviations mean ± sd over all walks. Pose spread: RMS distance of each step's time-normalized "
              "root-local joints to the mean step. Real steps: the same statistics across the test clips of each "
