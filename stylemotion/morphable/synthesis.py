@@ -24,7 +24,8 @@ speed, each over its scale in :class:`~stylemotion.synthesis.settings.FollowSett
 drawn from the primitive's mixture (the prior itself, by the walk's seeded generator), the cheapest under the
 step's objective is the start. As in the thesis' authors' implementation, a start that already meets the step
 (its step residual cost ``½‖r‖²`` without the prior at most ``accept_cost``) is kept as drawn; otherwise LM refines
-it (``accept_cost = 0``, the default chosen on a validation path: every start is refined). LM converges to
+it (``accept_cost = 1``, the default chosen on a validation path with line 9 after the walk; 0 refines every
+start, the choice before line 9 was built). LM converges to
 nearly the same MAP code from any start of one mixture component, so refined walks differ where the draws fall in
 other components or basins, and from then on through the previous step's pose and speed; ``accept_cost`` and
 ``prior_centre = "start"`` keep more of the draw. One seed gives one walk.
@@ -79,8 +80,9 @@ class MapSettings:
             kept, not tuned. 0: the tree's candidate (the same walk for every seed).
         accept_cost: a random start whose step residual cost (``½‖r‖²`` of the position, heading, pose and speed
             residuals over their ``follow.*`` scales, without the prior) is at most this is kept without LM
-            (the authors' implementation's ``start_error_threshold``); 0: every start is refined (chosen with
-            ``prior_centre`` on a validation path, a corner, by suite ``morphable_variation``).
+            (the authors' implementation's ``start_error_threshold``); 0: every start is refined. 1: chosen with
+            ``prior_centre`` on a validation path, a corner, by suite ``morphable_variation`` with line 9 after
+            each walk (without line 9 the same rule had chosen 0).
         joint_evaluations: after the walk, Algorithm 1's line 9: LM on the codes of all steps together
             (:mod:`stylemotion.synthesis.joint_walk`), at most this many objective evaluations; 0: off (the walk as
             searched step by step). 10: chosen among 0, 5, 10, 20, 40 and 80 on validation paths (suite
@@ -99,7 +101,7 @@ class MapSettings:
     tolerance_m: float = 0.05
     lookahead_steps: int = 1
     random_starts: int = 100
-    accept_cost: float = 0.0
+    accept_cost: float = 1.0
     prior_centre: str = "mixture"
     joint_evaluations: int = 10
 
