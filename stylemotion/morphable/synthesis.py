@@ -85,9 +85,10 @@ class MapSettings:
             each walk (without line 9 the same rule had chosen 0).
         joint_evaluations: after the walk, Algorithm 1's line 9: LM on the codes of all steps together
             (:mod:`stylemotion.synthesis.joint_walk`), at most this many objective evaluations; 0: off (the walk as
-            searched step by step). 10: chosen among 0, 5, 10, 20, 40 and 80 on validation paths (suite
+            searched step by step). 5: chosen among 0, 5, 10, 20, 40 and 80 on validation paths (suite
             ``morphable``'s corner and suite ``synthesis``'s random splines) by suite ``morphable_joint``; LM has
-            converged there by 10 (larger budgets score the same).
+            nearly converged there by 5 (larger budgets score within 0.01; a first run with ``accept_cost`` 0
+            chose 10).
         prior_centre: where LM's prior residual ``√λ L_k⁻¹ (s − c)`` is centred: ``mixture`` (``c = μ_k``, eq. 4.9,
             the thesis') or ``start`` (``c`` = the drawn start: LM meets the step and keeps the draw where the step
             leaves the code free, a perturb-and-MAP draw; the prior still counts in the costs compared).
@@ -103,7 +104,7 @@ class MapSettings:
     random_starts: int = 100
     accept_cost: float = 1.0
     prior_centre: str = "mixture"
-    joint_evaluations: int = 10
+    joint_evaluations: int = 5
 
     def __post_init__(self) -> None:
         if self.candidates < 1 or self.tree_evaluations < 1 or self.max_evaluations < 1 or self.lookahead_steps < 1:
