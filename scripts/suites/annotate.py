@@ -96,18 +96,20 @@ class _Annotated:
                 ) -> list[np.ndarray]:
         """``labels`` (one int array per document) after the turning layer at ``z`` sd in pieces of ``w`` s (``z``
         0: as they are)."""
-        from stylemotion.annotate.turning import document_yaw, refine_by_turning, template_families
+        from stylemotion.annotate.turning import document_yaw, refine_labels, root_track, template_families
 
-        statistics = self.model.record.get("turning")
-        if z <= 0 or not statistics:
+        turning, speed = self.model.record.get("turning"), self.model.record.get("speed")
+        if z <= 0 or not (turning or speed):
             return labels
         if self.yaw is None:
             self.yaw = [document_yaw(d.positions, d.fps) for d in self.documents]
+            self.track = [root_track(d.positions) for d in self.documents]
         if tau not in self._families:
             self._families[tau] = template_families(self.model.templates, tau)
-        return [refine_by_turning(lab, d.classes, d.delta, yaw, doc.fps, statistics, self._families[tau], z,
-                                  int(round(w * doc.fps)))
-                for lab, d, yaw, doc in zip(labels, self.distances(tol, sub), self.yaw, self.documents)]
+        return [refine_labels(lab, d.classes, d.delta, yaw, track, doc.fps, self._families[tau], turning, speed, z,
+                              int(round(w * doc.fps)))
+                for lab, d, yaw, track, doc in zip(labels, self.distances(tol, sub), self.yaw, self.track,
+                                                   self.documents)]
 
     def base(self, sub: int) -> list:
         from stylemotion.annotate.annotation import AnnotationSettings, class_distances

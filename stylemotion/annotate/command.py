@@ -116,7 +116,7 @@ def annotate_positions(positions: np.ndarray, model: AnnotationModel,
     annotation = annotate_distances(distances, settings.tau, settings.keyframes, settings.min_run)
     annotation = refine_annotation(annotation, distances, positions, model.fps, model.templates,
                                    model.record.get("turning"), settings.tau, settings.turning_z,
-                                   settings.turning_window_s)
+                                   settings.turning_window_s, model.record.get("speed"))
     labels = annotation.label_names()
     records = []
     for start, end, label in segments(labels):
@@ -169,7 +169,8 @@ def annotate(document: str, templates: str | os.PathLike, out: str | os.PathLike
                            "keyframe_tolerance": settings.keyframe_tolerance, "min_run": settings.min_run,
                            "sub_frames": settings.sub_frames, "turning_z": settings.turning_z,
                            "turning_window_s": settings.turning_window_s,
-                           "turning_layer": bool(settings.turning_z > 0 and model.record.get("turning"))},
+                           "turning_layer": bool(settings.turning_z > 0 and (model.record.get("turning")
+                                                                               or model.record.get("speed")))},
               "labelled_fraction": round(float(np.mean([lab != "" for lab in labels])), 4),
               "segments": records, "provenance": provenance(command or None)}
     with atomic_folder(out, on_exists=lambda: check_new_output(out, force)) as tmp:

@@ -19,7 +19,7 @@ import numpy as np
 from stylemotion.annotate.features import FEATURE_NAMES, relational_features
 from stylemotion.annotate.templates import DELTA, MotionTemplate, TemplateInputError, learn_template
 from stylemotion.annotate.tensors import MotionTensor, TensorInputError, build_tensor
-from stylemotion.annotate.turning import turning_statistics
+from stylemotion.annotate.turning import speed_statistics, turning_statistics
 from stylemotion.datasets.base import Take
 from stylemotion.io.atomic import atomic_write_bytes
 from stylemotion.io.errors import UserInputError
@@ -101,8 +101,10 @@ def learn_model(train: Sequence[Take], fps: float, per_class: int = 9, seed: int
                 learned[content] = build_tensor(content, usable, fps)[0]
             except TensorInputError as exc:
                 skipped[content] = str(exc)
-    turning = turning_statistics({c: [t.positions for t in train if t.content == c] for c in examples}, fps)
-    record = {"examples": {c: [t.name for t in takes] for c, takes in examples.items()}, "turning": turning,
+    by_class = {c: [t.positions for t in train if t.content == c] for c in examples}
+    turning, speed = turning_statistics(by_class, fps), speed_statistics(by_class, fps)
+    record = {"examples": {c: [t.name for t in takes] for c, takes in examples.items()},
+              "turning": turning, "speed": speed,
               "tensor_repetitions": tensor_repetitions, "tensors_skipped": skipped, "seed": seed}
     return AnnotationModel(templates, learned, fps, record)
 

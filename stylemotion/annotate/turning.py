@@ -1,5 +1,6 @@
-"""A second layer over the template annotation: classes that differ by how the body turns (Krüger §3.3's idea of
-a coarse layer refined into sub-classes, with the turning rate as the refining measure).
+"""A second layer over the template annotation: classes that differ by how the body turns or how fast it travels
+(Krüger §3.3's idea of a coarse layer refined into sub-classes, with the turning rate and the ground speed as the
+refining measures).
 
 Relational features see the pose, not where the body heads: a straight walk and a walk turning left fill
 nearly the same boolean features, so their templates match each other (walk-turn-left's template inside walk's
@@ -13,19 +14,22 @@ rad/s.
 * **Turning statistics** (:func:`turning_statistics`): per class, the mean and sd of the turning rate of its
   train takes (rad/s, the slope of the heading; left positive), stored with the templates (``model.json``'s
   ``turning``).
-* **Refinement** (:func:`refine_by_turning`): each labelled run whose class has family members is cut into pieces
-  of about ``window`` frames (equal parts; the whole run when ``window`` is 0 — a run may hold several motions
-  of one family, a straight walk and a turn). Only family members that turn unlike the class compete: those
-  whose mean rate lies at least ``z`` times the sum of the two sds from the class's (walk and walk-turn-left, not
-  raise-up-left-hand and wave-left-hand, which both stand still). A piece moves to the competitor whose mean
-  rate is nearest its own rate, if nearer than its class's mean (the boundary between a straight walk and a turn
-  is half way between their mean rates); among competitors that turn alike, the one whose template matched the
-  piece best (the least ``Δ`` ending in it).
+* **Ground speed**: the same for the root's ground speed (m/s; ``model.json``'s ``speed``): a walk whose template
+  matched a run's (walk and run match each other at τ = 0.08 on Bandai) is told from it by its speed, in a pass
+  before the turning rate's (:func:`refine_labels`).
+* **Refinement** (:func:`refine_by_rate`; :func:`refine_by_turning`, :func:`refine_by_speed`): each labelled run
+  whose class has family members is cut into pieces of about ``window`` frames (equal parts; the whole run when
+  ``window`` is 0 — a run may hold several motions of one family, a straight walk and a turn). Only family members
+  whose rate differs from the class's compete: those whose mean rate lies at least ``z`` times the sum of the two
+  sds from the class's (walk and walk-turn-left, not raise-up-left-hand and wave-left-hand, which both stand
+  still). A piece moves to the competitor whose mean rate is nearest its own rate, if nearer than its class's mean
+  (the boundary between a straight walk and a turn is half way between their mean rates); among competitors whose
+  rates are alike, the one whose template matched the piece best (the least ``Δ`` ending in it).
 """
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import replace
 
 import numpy as np
@@ -38,6 +42,8 @@ from stylemotion.representation import facing_yaw
 #: The least sd a class's turning rate is given (rad/s), so a class whose takes all walk straight does not
 #: refuse every run that turns a little.
 MIN_SD = 0.02
+#: The least sd of a class's ground speed (m/s).
+MIN_SPEED_SD = 0.05
 
 
 def document_yaw(positions: np.ndarray, fps: float) -> np.ndarray:
@@ -65,16 +71,42 @@ def turning_rate(positions: np.ndarray, fps: float) -> float:
     return yaw_rate(document_yaw(positions, fps), fps)
 
 
+def ground_speed(track: np.ndarray, fps: float) -> float:
+    """Mean ground speed (m/s) of a root track ``(frames, 2)`` (x, z metres): its length over its duration; 0 for
+    fewer than two frames."""
+    track = np.asarray(track, dtype=np.float64)
+    if len(track) < 2:
+        return 0.0
+    return float(np.linalg.norm(np.diff(track, axis=0), axis=-1).sum() * fps / (len(track) - 1))
+
+
+def root_track(positions: np.ndarray) -> np.ndarray:
+    """``(frames, 2)`` the root's ground track (x, z metres) of ``(frames, 21, 3)`` positions."""
+    return np.asarray(positions, dtype=np.float64)[:, 0, [0, 2]]
+
+
+def _statistics(rates_by_class: Mapping[str, Sequence[float]], least_sd: float) -> dict[str, dict[str, float]]:
+    out = {}
+    for label, rates in rates_by_class.items():
+        rates = np.asarray(rates, dtype=np.float64)
+        if rates.size:
+            out[label] = {"mean": float(rates.mean()), "sd": float(max(rates.std(), least_sd)),
+                          "takes": int(rates.size)}
+    return out
+
+
 def turning_statistics(takes_by_class: Mapping[str, Sequence[np.ndarray]], fps: float
                        ) -> dict[str, dict[str, float]]:
     """``{class: {"mean", "sd", "takes"}}`` of the turning rates of each class's ``(frames, 21, 3)`` takes (sd at
     least :data:`MIN_SD`)."""
-    out = {}
-    for label, takes in takes_by_class.items():
-        rates = np.array([turning_rate(t, fps) for t in takes])
-        if rates.size:
-            out[label] = {"mean": float(rates.mean()), "sd": float(max(rates.std(), MIN_SD)), "takes": int(rates.size)}
-    return out
+    return _statistics({c: [turning_rate(t, fps) for t in takes] for c, takes in takes_by_class.items()}, MIN_SD)
+
+
+def speed_statistics(takes_by_class: Mapping[str, Sequence[np.ndarray]], fps: float
+                     ) -> dict[str, dict[str, float]]:
+    """The same for the takes' ground speeds (m/s; sd at least :data:`MIN_SPEED_SD`)."""
+    return _statistics({c: [ground_speed(root_track(t), fps) for t in takes] for c, takes in takes_by_class.items()},
+                       MIN_SPEED_SD)
 
 
 def template_families(templates: Sequence[MotionTemplate], tau: float) -> dict[str, set[str]]:
@@ -103,16 +135,17 @@ def _apart(a: Mapping[str, float], b: Mapping[str, float], z: float) -> bool:
     return abs(a["mean"] - b["mean"]) >= z * (a["sd"] + b["sd"])
 
 
-def refine_by_turning(labels: np.ndarray, classes: Sequence[str], delta: np.ndarray, yaw: np.ndarray, fps: float,
-                      statistics: Mapping[str, Mapping[str, float]], families: Mapping[str, set[str]],
-                      z: float, window: int = 0) -> np.ndarray:
-    """``labels`` ``(frames,)`` (indices into ``classes``, -1 = none) with each run relabelled by its turning rate
-    (module doc); a copy.
+def refine_by_rate(labels: np.ndarray, classes: Sequence[str], delta: np.ndarray, rate_of: Callable[[int, int], float],
+                   statistics: Mapping[str, Mapping[str, float]], families: Mapping[str, set[str]],
+                   z: float, window: int = 0) -> np.ndarray:
+    """``labels`` ``(frames,)`` (indices into ``classes``, -1 = none) with each run (or piece of about ``window``
+    frames) relabelled by a rate of the body's motion (module doc); a copy.
 
     Args:
         delta: ``(classes, frames)`` each class's subsequence DTW cost ending at each frame.
-        yaw: ``(frames,)`` the document's unwrapped facing (rad).
-        statistics: :func:`turning_statistics`; a class without an entry is never relabelled nor chosen.
+        rate_of: ``(first, stop)`` frames → the rate of that stretch (e.g. its turning rate).
+        statistics: each class's ``mean`` and ``sd`` of the rate; a class without an entry is never relabelled nor
+            chosen.
         families: :func:`template_families`.
         z: how far apart (in sums of sd) two classes' mean rates must be for the layer to choose between them.
         window: frames per piece a run is decided in (about; 0: the whole run).
@@ -134,7 +167,7 @@ def refine_by_turning(labels: np.ndarray, classes: Sequence[str], delta: np.ndar
         for a, b in zip(bounds[:-1], bounds[1:]):
             if b - a < 2:
                 continue
-            rate = yaw_rate(yaw[a:b], fps)
+            rate = rate_of(int(a), int(b))
             nearest = min(rivals, key=lambda m: abs(rate - statistics[m]["mean"]))
             if abs(rate - statistics[nearest]["mean"]) >= abs(rate - own["mean"]):
                 continue
@@ -144,15 +177,44 @@ def refine_by_turning(labels: np.ndarray, classes: Sequence[str], delta: np.ndar
     return out
 
 
+def refine_by_turning(labels: np.ndarray, classes: Sequence[str], delta: np.ndarray, yaw: np.ndarray, fps: float,
+                      statistics: Mapping[str, Mapping[str, float]], families: Mapping[str, set[str]],
+                      z: float, window: int = 0) -> np.ndarray:
+    """:func:`refine_by_rate` with the turning rate of the document's unwrapped facing ``yaw`` ``(frames,)``."""
+    return refine_by_rate(labels, classes, delta, lambda a, b: yaw_rate(yaw[a:b], fps), statistics, families, z,
+                          window)
+
+
+def refine_by_speed(labels: np.ndarray, classes: Sequence[str], delta: np.ndarray, track: np.ndarray, fps: float,
+                    statistics: Mapping[str, Mapping[str, float]], families: Mapping[str, set[str]],
+                    z: float, window: int = 0) -> np.ndarray:
+    """:func:`refine_by_rate` with the ground speed of the root's track ``(frames, 2)`` (x, z metres)."""
+    return refine_by_rate(labels, classes, delta, lambda a, b: ground_speed(track[a:b], fps), statistics, families,
+                          z, window)
+
+
+def refine_labels(labels: np.ndarray, classes: Sequence[str], delta: np.ndarray, yaw: np.ndarray, track: np.ndarray,
+                  fps: float, families: Mapping[str, set[str]], turning: Mapping[str, Mapping[str, float]] | None,
+                  speed: Mapping[str, Mapping[str, float]] | None, z: float, window: int = 0) -> np.ndarray:
+    """The layer's two passes over ``labels``: by ground speed (``track`` ``(frames, 2)``), then by turning rate
+    (``yaw`` ``(frames,)``); a pass without statistics is skipped."""
+    if speed:
+        labels = refine_by_speed(labels, classes, delta, track, fps, speed, families, z, window)
+    if turning:
+        labels = refine_by_turning(labels, classes, delta, yaw, fps, turning, families, z, window)
+    return labels
+
+
 def refine_annotation(annotation: Annotation, distances: ClassDistances, positions: np.ndarray, fps: float,
                       templates: Sequence[MotionTemplate], statistics: Mapping[str, Mapping[str, float]] | None,
-                      tau: float, z: float, window_s: float = 0.0) -> Annotation:
-    """``annotation`` after the turning layer (:func:`refine_by_turning`, families at ``tau``, pieces of
-    ``window_s`` seconds); itself when ``z`` ≤ 0 or the model has no turning statistics (a templates folder
-    written before this layer)."""
-    if z <= 0 or not statistics:
+                      tau: float, z: float, window_s: float = 0.0,
+                      speed: Mapping[str, Mapping[str, float]] | None = None) -> Annotation:
+    """``annotation`` after the layer (:func:`refine_labels`, families at ``tau``, pieces of ``window_s`` seconds;
+    ``statistics``: the turning rates, ``speed``: the ground speeds); itself when ``z`` ≤ 0 or the model has no
+    statistics (a templates folder written before this layer)."""
+    if z <= 0 or not (statistics or speed):
         return annotation
-    labels = refine_by_turning(annotation.labels, distances.classes, distances.delta, document_yaw(positions, fps),
-                               fps, statistics, template_families(templates, tau), z,
-                               int(round(window_s * fps)))
+    labels = refine_labels(annotation.labels, distances.classes, distances.delta, document_yaw(positions, fps),
+                           root_track(positions), fps, template_families(templates, tau), statistics, speed, z,
+                           int(round(window_s * fps)))
     return replace(annotation, labels=labels)

@@ -110,3 +110,26 @@ def test_among_rivals_that_turn_alike_the_best_matching_template_wins_and_alike_
     assert (refine_by_turning(jog, classes, delta, yaw, FPS, stats, families, 2.0) == 3).all()
     left = _document_yaw([(60, 0.35)])                        # a turning stretch labelled turn: kept
     assert (refine_by_turning(labels, classes, delta, left, FPS, stats, families, 2.0) == 2).all()
+
+
+def test_speed_statistics_and_a_walk_labelled_run_goes_to_walk_by_its_speed(pose):
+    from stylemotion.annotate.turning import ground_speed, refine_labels, root_track, speed_statistics
+
+    def travelling(speed: float, frames: int = 60) -> np.ndarray:
+        steps = np.arange(frames)[:, None, None] / FPS * np.array([0.0, 0.0, speed])
+        return pose[None] + steps                                 # the pose carried forward along +z
+
+    assert ground_speed(root_track(travelling(1.3)), FPS) == pytest.approx(1.3)
+    stats = speed_statistics({"walk": [travelling(1.2), travelling(1.4)], "run": [travelling(3.0)]}, FPS)
+    assert stats["walk"]["mean"] == pytest.approx(1.3) and stats["walk"]["sd"] == pytest.approx(0.1)
+    assert stats["run"]["sd"] == 0.05                             # the floor
+    classes = ("walk", "run")
+    families = {"walk": {"run"}, "run": {"walk"}}
+    document = np.concatenate([travelling(1.3), travelling(3.1)])
+    labels = np.full(120, 1)                                      # all labelled run: a walk, then a run
+    delta = np.full((2, 120), 0.02)
+    yaw = np.zeros(120)
+    out = refine_labels(labels, classes, delta, yaw, root_track(document), FPS, families, None, stats, 2.0, 60)
+    assert (out[:60] == 0).all() and (out[60:] == 1).all()
+    same = refine_labels(labels, classes, delta, yaw, root_track(document), FPS, families, None, None, 2.0, 60)
+    assert (same == labels).all()                                 # no statistics: the pass is skipped
