@@ -137,9 +137,11 @@ def _apart(a: Mapping[str, float], b: Mapping[str, float], z: float) -> bool:
 
 def refine_by_rate(labels: np.ndarray, classes: Sequence[str], delta: np.ndarray, rate_of: Callable[[int, int], float],
                    statistics: Mapping[str, Mapping[str, float]], families: Mapping[str, set[str]],
-                   z: float, window: int = 0) -> np.ndarray:
+                   z: float, window: int = 0, tie: Callable[[str, int, int], float] | None = None) -> np.ndarray:
     """``labels`` ``(frames,)`` (indices into ``classes``, -1 = none) with each run (or piece of about ``window``
-    frames) relabelled by a rate of the body's motion (module doc); a copy.
+    frames) relabelled by a rate of the body's motion (module doc); a copy. ``tie(class, first, stop)``: how badly
+    a class fits the stretch by another measure, which decides first among rivals alike in this one (then the
+    template's ``Δ``).
 
     Args:
         delta: ``(classes, frames)`` each class's subsequence DTW cost ending at each frame.
@@ -172,36 +174,53 @@ def refine_by_rate(labels: np.ndarray, classes: Sequence[str], delta: np.ndarray
             if abs(rate - statistics[nearest]["mean"]) >= abs(rate - own["mean"]):
                 continue
             alike = [m for m in rivals if not _apart(statistics[m], statistics[nearest], z)]
-            best = min(alike, key=lambda m: float(np.min(delta[index[m], a:b])))
+            best = min(alike, key=lambda m: (tie(m, a, b) if tie else 0.0, float(np.min(delta[index[m], a:b]))))
             out[a:b] = index[best]
     return out
 
 
 def refine_by_turning(labels: np.ndarray, classes: Sequence[str], delta: np.ndarray, yaw: np.ndarray, fps: float,
                       statistics: Mapping[str, Mapping[str, float]], families: Mapping[str, set[str]],
-                      z: float, window: int = 0) -> np.ndarray:
+                      z: float, window: int = 0, tie: Callable[[str, int, int], float] | None = None) -> np.ndarray:
     """:func:`refine_by_rate` with the turning rate of the document's unwrapped facing ``yaw`` ``(frames,)``."""
     return refine_by_rate(labels, classes, delta, lambda a, b: yaw_rate(yaw[a:b], fps), statistics, families, z,
-                          window)
+                          window, tie)
 
 
 def refine_by_speed(labels: np.ndarray, classes: Sequence[str], delta: np.ndarray, track: np.ndarray, fps: float,
                     statistics: Mapping[str, Mapping[str, float]], families: Mapping[str, set[str]],
-                    z: float, window: int = 0) -> np.ndarray:
+                    z: float, window: int = 0, tie: Callable[[str, int, int], float] | None = None) -> np.ndarray:
     """:func:`refine_by_rate` with the ground speed of the root's track ``(frames, 2)`` (x, z metres)."""
     return refine_by_rate(labels, classes, delta, lambda a, b: ground_speed(track[a:b], fps), statistics, families,
-                          z, window)
+                          z, window, tie)
+
+
+def _misfit(statistics: Mapping[str, Mapping[str, float]] | None, rate_of: Callable[[int, int], float]
+            ) -> Callable[[str, int, int], float] | None:
+    """How many sd a stretch's rate lies from a class's mean (0 for a class without statistics); None without
+    statistics."""
+    if not statistics:
+        return None
+
+    def misfit(name: str, a: int, b: int) -> float:
+        stats = statistics.get(name)
+        return 0.0 if stats is None else abs(rate_of(a, b) - stats["mean"]) / stats["sd"]
+
+    return misfit
 
 
 def refine_labels(labels: np.ndarray, classes: Sequence[str], delta: np.ndarray, yaw: np.ndarray, track: np.ndarray,
                   fps: float, families: Mapping[str, set[str]], turning: Mapping[str, Mapping[str, float]] | None,
                   speed: Mapping[str, Mapping[str, float]] | None, z: float, window: int = 0) -> np.ndarray:
     """The layer's two passes over ``labels``: by ground speed (``track`` ``(frames, 2)``), then by turning rate
-    (``yaw`` ``(frames,)``); a pass without statistics is skipped."""
+    (``yaw`` ``(frames,)``); among rivals alike in one measure, the other decides (a straight 1 m/s walk labelled
+    walk-turn-right goes to walk, not to run, which turns as little); a pass without statistics is skipped."""
+    turning_misfit = _misfit(turning, lambda a, b: yaw_rate(yaw[a:b], fps))
+    speed_misfit = _misfit(speed, lambda a, b: ground_speed(track[a:b], fps))
     if speed:
-        labels = refine_by_speed(labels, classes, delta, track, fps, speed, families, z, window)
+        labels = refine_by_speed(labels, classes, delta, track, fps, speed, families, z, window, turning_misfit)
     if turning:
-        labels = refine_by_turning(labels, classes, delta, yaw, fps, turning, families, z, window)
+        labels = refine_by_turning(labels, classes, delta, yaw, fps, turning, families, z, window, speed_misfit)
     return labels
 
 

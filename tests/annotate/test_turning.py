@@ -133,3 +133,23 @@ def test_speed_statistics_and_a_walk_labelled_run_goes_to_walk_by_its_speed(pose
     assert (out[:60] == 0).all() and (out[60:] == 1).all()
     same = refine_labels(labels, classes, delta, yaw, root_track(document), FPS, families, None, None, 2.0, 60)
     assert (same == labels).all()                                 # no statistics: the pass is skipped
+
+
+def test_among_rivals_alike_in_turning_the_speed_decides(pose):
+    """A straight 1 m/s walk labelled turn-right: walk and run both turn as little; its speed picks walk, although
+    run's template matched it better."""
+    from stylemotion.annotate.turning import refine_labels
+
+    classes = ("walk", "run", "turn-right")
+    turning = {"walk": {"mean": 0.0, "sd": 0.02}, "run": {"mean": 0.0, "sd": 0.03},
+               "turn-right": {"mean": -0.45, "sd": 0.13}}
+    speed = {"walk": {"mean": 1.2, "sd": 0.2}, "run": {"mean": 2.7, "sd": 0.5}, "turn-right": {"mean": 1.1, "sd": 0.2}}
+    families = {c: set(classes) - {c} for c in classes}
+    labels = np.full(60, 2)
+    delta = np.full((3, 60), 0.05)
+    delta[1, 30] = 0.01                                           # run's template matched best
+    track = np.stack([np.zeros(60), np.arange(60) / FPS * 1.0], axis=1)
+    out = refine_labels(labels, classes, delta, np.zeros(60), track, FPS, families, turning, speed, 1.0)
+    assert (out == 0).all()
+    no_speed = refine_labels(labels, classes, delta, np.zeros(60), track, FPS, families, turning, None, 1.0)
+    assert (no_speed == 1).all()                                  # without speeds, the template decides
