@@ -215,12 +215,16 @@ def refine_labels(labels: np.ndarray, classes: Sequence[str], delta: np.ndarray,
     """The layer's two passes over ``labels``: by ground speed (``track`` ``(frames, 2)``), then by turning rate
     (``yaw`` ``(frames,)``); among rivals alike in one measure, the other decides (a straight 1 m/s walk labelled
     walk-turn-right goes to walk, not to run, which turns as little); a pass without statistics is skipped."""
-    turning_misfit = _misfit(turning, lambda a, b: yaw_rate(yaw[a:b], fps))
-    speed_misfit = _misfit(speed, lambda a, b: ground_speed(track[a:b], fps))
+    def turn(a: int, b: int) -> float:
+        return yaw_rate(yaw[a:b], fps)
+
+    def go(a: int, b: int) -> float:
+        return ground_speed(track[a:b], fps)
+
     if speed:
-        labels = refine_by_speed(labels, classes, delta, track, fps, speed, families, z, window, turning_misfit)
+        labels = refine_by_rate(labels, classes, delta, go, speed, families, z, window, _misfit(turning, turn))
     if turning:
-        labels = refine_by_turning(labels, classes, delta, yaw, fps, turning, families, z, window, speed_misfit)
+        labels = refine_by_rate(labels, classes, delta, turn, turning, families, z, window, _misfit(speed, go))
     return labels
 
 

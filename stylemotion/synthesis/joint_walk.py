@@ -131,7 +131,7 @@ class _Walk:
     def split(self, x: np.ndarray) -> list[np.ndarray]:
         return [x[self.offsets[i]:self.offsets[i + 1]] for i in range(len(self.steps))]
 
-    def place(self, i: int, clips: _Clips, previous_last: np.ndarray | None) -> dict[str, np.ndarray]:
+    def place(self, clips: _Clips, previous_last: np.ndarray | None) -> dict[str, np.ndarray]:
         return _placed(clips, previous_last, self.follow.blend_frames, self.fps)
 
     def states(self, codes: list[np.ndarray]) -> tuple[list[_Clips], list[dict[str, np.ndarray]]]:
@@ -139,7 +139,7 @@ class _Walk:
         clips, states, last = [], [], None
         for i, code in enumerate(codes):
             clips.append(_decode(self.steps[i].model, code[None]))
-            states.append(self.place(i, clips[-1], last))
+            states.append(self.place(clips[-1], last))
             last = states[-1]["last"]
         return clips, states
 
@@ -176,10 +176,10 @@ class _Walk:
             moved = codes[i] + DIFFERENCE_STEP * np.eye(d)
             states = [{k: np.repeat(v, d, axis=0) for k, v in b.items()} for b in base]
             previous = None if i == 0 else states[i - 1]["last"]
-            states[i] = self.place(i, _decode(self.steps[i].model, moved), previous)
+            states[i] = self.place(_decode(self.steps[i].model, moved), previous)
             for j in range(i + 1, len(self.steps)):  # the blend carries a change into the next clip (and on, while
                 repeated = _Clips(np.repeat(clips[j].frames, d, axis=0), np.repeat(clips[j].counts, d))  # it changes
-                states[j] = self.place(j, repeated, states[j - 1]["last"])  # a clip's last frame)
+                states[j] = self.place(repeated, states[j - 1]["last"])  # a clip's last frame)
                 if np.array_equal(states[j]["last"], np.repeat(base[j]["last"], d, axis=0)):
                     break
             batch_codes = [moved if j == i else np.repeat(c, d, axis=0) for j, c in enumerate(codes)]

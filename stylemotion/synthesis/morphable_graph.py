@@ -8,6 +8,7 @@ imports nothing of synthesis; synthesis builds on it here.
 
 from __future__ import annotations
 
+import time
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -95,8 +96,6 @@ def optimize_walk(graph: MotionGraph, walk: SynthesizedMotion, follow: FollowSet
     found no lower objective. Returns the walk and what happened: ``objective_before``/``_after`` (the joint
     objective), ``target_error_before``/``_after`` (:func:`target_error` of the stitched walks), ``kept``,
     ``evaluations`` and ``seconds``."""
-    import time
-
     began = time.perf_counter()
     models = []
     for step in walk.steps:
