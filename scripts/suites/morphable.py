@@ -110,8 +110,8 @@ def _walk(models: dict[str, dict[str, Any]], path: dict, steps: int, seed: int, 
 
 def _part_keyframe(split: dict, seeds: list[int], defaults: dict[str, Any]) -> dict[str, Any]:
     """σ_c chosen on the val takes' raise clips' final Hand_L as targets, reported on the test takes'."""
-    from stylemotion.morphable.arm import arm_clips
     from stylemotion.morphable.heldout import choose_constraint_scale, keyframe_errors
+    from stylemotion.primitives.arm import arm_clips
     from stylemotion.skeleton import CANONICAL_JOINTS
 
     # -- keyframe σ_c: the raise primitive, targets = held-out clips' own Hand_L end positions
@@ -162,9 +162,9 @@ def _part_regression(zip_path: str, split_cfg: dict, defaults: dict[str, Any]) -
     """The val references of tests/morphable/test_bandai_morphable.py."""
     from stylemotion.datasets.registry import load_dataset
     from stylemotion.morphable import FitSettings, fit_primitive
-    from stylemotion.morphable.arm import arm_clips
     from stylemotion.morphable.heldout import keyframe_errors
     from stylemotion.morphable.model import reconstruction_error
+    from stylemotion.primitives.arm import arm_clips
     from stylemotion.skeleton import CANONICAL_JOINTS
 
     j = CANONICAL_JOINTS.index(ARM_JOINT)

@@ -12,7 +12,7 @@ Items are dicts:
 * ``frames``: ``(length, 66)`` float32 raw frames, time-normalized (velocity channels per second);
 * ``duration_s``: the clip's real duration, seconds (to play it back at ``(length-1)/duration_s`` fps);
 * ``style``: index into :attr:`ClipDataModule.style_names`;
-* ``primitive``: index into :data:`stylemotion.primitives.segmentation.PRIMITIVES`.
+* ``primitive``: index into :data:`stylemotion.primitives.segmentation.PRIMITIVES` followed by ``ARM_PRIMITIVES``.
 
 Style examples (the thesis conditions each style model on a single clip): for each style one clip
 of ``example.primitive`` (default: the first selected primitive), cut from takes of
@@ -43,11 +43,13 @@ from stylemotion.datamodules.base import SplitDataModule
 from stylemotion.datasets import TakeSet
 from stylemotion.io.errors import UserInputError
 from stylemotion.primitives.segmentation import (
+    ARM_PRIMITIVES,
     PRIMITIVES,
     Clip,
     Segmentation,
     SegmentSettings,
     check_primitive,
+    is_arm_content,
     segment_action,
     time_normalize,
 )
@@ -57,6 +59,8 @@ log = logging.getLogger(__name__)
 
 SPLITS = ("train", "val", "test")
 EXAMPLE_PICKS = ("median", "first", "index", "take")
+#: What the items' ``primitive`` index counts in.
+PRIMITIVE_INDEX = PRIMITIVES + ARM_PRIMITIVES
 DEFAULT_EXAMPLE: dict[str, Any] = {"primitive": None, "content": None, "pick": "median", "index": 0,
                                    "take": None, "start": None, "split": "all"}
 
@@ -73,7 +77,7 @@ class ClipDataset(Dataset):
         frames: ``(clips, length, 66)`` float32 raw frames.
         duration_s: ``(clips,)`` float32 real durations, seconds.
         style: ``(clips,)`` int64 style indices.
-        primitive: ``(clips,)`` int64 primitive indices (into ``PRIMITIVES``).
+        primitive: ``(clips,)`` int64 primitive indices (into ``PRIMITIVES + ARM_PRIMITIVES``).
     """
 
     def __init__(self, clips: Sequence[Clip], length: int, style_names: Sequence[str]):
@@ -84,7 +88,7 @@ class ClipDataset(Dataset):
         self.frames = torch.from_numpy(np.stack(frames)) if frames else torch.zeros(0, length, FRAME_DIM)
         self.duration_s = torch.tensor([c.duration_s for c in self.clips], dtype=torch.float32)
         self.style = torch.tensor([style_index[c.style] for c in self.clips], dtype=torch.int64)
-        self.primitive = torch.tensor([PRIMITIVES.index(c.primitive) for c in self.clips], dtype=torch.int64)
+        self.primitive = torch.tensor([PRIMITIVE_INDEX.index(c.primitive) for c in self.clips], dtype=torch.int64)
 
     def __len__(self) -> int:
         return len(self.clips)
@@ -101,8 +105,10 @@ class ClipDataModule(SplitDataModule):
         data: a ``data`` config node as a plain mapping (``name``, loader options, ``split``);
             see ``configs/data/``. Ignored when ``takeset`` is given.
         takeset: an already built :class:`TakeSet` (Python use; not saved in checkpoints).
-        action: ``walk`` or ``run`` (see :data:`stylemotion.primitives.segmentation.ACTIONS`).
-        primitives: primitives to serve (names from :data:`~stylemotion.primitives.segmentation.PRIMITIVES`).
+        action: ``walk`` or ``run`` (see :data:`stylemotion.primitives.segmentation.ACTIONS`), or an arm content
+            (``raise-up-right-hand``, cut by :mod:`stylemotion.primitives.arm`).
+        primitives: primitives to serve (names from :data:`~stylemotion.primitives.segmentation.PRIMITIVES`; of an
+            arm content, from ``ARM_PRIMITIVES``).
         styles: styles to serve; None = every style of the dataset.
         timeline: ``"median"`` (the median length of the selected train clips, all selected
             primitives together) or a fixed number of frames.
@@ -141,7 +147,7 @@ class ClipDataModule(SplitDataModule):
         if not primitives:
             raise ValueError(f"select at least one primitive of {list(PRIMITIVES)}")
         for p in primitives:
-            check_primitive(p)
+            check_primitive(p, action)
         if not (timeline == "median" or (isinstance(timeline, int) and timeline >= 2)):
             raise ValueError(f"timeline must be 'median' or a number of frames ≥ 2, got {timeline!r}")
         unknown = sorted(set(example or {}) - set(DEFAULT_EXAMPLE))
@@ -151,7 +157,7 @@ class ClipDataModule(SplitDataModule):
         if self.example_cfg["pick"] not in EXAMPLE_PICKS:
             raise ValueError(f"unknown example pick {self.example_cfg['pick']!r}; one of {list(EXAMPLE_PICKS)}")
         if self.example_cfg["primitive"] is not None:
-            check_primitive(self.example_cfg["primitive"])
+            check_primitive(self.example_cfg["primitive"], action)
         if self.example_cfg["split"] not in ("all",) + SPLITS:
             raise ValueError(f"example split must be 'all' or one of {list(SPLITS)}, got "
                              f"{self.example_cfg['split']!r}")
@@ -162,8 +168,9 @@ class ClipDataModule(SplitDataModule):
         self.timeline = timeline
         self.requested_example_styles = None if example_styles is None else list(example_styles)
         self.segment_settings = SegmentSettings.from_dict(dict(segment or {}))
-        if action not in self.segment_settings.actions:
-            raise ValueError(f"unknown action {action!r}; segmented actions: {list(self.segment_settings.actions)}")
+        if action not in self.segment_settings.actions and not is_arm_content(action):
+            raise ValueError(f"unknown action {action!r}; segmented actions: {list(self.segment_settings.actions)} "
+                             "and the arm contents (raise-up-…, wave-…)")
         self.segmentation: Segmentation | None = None
         self._given_segmentation = segmentation
         self.split_of: dict[str, str] = {}

@@ -27,11 +27,11 @@ from stylemotion.evaluation.sources import MissingExampleError
 from stylemotion.models.loading import EvalModel
 from stylemotion.primitives.contacts import foot_signals
 from stylemotion.primitives.segmentation import (
-    STANCE_FOOT,
     Clip,
     Segmentation,
-    action_of,
+    of_action,
     parse_primitive,
+    stance_foot,
 )
 
 
@@ -57,9 +57,9 @@ class PrimitiveData:
     rest_heights: np.ndarray
 
     @property
-    def stance_foot(self) -> int:
-        """0 if the primitive plants the left foot, 1 if the right."""
-        return STANCE_FOOT[parse_primitive(self.primitive)[1]]
+    def stance_foot(self) -> int | None:
+        """0 if the primitive plants the left foot, 1 if the right, None for an arm primitive."""
+        return stance_foot(parse_primitive(self.primitive)[1])
 
     @property
     def styles(self) -> list[str]:
@@ -128,7 +128,7 @@ def primitive_data(takeset: TakeSet, primitive: str, length: int, neutral_style:
     if neutral_style not in module.style_names:
         raise ValueError(f"the neutral style {neutral_style!r} is not a style of dataset {takeset.name!r} "
                          f"(styles: {module.style_names}); set neutral_style")
-    takes = [t for t in takeset.takes if action_of(t.content, module.segment_settings.actions) == action
+    takes = [t for t in takeset.takes if of_action(t.content, action, module.segment_settings.actions)
              and module.split_of.get(t.name) == "train"]
     if not takes:
         raise ValueError(f"dataset {takeset.name!r} has no {action} take in the train split")

@@ -25,13 +25,6 @@ from stylemotion.config import ConfigError, set_torch_threads
 from stylemotion.io.atomic import atomic_write_bytes
 from stylemotion.io.jsonfile import write_json
 from stylemotion.io.outputs import OutputExistsError
-from stylemotion.morphable.arm import (
-    ARM_PRIMITIVES,
-    arm_clips,
-    check_arm_primitive,
-    content_primitives,
-    is_arm_content,
-)
 from stylemotion.morphable.model import FitSettings, MorphableModel, fit_primitive, reconstruction_error
 from stylemotion.morphable.variants import TURN_THRESHOLD_DEG, select_turn, variant_name
 from stylemotion.primitives.segmentation import parse_primitive
@@ -55,12 +48,9 @@ def run(cfg: DictConfig) -> dict[str, Any]:
     record_start(output_dir, cfg, None)
     atomic_write_bytes(output_dir / "config_resolved.yaml", OmegaConf.to_yaml(cfg, resolve=True).encode())
     styles = None if cfg.get("style") in (None, "all") else [str(cfg.style)]
-    if primitive in ARM_PRIMITIVES:
-        datamodule = _ArmClips(cfg, action, primitive, styles)
-    else:
-        datamodule = instantiate(cfg.datamodule, data=OmegaConf.to_container(cfg.data, resolve=True), action=action,
-                                 primitives=[primitive], styles=styles, _convert_="all")
-        datamodule.setup()
+    datamodule = instantiate(cfg.datamodule, data=OmegaConf.to_container(cfg.data, resolve=True), action=action,
+                             primitives=[primitive], styles=styles, _convert_="all")
+    datamodule.setup()
     turn = cfg.get("turn")
     if turn is not None:
         try:
@@ -104,40 +94,12 @@ def run(cfg: DictConfig) -> dict[str, Any]:
 
 
 def _parse(name: str) -> tuple[str, str]:
-    """``walk_leftStance`` → ``("walk", "leftStance")``; an arm primitive ``<arm content>_<raise|wave|lower>`` (e.g.
-    ``raise-up-left-hand_raise``, ``wave-left-hand_wave``; ``wave`` only of wave contents) → ``(content,
-    primitive)``; ConfigError listing both kinds otherwise."""
-    content, _, primitive = name.rpartition("_")
-    if primitive in ARM_PRIMITIVES and is_arm_content(content):
-        try:
-            check_arm_primitive(content, primitive)
-        except ValueError as err:
-            valid = ", ".join(f"{content}_{p}" for p in content_primitives(content))
-            raise ConfigError(f"primitive={name}: {err}; use one of {valid}") from None
-        return content, primitive
+    """``walk_leftStance`` → ``("walk", "leftStance")``, ``raise-up-left-hand_raise`` → ``("raise-up-left-hand",
+    "raise")`` (:func:`~stylemotion.primitives.segmentation.parse_primitive`); ConfigError otherwise."""
     try:
         return parse_primitive(name)
     except ValueError as err:
-        raise ConfigError(f"{err}, or an arm primitive <raise-up-…|wave-…>_<{'|'.join(ARM_PRIMITIVES)}> "
-                          "(e.g. raise-up-left-hand_raise, wave-left-hand_wave)") from None
-
-
-class _ArmClips:
-    """The clips of one arm primitive in the data's seeded split (what :class:`ClipDataModule` gives for walks)."""
-
-    def __init__(self, cfg: DictConfig, content: str, primitive: str, styles: list[str] | None):
-        from stylemotion.datasets import build_dataset
-
-        data = OmegaConf.to_container(cfg.data, resolve=True)
-        takeset = build_dataset(data)
-        split = dict(data.get("split") or {})
-        self.clips: dict[str, list] = {}
-        for part, takes in takeset.split(**split).items():
-            takes = [t for t in takes if styles is None or t.style in styles]
-            self.clips[part], _ = arm_clips(takes, content, primitive)
-        if not self.clips.get("train"):
-            raise ConfigError(f"experiment=morphable_graph, {content}_{primitive}: no {primitive} clip in the train "
-                              f"takes of {content} (style {styles or 'any'}) of dataset {takeset.name!r}")
+        raise ConfigError(f"primitive={name}: {err}") from None
 
 
 def _write_samples(model: MorphableModel, folder: Path, seed: int, data_name: str) -> None:

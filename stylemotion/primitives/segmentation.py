@@ -34,24 +34,70 @@ PRIMITIVES: tuple[str, ...] = (
 STANCE_FOOT: dict[str, int] = {p: 0 if "Left" in p or p.startswith("left") else 1 for p in PRIMITIVES}
 #: Locomotion actions segmented by default.
 ACTIONS: tuple[str, ...] = ("walk", "run")
+#: Arm primitives, in take order (``wave`` only for :data:`WAVE_CONTENTS`).
+ARM_PRIMITIVES = ("raise", "wave", "lower")
+#: Content prefixes of arm takes (Bandai dataset 2).
+ARM_CONTENTS = ("raise-up", "wave")
+#: Content prefixes of the arm takes that have ``wave`` cycles.
+WAVE_CONTENTS = ("wave",)
 _SIDE = ("Left", "Right")
 _FOOT = ("left", "right")
 
 
 def parse_primitive(name: str) -> tuple[str, str]:
-    """``"walk_leftStance"`` → ``("walk", "leftStance")``, or a ValueError listing valid names."""
+    """``"walk_leftStance"`` → ``("walk", "leftStance")``; an arm primitive ``<arm content>_<raise|wave|lower>``
+    (``raise-up-left-hand_raise``, ``wave-both-hands_wave``; ``wave`` only of wave contents) → ``(content,
+    primitive)``; a ValueError listing both kinds otherwise."""
+    content, _, arm_primitive = str(name).rpartition("_")
+    if arm_primitive in ARM_PRIMITIVES and is_arm_content(content):
+        check_arm_primitive(content, arm_primitive)
+        return content, arm_primitive
     action, _, primitive = str(name).partition("_")
     if action not in ACTIONS or primitive not in PRIMITIVES:
         valid = [f"{a}_{p}" for a in ACTIONS for p in PRIMITIVES]
-        raise ValueError(f"unknown motion primitive {name!r}; use <action>_<primitive>, one of {valid}")
+        raise ValueError(f"unknown motion primitive {name!r}; use <action>_<primitive>, one of {valid}, or an arm "
+                         f"primitive <raise-up-…|wave-…>_<{'|'.join(ARM_PRIMITIVES)}> (e.g. raise-up-right-hand_raise)")
     return action, primitive
 
 
-def check_primitive(primitive: str) -> str:
-    """``primitive`` itself, or a ValueError naming the six valid primitives."""
-    if primitive not in PRIMITIVES:
-        raise ValueError(f"unknown motion primitive {primitive!r}; the primitives are {list(PRIMITIVES)}")
+def check_primitive(primitive: str, action: str | None = None) -> str:
+    """``primitive`` itself, or a ValueError naming the valid primitives (of ``action``: an arm content's own)."""
+    if action is not None and is_arm_content(action):
+        check_arm_primitive(action, primitive)
+    elif primitive not in PRIMITIVES and (action is not None or primitive not in ARM_PRIMITIVES):
+        raise ValueError(f"unknown motion primitive {primitive!r}; the primitives are {list(PRIMITIVES)}"
+                         + ("" if action is not None else f" and the arm primitives {list(ARM_PRIMITIVES)}"))
     return primitive
+
+
+def stance_foot(primitive: str) -> int | None:
+    """0 if ``primitive`` (a name of :data:`PRIMITIVES` or :data:`ARM_PRIMITIVES`) plants the left foot, 1 the
+    right, None for an arm primitive (both feet stand)."""
+    return STANCE_FOOT.get(primitive)
+
+
+def _of_kind(content: str, prefixes: tuple[str, ...]) -> bool:
+    return any(content == p or content.startswith(p + "-") for p in prefixes)
+
+
+def is_arm_content(content: str) -> bool:
+    return _of_kind(content, ARM_CONTENTS)
+
+
+def content_primitives(content: str) -> tuple[str, ...]:
+    """The arm primitives of an arm content, in take order (``wave`` only for :data:`WAVE_CONTENTS`)."""
+    waves = _of_kind(content, WAVE_CONTENTS)
+    return tuple(p for p in ARM_PRIMITIVES if waves or p != "wave")
+
+
+def check_arm_primitive(content: str, primitive: str) -> None:
+    """A ValueError unless ``primitive`` is an arm primitive that ``content``'s takes have."""
+    if primitive not in ARM_PRIMITIVES:
+        raise ValueError(f"unknown arm primitive {primitive!r}; one of {list(ARM_PRIMITIVES)}")
+    if primitive not in content_primitives(content):
+        valid = ", ".join(f"{content}_{p}" for p in content_primitives(content))
+        raise ValueError(f"content {content!r} has no {primitive!r} primitive ({primitive} needs a "
+                         f"{'|'.join(WAVE_CONTENTS)}-… content); use one of {valid}")
 
 
 def action_of(content: str, actions: Sequence[str] = ACTIONS) -> str | None:
@@ -115,8 +161,8 @@ class Clip:
     """One motion primitive instance.
 
     Attributes:
-        action: ``walk`` or ``run``.
-        primitive: one of :data:`PRIMITIVES`.
+        action: ``walk`` or ``run``, or an arm content (``raise-up-right-hand``, :mod:`stylemotion.primitives.arm`).
+        primitive: one of :data:`PRIMITIVES` (of an arm content: :data:`ARM_PRIMITIVES`).
         style: the take's style label.
         take: the take's name.
         content: the take's content label (e.g. ``walk-turn-left``).
@@ -148,9 +194,9 @@ class Clip:
         return (self.num_frames - 1) / self.fps
 
     @property
-    def stance_foot(self) -> int:
-        """0 if the left foot is planted, 1 if the right."""
-        return STANCE_FOOT[self.primitive]
+    def stance_foot(self) -> int | None:
+        """0 if the left foot is planted, 1 if the right, None for an arm primitive."""
+        return stance_foot(self.primitive)
 
     @cached_property
     def positions(self) -> np.ndarray:
@@ -242,7 +288,7 @@ class Segmentation:
     def select(self, action: str | None = None, primitives: Iterable[str] | None = None,
                styles: Iterable[str] | None = None) -> list[Clip]:
         """Clips of one action, some primitives and some styles (None: all)."""
-        prims = None if primitives is None else {check_primitive(p) for p in primitives}
+        prims = None if primitives is None else {check_primitive(p, action) for p in primitives}
         styles = None if styles is None else set(styles)
         return [c for c in self.clips if (action is None or c.action == action)
                 and (prims is None or c.primitive in prims) and (styles is None or c.style in styles)]
@@ -285,10 +331,34 @@ def rest_runs(positions: np.ndarray, contacts: np.ndarray, fps: float, settings:
     return [(a, b) for a, b in _runs(still) if b - a >= min_len]
 
 
+def of_action(content: str, action: str, actions: Sequence[str] = ACTIONS) -> bool:
+    """Whether a take of ``content`` is one of ``action``: a locomotion action's by :func:`action_of`, an arm
+    content's (``raise-up-right-hand``) when it is that content."""
+    return content == action if is_arm_content(action) else action_of(content, actions) == action
+
+
 def segment_action(takes: Iterable[Take], action: str, settings: SegmentSettings | None = None) -> Segmentation:
-    """The takes whose content is of ``action`` (:func:`action_of`), segmented (:func:`segment_takes`)."""
+    """The takes of ``action`` (:func:`of_action`) segmented: a locomotion action's by :func:`segment_takes`, an arm
+    content's by :func:`stylemotion.primitives.arm.segment_arm_takes` (no foot-contact settings)."""
     settings = settings or SegmentSettings()
-    return segment_takes([t for t in takes if action_of(t.content, settings.actions) == action], settings)
+    chosen = [t for t in takes if of_action(t.content, action, settings.actions)]
+    if is_arm_content(action):
+        from stylemotion.primitives.arm import segment_arm_takes  # arm.py builds on this module's Clip
+
+        return segment_arm_takes(chosen)
+    return segment_takes(chosen, settings)
+
+
+def segment_actions(takes: Sequence[Take], actions: Iterable[str], settings: SegmentSettings | None = None
+                    ) -> Segmentation:
+    """:func:`segment_action` of each of ``actions``, merged in the order given."""
+    out = Segmentation()
+    for action in dict.fromkeys(actions):
+        seg = segment_action(takes, action, settings)
+        out.clips += seg.clips
+        out.rejections += seg.rejections
+        out.takes += seg.takes
+    return out
 
 
 def segment_take(take: Take, settings: SegmentSettings | None = None) -> TakeSegmentation:

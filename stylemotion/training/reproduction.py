@@ -61,7 +61,7 @@ from stylemotion.evaluation.run import recorded_path, run_evaluation, settings_f
 from stylemotion.io.errors import OutputWriteError, UserInputError
 from stylemotion.io.jsonfile import JsonFileError, json_text, read_json_object, write_json
 from stylemotion.io.outputs import check_new_output, inside, safe_name
-from stylemotion.primitives.segmentation import SegmentSettings, action_of, parse_primitive, segment_takes
+from stylemotion.primitives.segmentation import SegmentSettings, parse_primitive, segment_actions
 from stylemotion.provenance import provenance
 
 log = logging.getLogger(__name__)
@@ -178,9 +178,7 @@ class Reproduction:
         t0 = time.perf_counter()
         takeset = build_dataset(self.data_cfg)
         settings = SegmentSettings.from_dict(dict(self.cfg.evaluation.get("segment") or {}))
-        actions = {parse_primitive(p)[0] for p in self.primitives}
-        takes = [t for t in takeset.takes if action_of(t.content, settings.actions) in actions]
-        seg = segment_takes(takes, settings)
+        seg = segment_actions(takeset.takes, [parse_primitive(p)[0] for p in self.primitives], settings)
         counts = Counter((f"{c.action}_{c.primitive}", c.style) for c in seg.clips)
         styles = takeset.label_values("style")
         neutral = str(self.cfg.evaluation.neutral_style)

@@ -15,9 +15,9 @@ import pytest
 
 from stylemotion.datasets import load_dataset
 from stylemotion.morphable import FitSettings, fit_primitive
-from stylemotion.morphable.arm import arm_clips
 from stylemotion.morphable.heldout import keyframe_errors
 from stylemotion.morphable.model import reconstruction_error
+from stylemotion.primitives.arm import arm_clips
 from stylemotion.skeleton import CANONICAL_JOINTS
 
 #: val joint RMSE of the small model (results.regression.val_joint_rmse_m), metres.

@@ -1,4 +1,4 @@
-"""Arm primitives (stylemotion.morphable.arm): cuts on constructed takes (raise/lower, and wave cycles against
+"""Arm primitives (stylemotion.primitives.arm): cuts on constructed takes (raise/lower, and wave cycles against
 their known extremes at any facing), a raise primitive of Bandai fitted and driven to hand targets, and the wave
 cycles of Bandai's wave-left-hand takes (realdata)."""
 
@@ -13,9 +13,9 @@ from stylemotion.datasets import Take, load_dataset
 from stylemotion.datasets.synthetic import generate_take
 from stylemotion.geometry import rotate_yaw
 from stylemotion.morphable import FitSettings, fit_primitive
-from stylemotion.morphable.arm import ArmSettings, arm_clips, arm_keyframes, segment_arm_take, wave_signal
 from stylemotion.morphable.constraints import KeyframeConstraint
 from stylemotion.morphable.synthesis import MapSettings, solve_constraints
+from stylemotion.primitives.arm import ArmSettings, arm_clips, arm_keyframes, segment_arm_take, wave_signal
 from stylemotion.representation import facing_yaw
 from stylemotion.skeleton import CANONICAL_JOINTS
 

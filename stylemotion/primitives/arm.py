@@ -51,16 +51,18 @@ from scipy.signal import find_peaks
 from stylemotion.datasets.base import Take
 from stylemotion.geometry import direction_yaw, facing_direction, rotate_yaw
 from stylemotion.primitives.contacts import foot_contacts
-from stylemotion.primitives.segmentation import Clip
+from stylemotion.primitives.segmentation import (
+    ARM_CONTENTS,
+    Clip,
+    Rejection,
+    Segmentation,
+    check_arm_primitive,
+    content_primitives,
+    is_arm_content,
+)
 from stylemotion.representation import ROOT_JOINT, facing_yaw
 from stylemotion.skeleton import CANONICAL_JOINTS
 
-#: Arm primitives, in take order (``wave`` only for :data:`WAVE_CONTENTS`).
-ARM_PRIMITIVES = ("raise", "wave", "lower")
-#: Content prefixes of arm takes (Bandai dataset 2).
-ARM_CONTENTS = ("raise-up", "wave")
-#: Content prefixes of the arm takes that have ``wave`` cycles.
-WAVE_CONTENTS = ("wave",)
 HANDS = ("Hand_L", "Hand_R")
 
 
@@ -88,29 +90,6 @@ class ArmSettings:
                 or not self.min_wave_m > 0):
             raise ValueError(f"ArmSettings need min_raise_m > 0, 0 < threshold < 0.5, search_s ≥ 0, min_frames ≥ 2, "
                              f"min_wave_m > 0; got {self}")
-
-
-def _of_kind(content: str, prefixes: tuple[str, ...]) -> bool:
-    return any(content == p or content.startswith(p + "-") for p in prefixes)
-
-
-def is_arm_content(content: str) -> bool:
-    return _of_kind(content, ARM_CONTENTS)
-
-
-def content_primitives(content: str) -> tuple[str, ...]:
-    """The arm primitives of an arm content, in take order (``wave`` only for :data:`WAVE_CONTENTS`)."""
-    waves = _of_kind(content, WAVE_CONTENTS)
-    return tuple(p for p in ARM_PRIMITIVES if waves or p != "wave")
-
-
-def check_arm_primitive(content: str, primitive: str) -> None:
-    """A ValueError unless ``primitive`` is an arm primitive that ``content``'s takes have."""
-    if primitive not in ARM_PRIMITIVES:
-        raise ValueError(f"unknown arm primitive {primitive!r}; one of {list(ARM_PRIMITIVES)}")
-    if primitive not in content_primitives(content):
-        raise ValueError(f"content {content!r} has no {primitive!r} primitive (only {list(content_primitives(content))}"
-                         f"; {primitive} needs a {'|'.join(WAVE_CONTENTS)}-… content)")
 
 
 def arm_keyframes(positions: np.ndarray, fps: float, settings: ArmSettings | None = None
@@ -249,6 +228,22 @@ def segment_arm_take(take: Take, settings: ArmSettings | None = None, primitives
     nothing was rejected). ValueError for a content that is no arm motion or lacks one of ``primitives``."""
     clips, rejected = _segment(take, settings, primitives)
     return clips, "; ".join(rejected) or None
+
+
+def segment_arm_takes(takes: Iterable[Take], settings: ArmSettings | None = None) -> Segmentation:
+    """Every arm take of ``takes`` cut into its content's primitives (:func:`segment_arm_take`), as a
+    :class:`~stylemotion.primitives.segmentation.Segmentation` (a take without clips, or a wave cycle, is a
+    rejection naming why; takes of other contents are listed in ``ignored``)."""
+    out = Segmentation()
+    for take in takes:
+        if not is_arm_content(take.content):
+            out.ignored.append((take.name, take.content))
+            continue
+        clips, rejected = _segment(take, settings, None)
+        out.clips.extend(clips)
+        out.rejections.extend(Rejection(take.name, take.content, take.style, take.content, None, None, reason,
+                                        "step" if clips else "take") for reason in rejected)
+    return out
 
 
 def arm_clips(takes: Iterable[Take], content: str, primitive: str, settings: ArmSettings | None = None
