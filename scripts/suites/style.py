@@ -30,6 +30,9 @@ DATA = {
     "synthetic": ["data=synthetic"],
     "bandai": ["data=bandai", f"data.root={DATA_ROOT / 'bandai-namco-motion-2' / 'data.zip'}",
                "data.contents=[walk,walk-turn-left,walk-turn-right]"],
+    # suite primitive_vaes (Du Fig. 5.4): runs and an arm action
+    "bandai_run_arm": ["data=bandai", f"data.root={DATA_ROOT / 'bandai-namco-motion-2' / 'data.zip'}",
+                       "data.contents=[run,raise-up-right-hand]"],
 }
 #: Variation figures of the report (``variance_ratio``: model / training data; ``variation_vs_style``: model /
 #: real clips of its own style).

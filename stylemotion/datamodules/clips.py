@@ -111,7 +111,7 @@ class ClipDataModule(SplitDataModule):
             arm content, from ``ARM_PRIMITIVES``).
         styles: styles to serve; None = every style of the dataset.
         timeline: ``"median"`` (the median length of the selected train clips, all selected
-            primitives together) or a fixed number of frames.
+            primitives together, at least ``min_length``) or a fixed number of frames.
         example: how style examples are picked (see the module docstring); missing keys take
             the defaults ``pick=median, content=<action>, split=all``.
         example_styles: styles that need an example; None = every style of the dataset.
@@ -123,6 +123,8 @@ class ClipDataModule(SplitDataModule):
         segmentation: the takeset's ``action`` takes already segmented with these ``segment``
             settings (Python use, e.g. one segmentation shared by the primitives of an evaluation);
             None segments them in :meth:`setup`.
+        min_length: fewest frames of the ``median`` timeline (e.g. an autoencoder's receptive field: Bandai's run
+            steps last 12 frames at 30 fps, the encoder's kernel 15).
     """
 
     def __init__(
@@ -141,6 +143,7 @@ class ClipDataModule(SplitDataModule):
         num_workers: int = 0,
         split: Mapping[str, Any] | None = None,
         segmentation: Segmentation | None = None,
+        min_length: int = 2,
     ):
         super().__init__(data, takeset, batch_size, eval_batch_size, num_workers, split)
         primitives = [primitives] if isinstance(primitives, str) else list(primitives)
@@ -166,6 +169,7 @@ class ClipDataModule(SplitDataModule):
         self.primitives = primitives
         self.requested_styles = None if styles is None else ([styles] if isinstance(styles, str) else list(styles))
         self.timeline = timeline
+        self.min_length = int(min_length)
         self.requested_example_styles = None if example_styles is None else list(example_styles)
         self.segment_settings = SegmentSettings.from_dict(dict(segment or {}))
         if action not in self.segment_settings.actions and not is_arm_content(action):
@@ -208,7 +212,8 @@ class ClipDataModule(SplitDataModule):
         if not self.clips["train"]:
             raise NoClipsError(self._empty_message("train", wanted))
         if self.timeline == "median":
-            self.length = max(2, int(round(float(np.median([c.num_frames for c in self.clips["train"]])))))
+            median = int(round(float(np.median([c.num_frames for c in self.clips["train"]]))))
+            self.length = max(2, self.min_length, median)
         else:
             self.length = int(self.timeline)
         for part in SPLITS:

@@ -197,7 +197,8 @@ class FeatureDataModule(SplitDataModule):
             the module doc); instead of ``examples``.
         example_records: one mapping of plain values per clip of ``example_clips``, recorded with it.
         example_length: ``canonical`` or ``natural`` (see the module doc).
-        timeline: canonical length, ``median`` or frames (see :class:`ClipDataModule`).
+        timeline: canonical length, ``median`` (at least the autoencoder's receptive field) or frames (see
+            :class:`ClipDataModule`).
         segment: segmentation overrides (see :class:`ClipDataModule`).
         batch_size, eval_batch_size, num_workers: DataLoader settings.
         min_train_clips: fewest training clips accepted (validation needs at least one clip).
@@ -308,6 +309,7 @@ class FeatureDataModule(SplitDataModule):
         ae = self.autoencoder
         ae.check_compatible(fps=self.fps, frame_dim=FRAME_DIM, representation=REPRESENTATION,
                             joint_names=CANONICAL_JOINTS)
+        self.clip_data.min_length = receptive_field(ae)  # a "median" timeline shorter than the kernel is stretched
         self.clip_data.setup()
         clips = self.clip_data.clips
         counts = {part: len(clips[part]) for part in SPLITS}
