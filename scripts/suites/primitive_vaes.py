@@ -94,7 +94,8 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
                    "vs_real": {k: spread(s[p]["vs_real"][k] for s in per_seed.values()) for k in VS_REAL},
                    "skating_samples": spread(s[p]["skating"]["samples"] for s in per_seed.values()),
                    "skating_real": spread(s[p]["skating"]["real"] for s in per_seed.values()),
-                   "no_plant_samples": spread(s[p]["skating"]["samples_no_plant"] for s in per_seed.values())}
+                   "no_plant_samples": spread(s[p]["skating"]["samples_no_plant"] for s in per_seed.values()),
+                   "no_plant_real": spread(s[p]["skating"]["real_no_plant"] for s in per_seed.values())}
                for p in PRIMITIVES}
     first = per_seed[str(seeds[0])]
     return {"data": style.DATA[DATA], "primitives": PRIMITIVES, "split": split, "runs": runs,
@@ -122,7 +123,8 @@ def render(record: dict[str, Any]) -> dict[str, str]:
         rows.append([p, "VAE / training data", *(f"{fmt_spread(s['ratio'][k], 2)} ({fmt_range(s['ratio'][k], 2)})"
                                                   for k in TABLE), "", "", ""])
     vs_rows = [[p, *(f"{fmt_spread(r['summary'][p]['vs_real'][k], 2)} ({fmt_range(r['summary'][p]['vs_real'][k], 2)})"
-                     for k in VS_REAL), f"{fmt_spread(r['summary'][p]['no_plant_samples'], 2)}"]
+                     for k in VS_REAL), f"{fmt_spread(r['summary'][p]['no_plant_samples'], 2)}",
+                f"{fmt_spread(r['summary'][p]['no_plant_real'], 2)}"]
                for p in r["primitives"]]
     split = r.get("split") or {}
     clips = "; ".join(f"{p}: {c['train_clips']} train clips of every style, {c['heldout_clips']} held out"
@@ -140,7 +142,8 @@ def render(record: dict[str, Any]) -> dict[str, str]:
         + "\n\nAgainst the real held-out clips of the style (val+test `normal` clips): the samples' pose_across_SD "
           "and diversity as shares of the real clips', and the share of samples whose stance foot never touches "
           "the ground.\n\n"
-        + md_table(["primitive", "pose_across_SD / real", "diversity / real", "samples without a planted foot"],
+        + md_table(["primitive", "pose_across_SD / real", "diversity / real", "samples without a planted foot",
+                            "real clips without one"],
                    vs_rows)
         + f"\n\nData split by take (seed {split.get('seed')}, val {split.get('val_fraction')}, test "
           f"{split.get('test_fraction')}); {clips}. Nothing is chosen here: the budget and model settings are the "
