@@ -11,7 +11,7 @@ from hydra.utils import instantiate
 from omegaconf import OmegaConf
 
 from stylemotion.config import CONFIG_DIR
-from stylemotion.datamodules.clips import ClipDataModule, NoClipsError
+from stylemotion.datamodules.clips import PRIMITIVE_INDEX, ClipDataModule, NoClipsError
 from stylemotion.datasets import Take, TakeSet, load_dataset
 from stylemotion.datasets.registry import load_synthetic
 from stylemotion.datasets.synthetic import STYLES
@@ -134,3 +134,26 @@ def test_bandai_style_examples_for_all_seven_styles(bandai_zip_path: Path) -> No
     assert sorted(examples) == sorted(STYLES)
     assert all(c.content == "walk" and c.primitive == "leftStance" for c in examples.values())
     assert 10 <= dm.length <= 25  # a walking step at 30 fps
+
+
+def test_median_timeline_is_at_least_min_length(synthetic: TakeSet) -> None:
+    median = module(synthetic, action="run", primitives=["leftStance"]).length
+    stretched = module(synthetic, action="run", primitives=["leftStance"], min_length=median + 7)
+    assert stretched.length == median + 7
+    assert next(iter(stretched.val_dataloader()))["frames"].shape[1] == median + 7
+    assert module(synthetic, action="run", primitives=["leftStance"], min_length=2).length == median
+
+
+@pytest.mark.realdata
+def test_bandai_arm_action_serves_its_raise_clips(bandai_zip_path: Path) -> None:
+    full = load_dataset("bandai", root=bandai_zip_path, contents=["raise-up-right-hand"])
+    takes = [t for style in ("normal", "elderly") for t in [t for t in full.takes if t.style == style][:12]]
+    takeset = TakeSet("bandai-raise", takes, full.fps)
+    dm = module(takeset, action="raise-up-right-hand", primitives=["raise"], styles=["normal"])
+    clips = [c for part in ("train", "val", "test") for c in dm.clips[part]]
+    assert clips and {(c.action, c.primitive, c.style) for c in clips} == {("raise-up-right-hand", "raise", "normal")}
+    batch = next(iter(dm.train_dataloader()))
+    assert set(batch["primitive"].tolist()) == {PRIMITIVE_INDEX.index("raise")}
+    assert dm.style_example("elderly").primitive == "raise"
+    with pytest.raises(ValueError, match="has no 'wave' primitive"):
+        ClipDataModule(takeset=takeset, action="raise-up-right-hand", primitives=["wave"])

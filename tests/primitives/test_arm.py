@@ -16,6 +16,13 @@ from stylemotion.morphable import FitSettings, fit_primitive
 from stylemotion.morphable.constraints import KeyframeConstraint
 from stylemotion.morphable.synthesis import MapSettings, solve_constraints
 from stylemotion.primitives.arm import ArmSettings, arm_clips, arm_keyframes, segment_arm_take, wave_signal
+from stylemotion.primitives.segmentation import (
+    check_primitive,
+    parse_primitive,
+    segment_action,
+    segment_actions,
+    stance_foot,
+)
 from stylemotion.representation import facing_yaw
 from stylemotion.skeleton import CANONICAL_JOINTS
 
@@ -192,3 +199,37 @@ def test_bandai_wave_left_hand_cycles_are_single_waves(bandai_zip_path: Path) ->
             # it starts and ends at the same phase: both ends are the hand's outermost positions (within 20 %)
             assert s.max() - min(s[0], s[-1]) <= 0.2 * travel, (clip.describe(), s[0], s[-1], s.max())
             assert int(np.argmin(s)) not in (0, len(s) - 1)  # the inward extreme lies inside the cycle
+
+
+def test_arm_primitive_names_parse_and_refuse_what_the_content_lacks() -> None:
+    assert parse_primitive("raise-up-right-hand_raise") == ("raise-up-right-hand", "raise")
+    assert parse_primitive("wave-both-hands_wave") == ("wave-both-hands", "wave")
+    assert parse_primitive("run_leftStance") == ("run", "leftStance")
+    with pytest.raises(ValueError, match="raise-up-left-hand_raise, raise-up-left-hand_lower"):
+        parse_primitive("raise-up-left-hand_wave")
+    with pytest.raises(ValueError, match="arm primitive"):
+        parse_primitive("walk_raise")
+    assert check_primitive("lower", "raise-up-left-hand") == "lower"
+    with pytest.raises(ValueError):
+        check_primitive("leftStance", "raise-up-left-hand")
+    with pytest.raises(ValueError):
+        check_primitive("raise", "walk")
+    assert stance_foot("raise") is None and stance_foot("leftStance") == 0 and stance_foot("endRightStance") == 1
+
+
+def test_segment_action_cuts_an_arm_content_as_arm_clips_does() -> None:
+    takes = [_raise_take((10, 30), (50, 70)), _raise_take((5, 25), (45, 65), name="arm_raise-up-left-hand_normal_002"),
+             _raise_take((10, 30), (50, 70), name="arm_raise-up-left-hand_normal_003", back_down=False),
+             Take("synthetic_walk_normal_000", generate_take("walk", "normal", 0, duration_s=3.0).positions, FPS,
+                  {"content": "walk", "style": "normal", "take": "000"})]
+    seg = segment_action(takes, "raise-up-left-hand")
+    expected = [(c.take, c.primitive, c.start, c.stop) for p in ("raise", "lower")
+                for c in arm_clips(takes, "raise-up-left-hand", p)[0]]
+    assert sorted((c.take, c.primitive, c.start, c.stop) for c in seg.clips) == sorted(expected)
+    assert len(seg.clips) == 4 and {c.action for c in seg.clips} == {"raise-up-left-hand"}
+    # the take that does not come back down is a counted rejection, the walk is not of the action
+    assert [r.take for r in seg.rejections] == ["arm_raise-up-left-hand_normal_003"]
+    assert [c.stance_foot for c in seg.clips] == [None] * 4
+    assert segment_action(takes, "walk").clips
+    merged = segment_actions(takes, ["raise-up-left-hand", "walk"])
+    assert len(merged.clips) == len(seg.clips) + len(segment_action(takes, "walk").clips)
