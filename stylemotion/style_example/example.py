@@ -28,7 +28,14 @@ from stylemotion.datasets.user_motion import (
     on_run_skeleton,
     parse_example,
 )
-from stylemotion.primitives.segmentation import Clip, Segmentation, SegmentSettings, parse_primitive, segment_action
+from stylemotion.primitives.segmentation import (
+    Clip,
+    Segmentation,
+    SegmentSettings,
+    is_arm_content,
+    parse_primitive,
+    segment_action,
+)
 
 __all__ = ["EXAMPLE_FILE", "MAX_EXAMPLES", "MAX_REASONS", "ConvertedExample", "CutExample", "ExampleSpec",
            "StyleExampleError", "convert_example", "cut_example", "cut_examples", "example_file", "on_run_skeleton",
@@ -142,7 +149,10 @@ def cut_example(example: ConvertedExample, style: str, action: str, primitives: 
         raise StyleExampleError(
             f"{example.spec.key}={example.spec}: no complete step of the run's primitives {ours} can be cut from it "
             f"({example.positions.shape[0]} frames at {example.fps:g} fps after conversion; primitives cut: {cut}). "
-            f"Why: {reasons}. Give a longer {action} with at least one whole step between two support transfers")
+            f"Why: {reasons}. " + (f"Give a {action} take whose hand rises from rest and comes back down"
+                                   if is_arm_content(action) else
+                                   f"Give a longer {action} with at least one whole step between two support "
+                                   "transfers"))
     used, borrowed = {}, []
     for p in ours:
         used[p] = clips[p] or same_action

@@ -149,6 +149,13 @@ def test_an_example_without_a_complete_step_says_why(tmp_path: Path) -> None:
         cut_example(example, "tired", "walk", PRIMITIVES, {})
 
 
+def test_a_walk_given_for_an_arm_primitive_says_what_an_arm_example_needs(tmp_path: Path) -> None:
+    example = convert_example(parse_example(str(example_bvh(tmp_path, fps=60.0))), ConversionSettings())
+    with pytest.raises(StyleExampleError, match=r"primitives \['raise-up-right-hand_raise'\] .*Why: .*no hand "
+                                                r".*Give a raise-up-right-hand take whose hand rises from rest"):
+        cut_example(example, "tired", "raise-up-right-hand", ["raise-up-right-hand_raise"], {})
+
+
 @pytest.mark.realdata
 @pytest.mark.parametrize("name, fps, cut", [("cmu21_walk", 60.0, {"walk_leftStance": 1, "walk_rightStance": 1}),
                                            ("cmu21_female_walk", 60.0, {"walk_leftStance": 1, "walk_rightStance": 0}),
