@@ -43,18 +43,19 @@ METHODS = ("fat graph", "motion graph")
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--contents", nargs="+", default=None, help="Bandai contents of the databases (all)")
     parser.add_argument("--features", default="E15x3", help="feature set of the shared index (both graphs)")
-    parser.add_argument("--radii", type=float, nargs="+", default=[0.1, 0.2, 0.3, 0.5],
+    parser.add_argument("--radii", type=float, nargs="+", default=[0.1, 0.2, 0.3, 0.5, 0.8],
                         help="fat graph: base-pose radius candidates (feature units)")
     parser.add_argument("--min-members", type=int, nargs="+", default=[10, 30],
                         help="fat graph: least frames of a hub cluster, candidates")
     parser.add_argument("--fat-k", type=int, default=64, help="fat graph: most neighbours per frame")
-    parser.add_argument("--thresholds", type=float, nargs="+", default=[0.1, 0.2, 0.3, 0.5],
+    parser.add_argument("--thresholds", type=float, nargs="+", default=[0.1, 0.2, 0.3, 0.5, 0.8],
                         help="motion graph: transition threshold candidates (feature units)")
-    parser.add_argument("--graph-k", type=int, default=32, help="motion graph: most candidates per frame")
+    parser.add_argument("--graph-k", type=int, nargs="+", default=[32, 128],
+                        help="motion graph: most candidates per frame, candidates")
     parser.add_argument("--min-gap", type=int, default=10, help="motion graph: min_gap_frames")
     parser.add_argument("--walks", type=int, default=10, help="random walks per graph and seed")
     parser.add_argument("--seconds", type=float, default=20.0, help="length of a random walk")
-    parser.add_argument("--goals", type=int, default=20, help="goal walks per graph and seed")
+    parser.add_argument("--goals", type=int, default=30, help="goal walks per graph and seed")
     parser.add_argument("--blend", type=int, default=10, help="blend frames at a transition")
     parser.add_argument("--min-play", type=float, default=0.5,
                         help="random walks: seconds played in a take after a transition before the next")
@@ -94,7 +95,11 @@ def _evaluate(graph, rng: np.random.Generator, args: argparse.Namespace) -> dict
         goals.append({"goal": goal, "reached": found is not None,
                       "seconds": None if found is None else (walk_frames(scc, found.edges) - 1) / db.fps})
     done = [w for w in walks if not w["stuck"]]
+    covered = scc.covered()
+    content = np.asarray(db.contents)[db.take_id]
+    by_content = {str(c): float(covered[content == c].mean()) for c in sorted(set(db.contents))}
     return {"graph": graph.records(), "scc": scc.records(), "walk_coverage": float(played.mean()),
+            "coverage_by_content": by_content,
             "walks": walks, "goals": goals,
             "stuck": len(walks) - len(done),
             "mean_pose_gap_cm": _mean([w["pose_gap_cm"] for w in done]),
@@ -107,19 +112,19 @@ def _build(method: str, index, frames, setting: dict[str, Any], args: argparse.N
 
     if method == "fat graph":
         return fat_graph(index, setting["radius"], args.fat_k, setting["min_members"], clusters=clusters, frames=frames)
-    return motion_graph(index, setting["threshold"], args.graph_k, args.min_gap, frames=frames)
+    return motion_graph(index, setting["threshold"], setting["k"], args.min_gap, frames=frames)
 
 
 def _candidates(method: str, args: argparse.Namespace) -> list[dict[str, Any]]:
     if method == "fat graph":
         return [{"radius": r, "min_members": m} for r in args.radii for m in args.min_members]
-    return [{"threshold": t} for t in args.thresholds]
+    return [{"threshold": t, "k": k} for t in args.thresholds for k in args.graph_k]
 
 
 def _label(setting: dict[str, Any]) -> str:
     if "radius" in setting:
         return f"radius {setting['radius']:g}, hubs ≥ {setting['min_members']}"
-    return f"threshold {setting['threshold']:g}"
+    return f"threshold {setting['threshold']:g}, k {setting['k']}"
 
 
 def _choose(outcomes: list[dict[str, Any]], max_gap_cm: float) -> int:
@@ -295,4 +300,12 @@ def render(record: dict[str, Any]) -> dict[str, str]:
                f"**{fat[2]}** vs {plain[2]}, transition pose gap {fat[6]} vs {plain[6]} cm, foot skating {fat[8]} vs "
                f"{plain[8]} % (the takes' {fmt(take_skating, 1)} %), walks stuck {fat[4]} vs {plain[4]}, goals "
                f"reached {fat[10]} vs {plain[10]}.")
-    return {"table": md_table(HEADER, rows) + "\n\n" + note, "choice": choice, "summary": summary}
+    contents_seen = sorted({c for x in r["per_seed"] for c in x["test"]["fat graph"]["coverage_by_content"]})
+    crow = [[c, *[fmt_spread(spread([x["test"][m]["coverage_by_content"].get(c, 0.0) * 100.0
+                                      for x in r["per_seed"]]), 1, " %") for m in METHODS]]
+            for c in contents_seen]
+    by_content = (md_table(["content", *[f"{m}: SCC coverage" for m in METHODS]], crow)
+                  + f"\n\nShare of each content's test frames on an edge of the largest SCC (mean ± sd over seeds), "
+                    f"the settings above. {prov}")
+    return {"table": md_table(HEADER, rows) + "\n\n" + note, "choice": choice, "summary": summary,
+            "by_content": by_content}
