@@ -43,12 +43,12 @@ METHODS = ("fat graph", "motion graph")
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--contents", nargs="+", default=None, help="Bandai contents of the databases (all)")
     parser.add_argument("--features", default="E15x3", help="feature set of the shared index (both graphs)")
-    parser.add_argument("--radii", type=float, nargs="+", default=[0.1, 0.2, 0.3, 0.5, 0.8],
+    parser.add_argument("--radii", type=float, nargs="+", default=[0.2, 0.3, 0.5, 0.8],
                         help="fat graph: base-pose radius candidates (feature units)")
     parser.add_argument("--min-members", type=int, nargs="+", default=[10, 30],
                         help="fat graph: least frames of a hub cluster, candidates")
     parser.add_argument("--fat-k", type=int, default=64, help="fat graph: most neighbours per frame")
-    parser.add_argument("--thresholds", type=float, nargs="+", default=[0.1, 0.2, 0.3, 0.5, 0.8],
+    parser.add_argument("--thresholds", type=float, nargs="+", default=[0.2, 0.3, 0.5, 0.8],
                         help="motion graph: transition threshold candidates (feature units)")
     parser.add_argument("--graph-k", type=int, nargs="+", default=[32, 128],
                         help="motion graph: most candidates per frame, candidates")
@@ -152,8 +152,10 @@ def _take_skating(takes) -> float:
 
 
 def _graphs_on(takes, fps: float, name: str, args: argparse.Namespace, settings: dict[str, list[dict[str, Any]]],
-               rng: np.random.Generator) -> dict[str, list[dict[str, Any]]]:
-    """Per method, the outcome of every setting in ``settings[method]`` on the database of ``takes``."""
+               seed: int) -> dict[str, list[dict[str, Any]]]:
+    """Per method, the outcome of every setting in ``settings[method]`` on the database of ``takes``; the walks of
+    each graph draw from a generator of their own (``[seed, part, method, setting]``), so no setting's walks depend
+    on another's."""
     from stylemotion.search.clip_graph import DatabaseFrames
     from stylemotion.search.fat_graph import base_poses
     from stylemotion.search.index import FrameIndex
@@ -163,9 +165,11 @@ def _graphs_on(takes, fps: float, name: str, args: argparse.Namespace, settings:
     frames = DatabaseFrames.of(database)
     out: dict[str, list[dict[str, Any]]] = {}
     clusters_by_radius: dict[float, Any] = {}
-    for method in METHODS:
+    part = 0 if name == "val" else 1
+    for m, method in enumerate(METHODS):
         out[method] = []
-        for setting in settings[method]:
+        for c, setting in enumerate(settings[method]):
+            rng = np.random.default_rng([seed, part, m, c])
             started = time.perf_counter()
             clusters = None
             if method == "fat graph":
@@ -196,10 +200,10 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
         splits.append(take_split_record(parts, seed, VAL_FRACTION, TEST_FRACTION))
         print(f"seed {seed}: val {len(val_takes)} takes, test {len(test_takes)} takes", flush=True)
         candidates = {m: _candidates(m, args) for m in METHODS}
-        val = _graphs_on(val_takes, bandai.fps, "val", args, candidates, np.random.default_rng([seed, 0]))
+        val = _graphs_on(val_takes, bandai.fps, "val", args, candidates, seed)
         chosen = {m: _choose(val[m], args.max_gap_cm) for m in METHODS}
         test = _graphs_on(test_takes, bandai.fps, "test", args, {m: [candidates[m][chosen[m]]] for m in METHODS},
-                          np.random.default_rng([seed, 1]))
+                          seed)
         per_seed.append({"seed": seed, "val": val, "chosen": {m: candidates[m][chosen[m]] for m in METHODS},
                          "test": {m: test[m][0] for m in METHODS}, "test_take_skating": _take_skating(test_takes),
                          "test_frames": int(sum(len(t.positions) for t in test_takes)),
