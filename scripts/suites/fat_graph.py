@@ -299,11 +299,20 @@ def render(record: dict[str, Any]) -> dict[str, str]:
                        crows)
               + f"\n\nVal: per seed the val takes are the database. Rule: {r['rule']}. {prov}")
     fat, plain = rows[0], rows[1]
+    left_out = {m: sum(any(v < 0.1 for v in x["test"][m]["coverage_by_content"].values()) for x in r["per_seed"])
+                for m in METHODS}
     summary = (f"Krüger §2.5.3 fat graph that synthesizes vs a plain motion graph (Bandai test takes as the database, "
                f"{n} seeds, settings chosen on val takes; [benchmarks/search.md](benchmarks/search.md)): SCC coverage "
-               f"**{fat[2]}** vs {plain[2]}, transition pose gap {fat[6]} vs {plain[6]} cm, foot skating {fat[8]} vs "
-               f"{plain[8]} % (the takes' {fmt(take_skating, 1)} %), walks stuck {fat[4]} vs {plain[4]}, goals "
-               f"reached {fat[10]} vs {plain[10]}.")
+               f"{fat[2]} vs {plain[2]} (seeds whose SCC leaves out a whole content, < 10 % of its frames: "
+               f"{left_out['fat graph']} / {n} vs {left_out['motion graph']} / {n}), transition pose gap {fat[6]} vs "
+               f"{plain[6]} cm, foot skating {fat[8]} vs {plain[8]} % (the takes' {fmt(take_skating, 1)} %), walks "
+               f"stuck {fat[4]} vs {plain[4]}, goals reached {fat[10]} vs {plain[10]}.")
+    grids = {"radius": s["radii"], "min_members": s["min_members"], "threshold": s["thresholds"], "k": s["graph_k"]}
+    edges = sorted({key for x in r["per_seed"] for m in METHODS for key, value in x["chosen"][m].items()
+                    if len(grids[key]) > 1 and value in (min(grids[key]), max(grids[key]))})
+    if edges:
+        choice += (f"\n\n{', '.join(edges)}: a choice lies at the edge of its candidates; values beyond them were not "
+                   f"tried.")
     contents_seen = sorted({c for x in r["per_seed"] for c in x["test"]["fat graph"]["coverage_by_content"]})
     crow = [[c, *[fmt_spread(spread([x["test"][m]["coverage_by_content"].get(c, 0.0) * 100.0
                                       for x in r["per_seed"]]), 1, " %") for m in METHODS]]
