@@ -3,7 +3,8 @@
 Feature sets of canonical positions (§2.3.2, §2.6.1), every frame of a dataset in one
 :class:`MotionDatabase`, and a k-NN :class:`FrameIndex` over one feature set, persisted in the dataset cache;
 global motion matching of a query (:func:`search_motion`, §2.4.1), numerical and logical similarity searches
-(§2.5.1) and fast fat-graph base poses (§2.5.3). The ``stylemotion-search`` command: :mod:`.command`.
+(§2.5.1), fast fat-graph base poses and the fat graph that synthesizes, beside a plain motion graph (§2.5.3).
+The ``stylemotion-search`` command: :mod:`.command`.
 
 The names below load from their submodules on first use (PEP 562, :func:`stylemotion.lazy_exports`), so a light
 submodule of the package loads without the heavy ones.
@@ -16,8 +17,20 @@ from typing import TYPE_CHECKING
 from stylemotion import lazy_exports
 
 if TYPE_CHECKING:
+    from stylemotion.search.clip_graph import (
+        ClipGraph,
+        DatabaseFrames,
+        Walk,
+        WalkMotion,
+        goal_walk,
+        largest_scc,
+        random_walk,
+        synthesize,
+        walk_figures,
+        write_walk,
+    )
     from stylemotion.search.database import FrameLocation, MotionDatabase
-    from stylemotion.search.fat_graph import FatGraphClusters, base_poses, greedy_bases, write_clusters
+    from stylemotion.search.fat_graph import FatGraphClusters, base_poses, fat_graph, greedy_bases, write_clusters
     from stylemotion.search.features import (
         E15_JOINTS,
         E30_JOINTS,
@@ -56,6 +69,7 @@ if TYPE_CHECKING:
         search_features,
         search_motion,
     )
+    from stylemotion.search.motion_graph import motion_graph
     from stylemotion.search.similarity import LogicalResult, logical_search, numerical_search
 
 
@@ -67,7 +81,9 @@ __all__ = [
     "auto_engine", "feature_names", "feature_spec", "fit_features", "physics_terms", "root_frames",
     "DEFAULT_K", "MATCH_KEYS", "SearchResult", "SegmentMatch", "nearest_outside", "search_features", "search_motion",
     "LogicalResult", "logical_search", "numerical_search",
-    "FatGraphClusters", "base_poses", "greedy_bases", "write_clusters",
+    "FatGraphClusters", "base_poses", "greedy_bases", "write_clusters", "fat_graph", "motion_graph",
+    "ClipGraph", "DatabaseFrames", "Walk", "WalkMotion", "goal_walk", "largest_scc", "random_walk", "synthesize",
+    "walk_figures", "write_walk",
 ]
 
 __getattr__, __dir__ = lazy_exports(__name__, {
@@ -77,6 +93,18 @@ __getattr__, __dir__ = lazy_exports(__name__, {
     "base_poses": "fat_graph",
     "greedy_bases": "fat_graph",
     "write_clusters": "fat_graph",
+    "fat_graph": "fat_graph",
+    "motion_graph": "motion_graph",
+    "ClipGraph": "clip_graph",
+    "DatabaseFrames": "clip_graph",
+    "Walk": "clip_graph",
+    "WalkMotion": "clip_graph",
+    "goal_walk": "clip_graph",
+    "largest_scc": "clip_graph",
+    "random_walk": "clip_graph",
+    "synthesize": "clip_graph",
+    "walk_figures": "clip_graph",
+    "write_walk": "clip_graph",
     "E15_JOINTS": "features",
     "E30_JOINTS": "features",
     "E39_JOINTS": "features",

@@ -15,6 +15,13 @@ for a constant ``k``. A frame counts itself among its neighbours (distance 0).
 
 :func:`write_clusters` exports ``clusters.json`` (per base pose: its global index, take, frame, labels,
 members, neighbour count) and ``clusters.npz`` (memberships).
+
+:func:`fat_graph` builds the graph over the clusters (Shin and Oh's fat graph as the thesis describes it: the
+base poses are hubs, the motion between them edges): the clusters with at least ``min_members`` frames are the
+hubs (nodes); a *visit* is a run of consecutive frames of a take in one hub, represented by its frame nearest
+the hub's base pose (features); the frames from one visit's representative to the next visit's, in each take,
+are an edge from the first hub to the second. Many edges join the same two hubs (the graph is "fat"); a walk
+(:mod:`stylemotion.search.clip_graph`) changes take only at a hub, blending the two representatives there.
 """
 
 from __future__ import annotations
@@ -29,6 +36,7 @@ import numpy as np
 
 from stylemotion.io.atomic import atomic_write_bytes
 from stylemotion.io.jsonfile import write_json
+from stylemotion.search.clip_graph import ClipGraph, DatabaseFrames, edges_graph
 from stylemotion.search.index import FrameIndex
 
 #: Frames per batched radius query (bounds the (chunk, k) arrays).
@@ -131,3 +139,56 @@ def write_clusters(clusters: FatGraphClusters, index: FrameIndex, folder: str | 
              take_id=index.database.take_id, frame_in_take=index.database.frame_in_take)
     atomic_write_bytes(npz_path, buffer.getvalue())
     return json_path, npz_path
+
+
+def hub_visits(clusters: FatGraphClusters, index: FrameIndex, min_members: int) -> tuple[np.ndarray, np.ndarray]:
+    """Visits to the hubs (clusters of ≥ ``min_members`` frames), in database order: ``(representative (v,)
+    global frames, cluster (v,))`` — per run of consecutive frames of one take in one hub, the frame nearest (in
+    the index's features) the hub's base pose (ties: the earliest)."""
+    if isinstance(min_members, bool) or not isinstance(min_members, (int, np.integer)) or min_members < 1:
+        raise ValueError(f"min_members must be a whole number ≥ 1, got {min_members!r}")
+    db = index.database
+    a = clusters.assignment
+    hub = np.where(clusters.sizes[a] >= min_members, a, -1)
+    new_take = np.zeros(len(a), dtype=bool)
+    new_take[db.take_start[:-1][db.take_start[:-1] < len(a)]] = True
+    changed = np.ones(len(a), dtype=bool)
+    changed[1:] = hub[1:] != hub[:-1]
+    run_start = np.flatnonzero((hub >= 0) & (changed | new_take))
+    bounds = np.flatnonzero(changed | new_take)
+    run_end = np.append(bounds, len(a))[np.searchsorted(bounds, run_start, side="right")]
+    distance = np.linalg.norm(index.features - index.features[clusters.bases[np.maximum(a, 0)]], axis=1)
+    reps = np.array([s + int(np.argmin(distance[s:z])) for s, z in zip(run_start, run_end)], dtype=np.int64)
+    return reps, hub[run_start]
+
+
+def fat_graph(index: FrameIndex, radius: float, k: int = 64, min_members: int = 20,
+              clusters: FatGraphClusters | None = None, frames: DatabaseFrames | None = None) -> ClipGraph:
+    """The fat graph over the base-pose clusters of ``index``'s database (module docstring), not yet pruned
+    (:func:`stylemotion.search.clip_graph.largest_scc`).
+
+    Args:
+        index: the database's frame index (its features define the clusters).
+        radius, k: :func:`base_poses`' settings (ignored when ``clusters`` is given).
+        min_members: least frames of a cluster that is a hub.
+        clusters: base poses already computed on ``index``.  frames: the database's
+            :class:`~stylemotion.search.clip_graph.DatabaseFrames` (computed when None).
+
+    Returns:
+        A :class:`~stylemotion.search.clip_graph.ClipGraph`: node ``h`` is the ``h``-th hub in the clusters'
+        order (``node_frame``: its base pose), one edge per two consecutive visits of a take.
+    """
+    clusters = base_poses(index, radius, k) if clusters is None else clusters
+    if isinstance(min_members, (int, np.integer)) and not isinstance(min_members, bool) and min_members > clusters.k:
+        raise ValueError(f"min_members={min_members} exceeds k={clusters.k}: no cluster holds more than k frames")
+    reps, cluster = hub_visits(clusters, index, min_members)
+    hubs = np.flatnonzero(clusters.sizes >= min_members)
+    node_of = np.full(clusters.num_clusters, -1, dtype=np.int64)
+    node_of[hubs] = np.arange(len(hubs))
+    same_take = index.database.take_id[reps[:-1]] == index.database.take_id[reps[1:]]
+    first, second = np.flatnonzero(same_take), np.flatnonzero(same_take) + 1
+    frames = DatabaseFrames.of(index.database) if frames is None else frames
+    settings = {"features": index.feature_set, "radius": float(clusters.radius), "k": int(clusters.k),
+                "min_members": int(min_members), "clusters": clusters.num_clusters, "hubs": int(len(hubs))}
+    return edges_graph("fat graph", frames, clusters.bases[hubs], node_of[cluster[first]], node_of[cluster[second]],
+                       reps[first], reps[second], settings, candidates=int(len(reps)))

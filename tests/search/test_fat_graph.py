@@ -105,3 +105,42 @@ def test_bad_k_is_refused_and_padding_is_no_neighbour() -> None:
     np.testing.assert_array_equal(counts, [1, 2, 1])
     np.testing.assert_array_equal(bases, [1, 2])
     np.testing.assert_array_equal(assignment, [0, 0, 1])
+
+
+def hub_index() -> FrameIndex:
+    """Two takes of hub poses A, B, C (exact copies, centres 10 apart) and transit frames x (each alone):
+    take 0 ``A A A x x B B x C C x A A``, take 1 ``B B x A A x C C``."""
+    layout = ["AAAxxBBxCCxAA", "BBxAAxCC"]
+    database = database_of([len(t) for t in layout])
+    centres = {"A": 0, "B": 1, "C": 2}
+    features = np.zeros((database.num_frames, 15), dtype=np.float32)
+    for g, symbol in enumerate("".join(layout)):
+        if symbol == "x":
+            features[g, 3 + g % 12] = 100.0 + 10.0 * g  # far from everything and from each other
+        else:
+            features[g, centres[symbol]] = 10.0
+    return FrameIndex(database, "E15", features)
+
+
+def test_fat_graph_nodes_are_the_hubs_and_edges_the_motion_between_visits() -> None:
+    from stylemotion.search.clip_graph import largest_scc
+    from stylemotion.search.fat_graph import fat_graph, hub_visits
+
+    index = hub_index()
+    clusters = base_poses(index, radius=0.5, k=16)
+    reps, cluster = hub_visits(clusters, index, min_members=2)
+    np.testing.assert_array_equal(reps, [0, 5, 8, 11, 13, 16, 19])  # each visit's first frame (all tie)
+    graph = fat_graph(index, radius=0.5, k=16, min_members=2)
+    # clusters by neighbour count: A (7 frames), then B and C (4 each; B's first frame is earlier)
+    np.testing.assert_array_equal(graph.node_frame, [0, 5, 8])
+    assert graph.settings["hubs"] == 3 and graph.candidates == 7
+    edges = list(zip(graph.src.tolist(), graph.dst.tolist(), graph.start.tolist(), graph.end.tolist()))
+    assert edges == [(0, 1, 0, 5), (1, 2, 5, 8), (2, 0, 8, 11), (1, 0, 13, 16), (0, 2, 16, 19)]
+    assert graph.coverage == pytest.approx(19 / 21)  # take 0's last frame and take 1's last one: after the visits
+    pruned = largest_scc(graph)
+    assert pruned.num_nodes == 3 and pruned.num_edges == 5
+    # a hub needs 5 frames: A alone, visited twice in take 0 and once in take 1: one self-loop A → A in take 0
+    lone = fat_graph(index, radius=0.5, k=16, min_members=5)
+    assert list(zip(lone.src.tolist(), lone.dst.tolist(), lone.start.tolist(), lone.end.tolist())) == [(0, 0, 0, 11)]
+    with pytest.raises(ValueError, match="exceeds k"):
+        fat_graph(index, radius=0.5, k=16, min_members=17)
