@@ -21,7 +21,6 @@ frame, metres (the thesis measured quaternion angles, eq. 4.6; the project's rep
 from __future__ import annotations
 
 import numpy as np
-from threadpoolctl import threadpool_limits
 
 from stylemotion.multilinear.model import MultilinearModel
 from stylemotion.representation import FRAME_DIM, frames_to_positions
@@ -42,28 +41,29 @@ def path_error(frames: np.ndarray, reference: np.ndarray, fps: float) -> float:
     return float(np.linalg.norm(a - b, axis=-1).mean())
 
 
-def fit_natural_weights(model: MultilinearModel, frames: np.ndarray, rounds: int = 30
+def fit_natural_weights(model: MultilinearModel, frames: np.ndarray, rounds: int = 20
                         ) -> tuple[np.ndarray, tuple[np.ndarray, ...]]:
     """``(reconstruction (f, 66), (α, β, γ))``: the product-of-weights fit of ``frames`` ``(f, 66)`` in the
-    model's reduced natural coefficient spaces (alternating least squares from the mean rows)."""
-    psi = model.psi.reshape(-1, *model.ranks[2:])                       # (66 f, k_a, k_s, k_r)
-    x = np.asarray(frames, dtype=np.float64).T.reshape(-1)
+    model's reduced natural coefficient spaces (alternating least squares from the mean rows, on the QR triangle of
+    Ψ's slices: ``‖Ψ (α⊗β⊗γ) − x‖² = ‖R (α⊗β⊗γ) − Qᵀx‖² + const``)."""
+    q, tri = model.natural_qr
+    y = q.T @ np.asarray(frames, dtype=np.float64).T.reshape(-1)
+    core = tri.reshape(-1, *model.ranks[2:])                                # (k, k_a, k_s, k_r)
     w = [u.mean(axis=0) for u in model.factors[2:]]
     blocks = ("dabc,b,c->da", "dabc,a,c->db", "dabc,a,b->dc")
-    with threadpool_limits(limits=1):       # small products: extra BLAS threads only contend
-        for _ in range(rounds):
-            for mode in range(3):
-                others = [w[k] for k in range(3) if k != mode]
-                w[mode] = np.linalg.lstsq(np.einsum(blocks[mode], psi, *others), x, rcond=None)[0]
-        fitted = np.einsum("dabc,a,b,c->d", psi, *w)
+    for _ in range(rounds):
+        for mode in range(3):
+            others = [w[k] for k in range(3) if k != mode]
+            w[mode] = np.linalg.lstsq(np.einsum(blocks[mode], core, *others), y, rcond=None)[0]
+    fitted = q @ np.einsum("dabc,a,b,c->d", core, *w)
     return fitted.reshape(FRAME_DIM, -1).T, tuple(w)
 
 
 def project_natural(model: MultilinearModel, frames: np.ndarray) -> np.ndarray:
     """``(f, 66)``: the least-squares projection onto the span of the ``k_a · k_s · k_r`` slices of Ψ."""
-    basis = model.psi.reshape(model.psi.shape[0] * model.psi.shape[1], -1)
+    q, _ = model.natural_qr
     x = np.asarray(frames, dtype=np.float64).T.reshape(-1)
-    return (basis @ np.linalg.lstsq(basis, x, rcond=None)[0]).reshape(FRAME_DIM, -1).T
+    return (q @ (q.T @ x)).reshape(FRAME_DIM, -1).T
 
 
 def project_technical(model: MultilinearModel, frames: np.ndarray) -> np.ndarray:

@@ -77,6 +77,12 @@ class MultilinearModel:
         """``Ψ = Φ ×_1 U_1 ×_2 U_2``: ``(66, f, rank_actor, rank_style, rank_repetition)``."""
         return multi_mode_dot(self.core, [self.factors[0], self.factors[1]], modes=[0, 1])
 
+    @cached_property
+    def natural_qr(self) -> tuple[np.ndarray, np.ndarray]:
+        """``(Q, R)``: the thin QR factorization of Ψ's slices as columns, ``Q`` ``(66 f, k)`` and ``R`` ``(k, k)``
+        with ``k = k_a k_s k_r`` (least-squares fits in the natural coefficient spaces work on ``R`` and ``Qᵀ x``)."""
+        return np.linalg.qr(self.psi.reshape(self.psi.shape[0] * self.psi.shape[1], -1))
+
     def truncated(self, ranks: Sequence[int]) -> MultilinearModel:
         """The model with every mode cut to ``ranks`` (5 values, each ≤ the current rank)."""
         core, factors = truncate(self.core, self.factors, ranks)
