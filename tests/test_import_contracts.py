@@ -7,7 +7,7 @@ is an edge to the submodule ``stylemotion.a.b`` when that is a module, else to `
 package ``__init__``). Contracts:
 
 * the core (the kinematics modules at the top level, ``io``, ``config``, ``provenance``) imports no wing
-  (search, reconstruct, annotate, morphable, style_example), no evaluation and no data set code;
+  (search, reconstruct, annotate, morphable, style_example, multilinear), no evaluation and no data set code;
 * no wing imports another wing's command module (``command.py``, ``*_command.py``) or another wing's
   package ``__init__`` (a wing's library modules may be used: reconstruct and annotate use search's,
   annotate uses the Morphable Graph's time warping);
@@ -40,7 +40,7 @@ PACKAGE = Path(__file__).resolve().parents[1] / "stylemotion"
 
 KINEMATICS = {"skeleton", "motion", "geometry", "representation", "ik", "bones"}
 CORE = KINEMATICS | {"io", "config", "provenance"}
-WINGS = {"search", "reconstruct", "annotate", "morphable", "style_example"}
+WINGS = {"search", "reconstruct", "annotate", "morphable", "style_example", "multilinear"}
 NEVER_EVALUATION = {"synthesis", "models", "viewer"}
 
 

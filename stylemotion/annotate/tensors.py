@@ -9,8 +9,8 @@ natural modes the styles (sub-classes) and repetitions. Bandai has no actor labe
 Time warping: every example is warped onto the reference (the example closest to the mean length, resampled
 to that length) by DTW on those coordinates (:func:`stylemotion.annotate.templates.warp_to`).
 
-Decomposition (eq. 3.3): ``U_n`` are the left singular vectors of the mode-``n`` unfolding (``tensorly``),
-truncated to ``ranks[n]``, and ``Φ = Θ ×_n U_nᵀ``. The technical modes are folded into
+Decomposition (eq. 3.3): the N-mode SVD of :mod:`stylemotion.multilinear.decomposition` (shared with the
+multilinear synthesis of Krüger §4.1), truncated to ``ranks[n]``. The technical modes are folded into
 ``Ψ = Φ ×_1 U_1 ×_2 U_2`` (eq. 3.4), and a motion is synthesized from weight vectors ``β`` (styles) and
 ``γ`` (repetitions) as ``M = Ψ ×_3 βᵀU_3 ×_4 γᵀU_4`` (eq. 3.5); a unit ``β = e_s``, ``γ = e_r`` of the
 untruncated tensor returns example ``(s, r)``.
@@ -29,13 +29,13 @@ from dataclasses import dataclass
 from functools import cached_property
 
 import numpy as np
-import tensorly as tl
 from scipy.optimize import lsq_linear
 from tensorly.tenalg import multi_mode_dot
 from threadpoolctl import threadpool_limits
 
 from stylemotion.annotate.templates import resample_length, warp_to
 from stylemotion.io.errors import UserInputError
+from stylemotion.multilinear.decomposition import n_mode_svd, truncate
 from stylemotion.representation import positions_to_frames
 from stylemotion.skeleton import NUM_JOINTS
 
@@ -110,12 +110,8 @@ class MotionTensor:
 
     def truncated(self, ranks: Sequence[int]) -> MotionTensor:
         """The tensor with every mode cut to ``ranks`` (≤ the current ranks)."""
-        ranks = tuple(int(r) for r in ranks)
-        if len(ranks) != 4 or any(not 1 <= r <= c for r, c in zip(ranks, self.ranks)):
-            raise ValueError(f"ranks {ranks} must be 4 values in [1, {self.ranks}]")
-        core = self.core[tuple(slice(0, r) for r in ranks)]
-        return MotionTensor(self.label, self.styles, self.repetitions, self.reference, core,
-                            tuple(f[:, :r] for f, r in zip(self.factors, ranks)), self.fps)
+        core, factors = truncate(self.core, self.factors, ranks)
+        return MotionTensor(self.label, self.styles, self.repetitions, self.reference, core, factors, self.fps)
 
     def warp(self, positions: np.ndarray) -> np.ndarray:
         """``(frames, 63)`` coordinates of a motion ``(n, 21, 3)`` warped onto the reference timeline."""
@@ -153,24 +149,6 @@ class Parametrization:
     style_weights: np.ndarray
     repetition_weights: np.ndarray
     rms: float
-
-
-def left_singular_vectors(x: np.ndarray) -> np.ndarray:
-    """``U`` ``(d, min(d, n))`` of the thin SVD of ``x`` ``(d, n)``. A wide ``x`` (an unfolding: ``n`` up to
-    ``63 · frames · repetitions``) is first reduced by the QR factorization ``xᵀ = Q R`` (``x = Rᵀ Qᵀ``
-    has the left singular vectors of ``Rᵀ``), so no ``(d, n)`` right factor is formed."""
-    x = np.asarray(x, dtype=np.float64)
-    if x.shape[1] > x.shape[0]:
-        x = np.linalg.qr(x.T, mode="r").T
-    return np.linalg.svd(x, full_matrices=False)[0]
-
-
-def n_mode_svd(tensor: np.ndarray) -> tuple[np.ndarray, tuple[np.ndarray, ...]]:
-    """Full N-mode SVD (eq. 3.3): ``(Φ, (U_1, ..., U_N))`` with ``U_n`` ``(d_n, min(d_n, ∏ others))``."""
-    with threadpool_limits(limits=1):       # thin factorizations: extra BLAS threads only contend
-        factors = [left_singular_vectors(tl.unfold(tensor, mode)) for mode in range(tensor.ndim)]
-    core = multi_mode_dot(tensor, factors, modes=list(range(tensor.ndim)), transpose=True)
-    return core, tuple(factors)
 
 
 def build_tensor(label: str, examples: Mapping[str, Sequence[np.ndarray]], fps: float,

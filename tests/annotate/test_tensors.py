@@ -7,7 +7,6 @@ from stylemotion.annotate.tensors import (
     TensorInputError,
     _bounded_least_squares,
     build_tensor,
-    left_singular_vectors,
 )
 
 
@@ -54,16 +53,6 @@ def test_bad_input(synthetic_split):
         build_tensor("walk", {"normal": walk[:3]}, 30.0)
     with pytest.raises(TensorInputError, match="fewer than 2"):
         build_tensor("walk", {"normal": walk[:3], "elderly": walk[3:4]}, 30.0, repetitions=2)
-
-
-def test_left_singular_vectors_equal_numpy_svd():
-    rng = np.random.default_rng(2)
-    for shape in [(7, 400), (30, 12), (12, 12)]:
-        x = rng.normal(size=shape)
-        want = np.linalg.svd(x, full_matrices=False)[0]
-        got = left_singular_vectors(x)
-        assert got.shape == want.shape
-        assert np.allclose(np.abs(got.T @ want), np.eye(want.shape[1]), atol=1e-8)   # same vectors up to sign
 
 
 def test_bounded_least_squares_equals_the_full_problem():
