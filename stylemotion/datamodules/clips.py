@@ -42,6 +42,7 @@ from torch.utils.data import Dataset
 from stylemotion.datamodules.base import SplitDataModule
 from stylemotion.datasets import TakeSet
 from stylemotion.io.errors import UserInputError
+from stylemotion.primitives.actions import segment_action
 from stylemotion.primitives.segmentation import (
     ARM_PRIMITIVES,
     PRIMITIVES,
@@ -50,7 +51,6 @@ from stylemotion.primitives.segmentation import (
     SegmentSettings,
     check_primitive,
     is_arm_content,
-    segment_action,
     time_normalize,
 )
 from stylemotion.representation import FRAME_DIM

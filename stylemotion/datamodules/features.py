@@ -34,7 +34,7 @@ steps). The frames an example is encoded at must be at least as many as the auto
 receptive field (:func:`receptive_field`).
 
 Examples from outside the dataset (``stylemotion-style``: a user's own BVH file): ``example_clips``
-gives the clips themselves (cut with :func:`stylemotion.primitives.segmentation.segment_action` like the
+gives the clips themselves (cut with :func:`stylemotion.primitives.actions.segment_action` like the
 dataset's, at the data's fps) instead of ``examples`` specs; the style then need not be a style of
 the dataset. ``example_records`` adds plain values to each clip's record in the model's
 ``spec.style_examples`` (e.g. the file, its sha256 and the clip's frames in it).

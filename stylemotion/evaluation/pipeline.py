@@ -65,7 +65,8 @@ from stylemotion.models.autoencoder import local_mpjpe, mpjpe
 from stylemotion.models.loading import NEUTRAL, EvalModel
 from stylemotion.models.sampling import MotionSamples, decode_features
 from stylemotion.models.style import mean_gram
-from stylemotion.primitives.segmentation import Segmentation, parse_primitive, segment_action, time_normalize
+from stylemotion.primitives.actions import segment_action
+from stylemotion.primitives.segmentation import Segmentation, parse_primitive, time_normalize
 
 log = logging.getLogger(__name__)
 
@@ -269,7 +270,7 @@ def real_side(primitive: str, models: Sequence[EvalModel], takeset: TakeSet, set
     """Split the (segmented) data for ``primitive``, fit the style classifier, gather the ground truths.
 
     ``segmentation``: the primitive's action already segmented with ``settings.segment``
-    (:func:`stylemotion.primitives.segmentation.segment_action`), shared by the primitives of one evaluation;
+    (:func:`stylemotion.primitives.actions.segment_action`), shared by the primitives of one evaluation;
     None segments here.
 
     Raises:

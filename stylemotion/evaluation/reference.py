@@ -25,14 +25,9 @@ from stylemotion.datamodules.clips import ClipDataModule
 from stylemotion.datasets import TakeSet
 from stylemotion.evaluation.sources import MissingExampleError
 from stylemotion.models.loading import EvalModel
+from stylemotion.primitives.actions import of_action
 from stylemotion.primitives.contacts import foot_signals
-from stylemotion.primitives.segmentation import (
-    Clip,
-    Segmentation,
-    of_action,
-    parse_primitive,
-    stance_foot,
-)
+from stylemotion.primitives.segmentation import Clip, Segmentation, parse_primitive, stance_foot
 
 
 @dataclass
@@ -118,7 +113,7 @@ def primitive_data(takeset: TakeSet, primitive: str, length: int, neutral_style:
         segment: segmentation overrides (as for training).
         split: split settings (as for training; the data config's ``split``).
         segmentation: the action's takes already segmented with ``segment``
-            (:func:`stylemotion.primitives.segmentation.segment_action`); None segments them here.
+            (:func:`stylemotion.primitives.actions.segment_action`); None segments them here.
     """
     action, name = parse_primitive(primitive)
     module = ClipDataModule(takeset=takeset, action=action, primitives=[name], styles=None, timeline=int(length),

@@ -44,11 +44,10 @@ from __future__ import annotations
 
 from collections.abc import Iterable
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
-from scipy.signal import find_peaks
 
-from stylemotion.datasets.base import Take
 from stylemotion.geometry import direction_yaw, facing_direction, rotate_yaw
 from stylemotion.primitives.contacts import foot_contacts
 from stylemotion.primitives.segmentation import (
@@ -62,6 +61,9 @@ from stylemotion.primitives.segmentation import (
 )
 from stylemotion.representation import ROOT_JOINT, facing_yaw
 from stylemotion.skeleton import CANONICAL_JOINTS
+
+if TYPE_CHECKING:  # the data-set package loads scipy: not needed to import this module (command start-up)
+    from stylemotion.datasets.base import Take
 
 HANDS = ("Hand_L", "Hand_R")
 
@@ -169,6 +171,8 @@ def wave_cycles(positions: np.ndarray, fps: float, hold: tuple[int, int], hands:
     The extremes are looked for in ``w`` over the whole take and kept when they lie in the hold, so that one at
     or next to the hold's first or last frame is judged (local maximum, prominence) against the frames beyond.
     """
+    from scipy.signal import find_peaks  # scipy is not needed to import this module (command start-up)
+
     settings = settings or ArmSettings()
     a, b = hold
     if b - a < 3:

@@ -331,36 +331,6 @@ def rest_runs(positions: np.ndarray, contacts: np.ndarray, fps: float, settings:
     return [(a, b) for a, b in _runs(still) if b - a >= min_len]
 
 
-def of_action(content: str, action: str, actions: Sequence[str] = ACTIONS) -> bool:
-    """Whether a take of ``content`` is one of ``action``: a locomotion action's by :func:`action_of`, an arm
-    content's (``raise-up-right-hand``) when it is that content."""
-    return content == action if is_arm_content(action) else action_of(content, actions) == action
-
-
-def segment_action(takes: Iterable[Take], action: str, settings: SegmentSettings | None = None) -> Segmentation:
-    """The takes of ``action`` (:func:`of_action`) segmented: a locomotion action's by :func:`segment_takes`, an arm
-    content's by :func:`stylemotion.primitives.arm.segment_arm_takes` (no foot-contact settings)."""
-    settings = settings or SegmentSettings()
-    chosen = [t for t in takes if of_action(t.content, action, settings.actions)]
-    if is_arm_content(action):
-        from stylemotion.primitives.arm import segment_arm_takes  # arm.py builds on this module's Clip
-
-        return segment_arm_takes(chosen)
-    return segment_takes(chosen, settings)
-
-
-def segment_actions(takes: Sequence[Take], actions: Iterable[str], settings: SegmentSettings | None = None
-                    ) -> Segmentation:
-    """:func:`segment_action` of each of ``actions``, merged in the order given."""
-    out = Segmentation()
-    for action in dict.fromkeys(actions):
-        seg = segment_action(takes, action, settings)
-        out.clips += seg.clips
-        out.rejections += seg.rejections
-        out.takes += seg.takes
-    return out
-
-
 def segment_take(take: Take, settings: SegmentSettings | None = None) -> TakeSegmentation:
     """Cut one walk or run take into primitive clips (see the module docstring).
 

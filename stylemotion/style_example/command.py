@@ -51,7 +51,8 @@ from stylemotion.io.jsonfile import plain, write_json
 from stylemotion.io.outputs import check_new_output, inside
 from stylemotion.models.checkpoints import autoencoder_info, load_autoencoder
 from stylemotion.models.loading import EvalModel, load_model
-from stylemotion.primitives.segmentation import Clip, parse_primitive, segment_action
+from stylemotion.primitives.actions import segment_action
+from stylemotion.primitives.segmentation import Clip, parse_primitive
 from stylemotion.provenance import provenance
 from stylemotion.skeleton import CANONICAL_JOINTS
 from stylemotion.style_example.base_run import STYLE_KIND, SourceRun, check_name, load_run, run_action, train_config

@@ -2,7 +2,7 @@
 canonical positions, on the run's skeleton), then cut into the primitives of a run.
 
 Each converted take is labelled with the new style's name and the run's action and cut by
-:func:`stylemotion.primitives.segmentation.segment_action` with the run's segmentation settings.
+:func:`stylemotion.primitives.actions.segment_action` with the run's segmentation settings.
 
 Several examples (``example=[a.bvh:0-600,b.bvh]``, issue 27): :func:`parse_examples` checks each item (a bad one is
 named by its place, ``example[2]=…``), :func:`cut_examples` cuts each and pools their clips: a primitive's model is
@@ -28,14 +28,8 @@ from stylemotion.datasets.user_motion import (
     on_run_skeleton,
     parse_example,
 )
-from stylemotion.primitives.segmentation import (
-    Clip,
-    Segmentation,
-    SegmentSettings,
-    is_arm_content,
-    parse_primitive,
-    segment_action,
-)
+from stylemotion.primitives.actions import segment_action
+from stylemotion.primitives.segmentation import Clip, Segmentation, SegmentSettings, is_arm_content, parse_primitive
 
 __all__ = ["EXAMPLE_FILE", "MAX_EXAMPLES", "MAX_REASONS", "ConvertedExample", "CutExample", "ExampleSpec",
            "StyleExampleError", "convert_example", "cut_example", "cut_examples", "example_file", "on_run_skeleton",

@@ -61,7 +61,8 @@ from stylemotion.evaluation.run import recorded_path, run_evaluation, settings_f
 from stylemotion.io.errors import OutputWriteError, UserInputError
 from stylemotion.io.jsonfile import JsonFileError, json_text, read_json_object, write_json
 from stylemotion.io.outputs import check_new_output, inside, safe_name
-from stylemotion.primitives.segmentation import SegmentSettings, parse_primitive, segment_actions
+from stylemotion.primitives.actions import segment_actions
+from stylemotion.primitives.segmentation import SegmentSettings, parse_primitive
 from stylemotion.provenance import provenance
 
 log = logging.getLogger(__name__)

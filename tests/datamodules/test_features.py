@@ -12,7 +12,8 @@ from vae_fixtures import feature_module, tiny_autoencoder_ckpt
 from stylemotion.datamodules.features import encode_examples
 from stylemotion.datasets.base import Take
 from stylemotion.datasets.synthetic import generate_take
-from stylemotion.primitives.segmentation import Clip, segment_action
+from stylemotion.primitives.actions import segment_action
+from stylemotion.primitives.segmentation import Clip
 
 torch.set_num_threads(1)
 

@@ -15,14 +15,9 @@ from stylemotion.geometry import rotate_yaw
 from stylemotion.morphable import FitSettings, fit_primitive
 from stylemotion.morphable.constraints import KeyframeConstraint
 from stylemotion.morphable.synthesis import MapSettings, solve_constraints
+from stylemotion.primitives.actions import segment_action, segment_actions
 from stylemotion.primitives.arm import ArmSettings, arm_clips, arm_keyframes, segment_arm_take, wave_signal
-from stylemotion.primitives.segmentation import (
-    check_primitive,
-    parse_primitive,
-    segment_action,
-    segment_actions,
-    stance_foot,
-)
+from stylemotion.primitives.segmentation import check_primitive, parse_primitive, stance_foot
 from stylemotion.representation import facing_yaw
 from stylemotion.skeleton import CANONICAL_JOINTS
 
