@@ -24,7 +24,8 @@ class SparseModelSettings:
     ``variance``: fraction of the neighbours' spread the local PCA keeps; ``marker_sd``: metres a marker may miss
     by; ``smooth_sd``: metres a joint may move between frames (body frame); ``prior_weight``: weight of the
     Mahalanobis prior of the local PCA; ``iterations``: k-NN searches per frame for E30/E39/pca* (searched
-    around the synthesized pose); ``weighted``: neighbours weighted by ``1/(feature distance + marker_sd)^2``.
+    around the synthesized pose); ``weighted``: neighbours weighted by ``1/(feature distance + marker_sd)^2``;
+    ``hold_bones``: every output frame's bones set to the subject's lengths (constant over time).
     """
 
     variance: float = 0.99
@@ -33,6 +34,7 @@ class SparseModelSettings:
     prior_weight: float = 1.0
     iterations: int = 1
     weighted: bool = True
+    hold_bones: bool = True
 
 
 @dataclass(frozen=True)
