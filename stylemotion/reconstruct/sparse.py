@@ -34,7 +34,8 @@ fits. The marker frame of step 1 is built from the markers' segments' names (a w
 Subject and bones (docs/reconstruct.md): ``bones`` (20 bone lengths, metres: a calibration's skeleton, or the
 database's scaled by :func:`subject_scale`) puts every database take on those bones first
 (:func:`stylemotion.bones.retarget_positions`); ``hold_bones`` sets every output frame's bones to those lengths
-(else to the result's own median lengths over its frames), each bone keeping its direction (:func:`stylemotion.bones.place_bones`).
+(else to the result's own median lengths over its frames), each bone keeping its direction
+(:func:`stylemotion.bones.place_bones`).
 
 Simplified against Chai & Hodgins: no per-frame optimization of joint angles (the pose is a point of
 the neighbours' linear model in joint positions); bone lengths are held by placing the bones afterwards.
@@ -166,7 +167,8 @@ class SparseReconstructor:
         database: the motion database (its fps is the markers' required rate).
         joints: marker names (joint centres) or a :class:`MarkerSet` (skin markers, marker-only feature sets).
         bones: ``(20,)`` metres, the subject's bone lengths: the database is put on them first.
-        hold_bones: every output frame's bones set to ``bones`` (else to the result's median bone lengths).  features: one of :data:`RECONSTRUCT_FEATURE_SETS`.  k: neighbours per frame.
+        hold_bones: every output frame's bones set to ``bones`` (else to the result's median bone lengths).
+        features: one of :data:`RECONSTRUCT_FEATURE_SETS`.  k: neighbours per frame.
         variance: fraction of the neighbours' spread the local PCA keeps.  marker_sd: metres a marker may miss
             by.  smooth_sd: metres a joint may move between frames (in the marker frame).  prior_weight: weight
             of the Mahalanobis prior.  iterations: k-NN searches per frame for pose-guided sets.
