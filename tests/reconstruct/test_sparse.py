@@ -148,8 +148,8 @@ def test_skin_markers_give_a_database_take_back_and_beat_the_nearest_neighbour(s
 
 def test_held_bones_are_constant_and_free_ones_are_not(split, skin_reconstructor):
     take = split[2][0]
-    markers = virtual_markers(take.positions, SKIN_MARKERS) + np.random.default_rng(3).uniform(-0.005, 0.005,
-                                                                                             (len(take.positions), 6, 3))
+    noise = np.random.default_rng(3).uniform(-0.005, 0.005, (len(take.positions), 6, 3))
+    markers = virtual_markers(take.positions, SKIN_MARKERS) + noise
     held = skin_reconstructor.reconstruct(markers).positions
     assert skin_reconstructor.hold_bones and bone_length_spread_cm(held)["max_range_cm"] < 1e-6
     free = SparseReconstructor(split[0], SKIN_MARKERS, hold_bones=False).reconstruct(markers).positions
