@@ -9,10 +9,13 @@ Per seed: Bandai is split by take (``TakeSet.split(seed, 0.1, 0.1)``, grouped by
   :func:`stylemotion.reconstruct.benchmark.skin_marker_noise` (placement ± 10 mm per axis per recording, jitter
   ± 1 mm per frame); database = the seed's train takes. Conditions: today's method (markers at the joint centres,
   no bone holding), skin markers on the database's bones, skin markers with the database scaled to the subject
-  from the markers (:func:`~stylemotion.reconstruct.sparse.subject_scale`), and skin markers with the subject's
-  bone lengths given (a calibration: the capture's own skeleton); beside them the nearest-neighbour baseline and
-  the **floor**: the database pose (on the same bones, in the markers' frame) nearest to the truth in all joints,
-  which no method that returns a point of the database's poses can beat by much.
+  from the markers (:func:`~stylemotion.reconstruct.sparse.subject_scale`), skin markers with the subject's
+  bone lengths given, and with the subject's skeleton given (bone lengths and the directions of the bones fixed in
+  the pelvis and chest: :func:`stylemotion.reconstruct.subject.subject_from_motion` on the recording itself, as a
+  capture system's subject calibration gives them; no separate calibration take exists in the shared data);
+  beside them the nearest-neighbour baseline and
+  the **floor**: the database pose (on the same skeleton, in the markers' frame) nearest to the truth in all
+  joints, which the k-NN alone cannot beat.
 * **Bandai leave-style-out**: :func:`stylemotion.datasets.retarget.actor_groups` finds one actor group in Bandai
   (suite ``actors``), so a leave-actor-group-out split does not exist; the nearest stand-in: per seed one style
   (drawn with the seed) is left out of the database (train takes of the other styles), ``k`` is chosen on that
@@ -35,13 +38,14 @@ DESCRIPTION = ("six skin markers → 21 joints on other captures (virtual marker
 VAL_FRACTION, TEST_FRACTION = 0.1, 0.1
 OTHER_CAPTURES = ("walk_21joint_60fps.bvh", "female-walk_21joint_60fps.bvh", "xia_neutral_01_000_31joint_120fps.bvh")
 CONDITIONS = {
-    "joints": "today's method: markers at the joint centres, database's bones, bones not held",
+    "joints": "the method before: markers at the joint centres, database's bones, bones not held",
     "skin": "skin markers, database's bones",
     "skin_scaled": "skin markers, database scaled to the subject from the markers",
-    "skin_calibrated": "skin markers, the subject's bone lengths given (calibration)",
-    "skin_calibrated_nn": "nearest neighbour (k = 1), the subject's bone lengths given",
-    "skin_calibrated_unheld": "skin markers, the subject's bone lengths given, bones not held",
-    "floor_calibrated": "floor: database pose nearest to the truth in all joints, the subject's bones",
+    "skin_lengths": "skin markers, the subject's bone lengths given",
+    "skin_subject": "skin markers, the subject's skeleton given (bone lengths and rigid bones: calibration)",
+    "skin_subject_unheld": "the same, bones not held (the local model's poses as they come)",
+    "skin_subject_nn": "nearest neighbour (k = 1), the subject's skeleton given",
+    "floor_subject": "floor: the database pose nearest to the truth in all joints, on the subject's skeleton",
 }
 
 
@@ -76,6 +80,7 @@ def _other_captures(args, database, k: int, rng: np.random.Generator) -> dict[st
     )
     from stylemotion.reconstruct.marker_set import SKIN_MARKERS, virtual_markers
     from stylemotion.reconstruct.sparse import subject_scale
+    from stylemotion.reconstruct.subject import subject_from_motion
     from stylemotion.skeleton import CANONICAL_JOINTS, JOINT_INDEX
 
     joint_rec = SparseReconstructor(database, DEFAULT_MARKERS, k=k, hold_bones=False)
@@ -83,7 +88,7 @@ def _other_captures(args, database, k: int, rng: np.random.Generator) -> dict[st
     database_bones = median_bone_lengths(np.asarray(database.positions[:: max(1, database.num_frames // 50_000)],
                                                     np.float64))
     tables: dict[str, list[np.ndarray]] = {c: [] for c in CONDITIONS}
-    bones: dict[str, list[dict]] = {"joints": [], "skin_calibrated": [], "skin_calibrated_unheld": [], "truth": []}
+    bones: dict[str, list[dict]] = {"joints": [], "skin_subject": [], "skin_subject_unheld": [], "truth": []}
     files = []
     for name in OTHER_CAPTURES:
         truth = read_markers(DATA_ROOT / "other-skeletons" / name, list(CANONICAL_JOINTS), fps=database.fps).full
@@ -92,18 +97,20 @@ def _other_captures(args, database, k: int, rng: np.random.Generator) -> dict[st
         skin = skin_marker_noise(virtual_markers(truth, SKIN_MARKERS), rng, args.placement_mm, args.jitter_mm)
         scale = subject_scale(skin, SKIN_MARKERS, database)
         scaled = SparseReconstructor(database, SKIN_MARKERS, k=k, bones=database_bones * scale)
-        calibrated = SparseReconstructor(database, SKIN_MARKERS, k=k, bones=median_bone_lengths(truth))
+        lengths = SparseReconstructor(database, SKIN_MARKERS, k=k, bones=median_bone_lengths(truth))
+        subject = SparseReconstructor(database, SKIN_MARKERS, k=k, bones=subject_from_motion(truth))
         outputs = {"joints": joint_rec.reconstruct(joint_markers).positions,
                    "skin": skin_rec.reconstruct(skin).positions,
                    "skin_scaled": scaled.reconstruct(skin).positions,
-                   "skin_calibrated": calibrated.reconstruct(skin).positions,
-                   "skin_calibrated_nn": calibrated.nearest_neighbour(skin),
-                   "floor_calibrated": _floor(calibrated, skin, truth)}
-        calibrated.hold_bones = False
-        outputs["skin_calibrated_unheld"] = calibrated.reconstruct(skin).positions
+                   "skin_lengths": lengths.reconstruct(skin).positions,
+                   "skin_subject": subject.reconstruct(skin).positions,
+                   "skin_subject_nn": subject.nearest_neighbour(skin),
+                   "floor_subject": _floor(subject, skin, truth)}
+        subject.hold_bones = False
+        outputs["skin_subject_unheld"] = subject.reconstruct(skin).positions
         for condition, positions in outputs.items():
             tables[condition].append(joint_error_table(positions, truth))
-        for key in ("joints", "skin_calibrated", "skin_calibrated_unheld"):
+        for key in ("joints", "skin_subject", "skin_subject_unheld"):
             bones[key].append(bone_length_spread_cm(outputs[key]))
         bones["truth"].append(bone_length_spread_cm(truth))
         files.append({"file": name, "frames": int(len(truth)), "scale": round(scale, 4),
@@ -181,7 +188,7 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
                          "seconds": round(time.perf_counter() - started, 1)})
         print(f"seed {seed}: style {bandai_part['style']} k {bandai_part['k']}: "
               f"{bandai_part['figures']['ours']['mean_cm']:.2f} cm; other captures "
-              f"{other['figures']['skin_calibrated']['mean_cm']:.2f} cm", flush=True)
+              f"{other['figures']['skin_subject']['mean_cm']:.2f} cm", flush=True)
     return {"splits": {"kind": "by take, one split per seed; Bandai: one style left out of the database per seed",
                        "choose": "val (the left-out style's val takes)", "report": "test", "per_seed": splits,
                        "actor_groups_in_bandai": groups,
@@ -216,8 +223,7 @@ def render(record: dict[str, Any]) -> dict[str, str]:
     r = record["results"]
     prov = provenance_line(record)
     rows = []
-    for c in ("joints", "skin", "skin_scaled", "skin_calibrated", "skin_calibrated_unheld", "skin_calibrated_nn",
-              "floor_calibrated"):
+    for c in CONDITIONS:
         base = ["other", "figures", c]
         rows.append(["other captures (3 walks, other actors)", CONDITIONS[c], _cm(r, base + ["mean_cm"]),
                      _cm(r, base + ["p95_cm"]), _cm(r, base + ["max_cm"])])
@@ -242,19 +248,19 @@ def render(record: dict[str, Any]) -> dict[str, str]:
     joint_rows = []
     for j in CANONICAL_JOINTS:
         cells = [j]
-        for c in ("joints", "skin_calibrated", "skin_calibrated_nn", "floor_calibrated"):
+        for c in ("joints", "skin_subject_unheld", "skin_subject", "skin_subject_nn", "floor_subject"):
             cells.append(_cm(r, ["other", "figures", c, "per_joint", j, "mean_cm"], 1))
         joint_rows.append(cells)
     spreads = []
-    for key, text in (("truth", "the recordings' own joints"), ("joints", "today's method"),
-                      ("skin_calibrated_unheld", "skin, calibrated, bones not held"),
-                      ("skin_calibrated", "skin, calibrated, bones held")):
+    for key, text in (("truth", "the recordings' own joints"), ("joints", "the method before (joint centres)"),
+                      ("skin_subject_unheld", "skin, subject's skeleton, bones not held"),
+                      ("skin_subject", "skin, subject's skeleton, bones held")):
         spreads.append([text, _cm(r, ["other", "bone_spread", key, "mean_sd_cm"], 2),
                         _cm(r, ["other", "bone_spread", key, "max_range_cm"], 1)])
     spreads.append(["Bandai left-out style: bones not held", _cm(r, ["bandai", "bone_sd_cm", "unheld"], 2), ""])
     spreads.append(["Bandai left-out style: bones held", _cm(r, ["bandai", "bone_sd_cm", "held"], 2), ""])
-    diagnosis = (md_table(["joint", "today's method", "skin, calibrated", "nearest neighbour, calibrated",
-                           "floor (best database pose)"], joint_rows)
+    diagnosis = (md_table(["joint", "method before (joint centres)", "skin, subject's skeleton, bones not held",
+                           "the same, bones held", "nearest neighbour", "floor (best database pose)"], joint_rows)
                  + "\n\nOther captures, mean cm per joint (± sd over seeds).\n\n"
                  + md_table(["output", "bone length sd over frames, cm (mean over bones)",
                              "largest change of a bone, cm"], spreads) + f"\n\n{prov}")

@@ -34,8 +34,8 @@ fits. The marker frame of step 1 is built from the markers' segments' names (a w
 Subject and bones (docs/reconstruct.md): ``bones`` (20 bone lengths, metres: a calibration's skeleton, or the
 database's scaled by :func:`subject_scale`) puts every database take on those bones first
 (:func:`stylemotion.bones.retarget_positions`); ``hold_bones`` sets every output frame's bones to those lengths
-(else to the result's own median lengths over its frames), each bone keeping its direction
-(:func:`stylemotion.bones.place_bones`).
+(else to the result's own median lengths over its frames), the wrists and ankles kept where the model put them
+(:func:`stylemotion.reconstruct.subject.hold_bone_lengths`: knees and elbows by two-bone IK).
 
 Simplified against Chai & Hodgins: no per-frame optimization of joint angles (the pose is a point of
 the neighbours' linear model in joint positions); bone lengths are held by placing the bones afterwards.
@@ -53,6 +53,7 @@ from stylemotion.reconstruct.marker_set import MarkerSet, joint_marker_set, virt
 from stylemotion.reconstruct.markers import MarkerInputError, MarkerTracks, check_marker_names
 from stylemotion.reconstruct.settings import ReconstructSettings as _C
 from stylemotion.reconstruct.settings import SparseModelSettings as _M
+from stylemotion.reconstruct.subject import Subject, database_on_subject, hold_bone_lengths
 from stylemotion.search.database import MotionDatabase
 from stylemotion.search.features import feature_spec, stack_window, window_offsets
 from stylemotion.search.index import FrameIndex
@@ -61,6 +62,7 @@ from stylemotion.skeleton import JOINT_INDEX, NUM_JOINTS
 #: Feature sets the reconstruction can search in (windows only over markers; no physics terms).
 RECONSTRUCT_FEATURE_SETS = ("E15", "E30", "E39", "E15x3", "E15x5", "pca8", "pca16", "pca25")
 _EPS = 1e-9
+_LIMB_ENDS = ("Hand_L", "Hand_R", "Foot_L", "Foot_R")
 
 
 def marker_frames(markers: np.ndarray, joints: Sequence[str]) -> tuple[np.ndarray, np.ndarray]:
@@ -148,16 +150,8 @@ def subject_scale(markers: np.ndarray, marker_set: MarkerSet, database: MotionDa
 
 def database_on_bones(database: MotionDatabase, bones: np.ndarray) -> MotionDatabase:
     """``database`` with every take put on the bone lengths ``bones`` ``(20,)`` metres
-    (:func:`stylemotion.bones.retarget_positions`, take by take)."""
-    from dataclasses import replace
-
-    from stylemotion.bones import retarget_positions
-
-    out = np.empty_like(database.positions)
-    starts = database.take_start
-    for a, b in zip(starts[:-1], starts[1:]):
-        out[a:b] = retarget_positions(database.positions[a:b], bones)
-    return replace(database, name=f"{database.name}-on-bones", positions=out)
+    (:func:`stylemotion.reconstruct.subject.database_on_subject` with lengths only)."""
+    return database_on_subject(database, Subject(np.asarray(bones, np.float64)))
 
 
 class SparseReconstructor:
@@ -166,7 +160,8 @@ class SparseReconstructor:
     Args:
         database: the motion database (its fps is the markers' required rate).
         joints: marker names (joint centres) or a :class:`MarkerSet` (skin markers, marker-only feature sets).
-        bones: ``(20,)`` metres, the subject's bone lengths: the database is put on them first.
+        bones: ``(20,)`` metres, the subject's bone lengths, or a :class:`~stylemotion.reconstruct.subject.Subject`
+            (lengths and rigid bone directions): the database is put on them first.
         hold_bones: every output frame's bones set to ``bones`` (else to the result's median bone lengths).
         features: one of :data:`RECONSTRUCT_FEATURE_SETS`.  k: neighbours per frame.
         variance: fraction of the neighbours' spread the local PCA keeps.  marker_sd: metres a marker may miss
@@ -180,7 +175,7 @@ class SparseReconstructor:
                  k: int = _C.k, variance: float = _M.variance, marker_sd: float = _M.marker_sd,
                  smooth_sd: float = _M.smooth_sd, prior_weight: float = _M.prior_weight,
                  iterations: int = _M.iterations, weighted: bool = _M.weighted, engine: str = "ckdtree",
-                 workers: int = 1, bones: np.ndarray | None = None, hold_bones: bool = _M.hold_bones):
+                 workers: int = 1, bones: np.ndarray | Subject | None = None, hold_bones: bool = _M.hold_bones):
         if isinstance(joints, MarkerSet):
             self.marker_set = joints
             self.joints = joints.names
@@ -215,14 +210,16 @@ class SparseReconstructor:
             raise ValueError(f"features={features}: a window over joints that are not markers "
                              f"({sorted(set(spec.joints) - set(self.joints))}) is not supported")
         self.feature_joints = [j for j in (spec.joints or ()) if j in JOINT_INDEX]
+        self.subject = None
         if bones is not None:
             from stylemotion.bones import BONE_NAMES
 
-            bones = np.asarray(bones, np.float64)
-            if bones.shape != (len(BONE_NAMES),) or not np.all(np.isfinite(bones)) or np.any(bones < 0):
-                raise ValueError(f"bones must be {len(BONE_NAMES)} lengths ≥ 0 in metres, got shape {bones.shape}")
-            database = database_on_bones(database, bones)
-            self.database = database
+            subject = bones if isinstance(bones, Subject) else Subject(np.asarray(bones, np.float64))
+            lengths = np.asarray(subject.lengths, np.float64)
+            if lengths.shape != (len(BONE_NAMES),) or not np.all(np.isfinite(lengths)) or np.any(lengths < 0):
+                raise ValueError(f"bones must be {len(BONE_NAMES)} lengths ≥ 0 in metres, got shape {lengths.shape}")
+            database = database_on_subject(database, subject)
+            self.database, self.subject, bones = database, subject, lengths
         self.hold_bones = bool(hold_bones)
         self.bones = bones  # the subject's, or None: each result's own median bones
         positions = np.asarray(database.positions, np.float64)
@@ -345,11 +342,25 @@ class SparseReconstructor:
             previous_world = to_world(pose.reshape(NUM_JOINTS, 3), rotation[t], origin[t])
         positions = to_world(out.reshape(-1, NUM_JOINTS, 3), rotation, origin)
         if self.hold_bones:
-            from stylemotion.bones import median_bone_lengths, place_bones
-
-            positions = place_bones(positions, median_bone_lengths(positions) if self.bones is None else self.bones)
+            positions = self.held(positions, markers)
         total = time.perf_counter() - started
         return Reconstruction(positions, self.settings(), {"knn": knn_s, "total": total}, nearest)
+
+    def held(self, positions: np.ndarray, markers: np.ndarray) -> np.ndarray:
+        """The model's poses ``(frames, 21, 3)`` on the subject's bones (module docstring), moved onto the markers
+        ``(frames, m, 3)``: the whole body by the root marker's miss, each limb end by its marker's remaining miss
+        (the misses measured on the set's virtual markers of the poses)."""
+        from stylemotion.bones import median_bone_lengths
+
+        miss = markers - virtual_markers(positions, self.marker_set)  # (frames, m, 3)
+        if "Hips" in self.roles:
+            root = miss[:, self.roles.index("Hips")]
+            positions = positions + root[:, None]
+            miss = miss - root[:, None]
+        ends = {seg: positions[:, JOINT_INDEX[seg]] + miss[:, m] for m, seg in enumerate(self.roles)
+                if seg in _LIMB_ENDS}
+        lengths = median_bone_lengths(positions) if self.bones is None else self.bones
+        return hold_bone_lengths(positions, lengths, ends)
 
     def nearest_neighbour(self, tracks: MarkerTracks | np.ndarray) -> np.ndarray:
         """Baseline: each frame's nearest database pose (k = 1 in the same features) placed with the markers'
@@ -370,7 +381,7 @@ class SparseReconstructor:
                 "search": "pose-guided" if self.guided else "markers",
                 "marker_set": {"name": self.marker_set.name, "markers": self.marker_set.describe()},
                 "hold_bones": self.hold_bones,
-                "bones_m": None if self.bones is None else [round(float(b), 5) for b in self.bones],
+                "subject": None if self.subject is None else self.subject.describe(),
                 "database": {"name": self.database.name, "takes": self.database.num_takes,
                              "frames": self.database.num_frames, "fps": self.database.fps}}
 
