@@ -62,7 +62,7 @@ class ReconstructSettings(MotionFileKeys):
 
     markers: str = MISSING
     joints: list[str] | None = None
-    marker_set: str | None = None
+    marker_set: str = "joints"
     marker_names: dict[str, str] | None = None
     markers_fps: float | None = None
     markers_up_axis: str = "z"
