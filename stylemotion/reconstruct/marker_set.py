@@ -44,7 +44,7 @@ class SkinMarker:
 
 @dataclass(frozen=True)
 class MarkerSet:
-    """Named skin markers; ``kind`` is ``"joints"`` when every offset is zero and each marker is named after its
+    """Named skin markers; :attr:`is_joint_centres` when every offset is zero and each marker is named after its
     joint (the markers are then the joint centres, as before skin markers existed)."""
 
     name: str
