@@ -112,8 +112,70 @@ def retarget_positions(positions: np.ndarray, target_lengths: np.ndarray) -> np.
             child joint has zero length too (naming the bone and frame; a zero-length bone otherwise
             takes the direction from its parent to its child joint), or a zero leg length.
     """
-    source = checked_positions(positions)
+    result = retarget_takes(positions, np.array([0, len(np.asarray(positions))]), target_lengths)
+    dtype = np.asarray(positions).dtype
+    return result.astype(dtype if np.issubdtype(dtype, np.floating) else np.float64)
+
+
+def retarget_takes(positions: np.ndarray, take_start: np.ndarray, target_lengths: np.ndarray,
+                   directions: np.ndarray | None = None) -> np.ndarray:
+    """:func:`retarget_positions` of several takes at once (each take's root path and ground as there).
+
+    Args:
+        positions: ``(frames, 21, 3)`` the takes one after another, metres.  take_start: ``(takes + 1,)`` offsets
+            (take ``i`` is ``positions[take_start[i]:take_start[i + 1]]``).  target_lengths: ``(20,)`` metres.
+        directions: ``(frames, 20, 3)`` unit bone vectors to use instead of the source's (None: the source's).
+
+    Returns:
+        ``(frames, 21, 3)`` float64 positions, metres.
+    """
+    source = checked_positions(positions).astype(np.float64)
     target = _check_lengths(target_lengths)
+    own, lengths = _bone_directions(source, target)
+    directions = own if directions is None else np.asarray(directions, np.float64)
+    starts = np.asarray(take_start, dtype=np.int64)
+    if starts.ndim != 1 or len(starts) < 2 or starts[0] != 0 or starts[-1] != len(source) or \
+            np.any(np.diff(starts) < 1):
+        raise ValueError(f"take_start must rise from 0 to the {len(source)} frames, got {starts[:5]}…")
+    take = np.repeat(np.arange(len(starts) - 1), np.diff(starts))
+    legs = np.array([leg_length(np.median(lengths[a:b], axis=0)) for a, b in zip(starts[:-1], starts[1:])])
+    if np.any(legs < MIN_BONE_LENGTH):
+        raise ValueError(f"positions: the leg (thigh + shin) has zero length ({legs.min():.3g} m) in take "
+                         f"{int(np.argmin(legs))}; cannot scale the root's path")
+    ratio = (float(leg_length(target)) / legs)[take][:, None]
+    root = source[:, _ROOT]
+    start = root[starts[:-1]][take] * np.array([1.0, 0.0, 1.0])  # each take's first ground point stays put
+    result = _place(directions, target, start + ratio * (root - start))
+    feet = list(FOOT_POINTS.ravel())
+    shift = np.minimum.reduceat(source[:, feet, 1].min(axis=1), starts[:-1]) \
+        - np.minimum.reduceat(result[:, feet, 1].min(axis=1), starts[:-1])
+    result[..., 1] += shift[take][:, None]
+    return result
+
+
+def place_bones(positions: np.ndarray, target_lengths: np.ndarray) -> np.ndarray:
+    """``positions`` with every bone set to its length in ``target_lengths``, each frame's root kept where it is
+    (unlike :func:`retarget_positions`, no scaling of the root's path and no ground shift): the bone lengths of the
+    result are constant over time.
+
+    Args:
+        positions: ``(frames, 21, 3)`` canonical positions, metres.  target_lengths: ``(20,)`` metres.
+
+    Returns:
+        ``(frames, 21, 3)`` float64 positions, metres.
+
+    Raises:
+        ValueError: as :func:`retarget_positions` (a zero-length source bone without a direction).
+    """
+    source = checked_positions(positions).astype(np.float64)
+    target = _check_lengths(target_lengths)
+    directions, _ = _bone_directions(source, target)
+    return _place(directions, target, source[:, _ROOT])
+
+
+def _bone_directions(source: np.ndarray, target: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Unit bone vectors ``(frames, 20, 3)`` (zero for a bone without a direction whose target is zero) and the
+    source's bone lengths ``(frames, 20)``; ValueError for a bone without a direction whose target is not zero."""
     children, parents = list(BONE_JOINTS), [CANONICAL_PARENTS[j] for j in BONE_JOINTS]
     vectors = source[:, children] - source[:, parents]  # (frames, 20, 3)
     lengths = bone_lengths(source)[:, children]  # (frames, 20)
@@ -125,24 +187,17 @@ def retarget_positions(positions: np.ndarray, target_lengths: np.ndarray) -> np.
         raise ValueError(f"positions: bone {BONE_NAMES[bone]!r} has zero length (< {MIN_BONE_LENGTH} m) in "
                          f"{int(lost[:, bone].sum())} frame(s), first at frame {frame}, so it has no direction "
                          f"to give the target length {target[bone]:.4g} m")
-    directions = np.where(short[..., None], 0.0, vectors / np.where(short, 1.0, lengths)[..., None])
+    return np.where(short[..., None], 0.0, vectors / np.where(short, 1.0, lengths)[..., None]), lengths
 
-    source_leg = float(leg_length(np.median(lengths, axis=0)))
-    if source_leg < MIN_BONE_LENGTH:
-        raise ValueError(f"positions: the leg (thigh + shin) has zero length ({source_leg:.3g} m); cannot scale "
-                         "the root's path")
-    ratio = float(leg_length(target)) / source_leg
-    root = source[:, _ROOT]
-    start = root[0] * np.array([1.0, 0.0, 1.0])  # the first frame's ground point stays put
-    translations = np.zeros_like(source)
-    translations[:, _ROOT] = start + ratio * (root - start)
-    translations[:, children] = directions * target[:, None]
-    result = forward_kinematics(np.broadcast_to(np.eye(3), (len(CANONICAL_JOINTS), 3, 3)), translations,
-                                CANONICAL_PARENTS)
-    feet = list(FOOT_POINTS.ravel())
-    result[..., 1] += source[:, feet, 1].min() - result[:, feet, 1].min()
-    dtype = np.asarray(positions).dtype
-    return result.astype(dtype if np.issubdtype(dtype, np.floating) else np.float64)
+
+def _place(directions: np.ndarray, target: np.ndarray, root: np.ndarray) -> np.ndarray:
+    """Joints from unit bone vectors ``(frames, 20, 3)``, bone lengths ``(20,)`` and root positions ``(frames, 3)``
+    (the one FK, identity rotations)."""
+    translations = np.zeros(directions.shape[:1] + (len(CANONICAL_JOINTS), 3))
+    translations[:, _ROOT] = root
+    translations[:, list(BONE_JOINTS)] = directions * target[:, None]
+    return forward_kinematics(np.broadcast_to(np.eye(3), (len(CANONICAL_JOINTS), 3, 3)), translations,
+                              CANONICAL_PARENTS)
 
 
 def _through_short_bones(source: np.ndarray, vectors: np.ndarray, lengths: np.ndarray, short: np.ndarray

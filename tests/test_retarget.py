@@ -12,6 +12,7 @@ from stylemotion.bones import (
     NUM_BONES,
     leg_length,
     median_bone_lengths,
+    place_bones,
     retarget_positions,
     target_bone_lengths,
 )
@@ -169,3 +170,14 @@ def test_a_bone_of_zero_length_takes_the_direction_to_its_child() -> None:
     everywhere[:, child] = everywhere[:, parent]  # the child on the same point too: no direction at all
     with pytest.raises(ValueError, match=r"bone 'Shoulder_L' has zero length"):
         retarget_positions(everywhere, lengths)
+
+
+def test_place_bones_keeps_the_root_and_directions_and_makes_the_bones_constant() -> None:
+    positions, lengths = rigid_walk(seed=3)
+    stretched = positions + np.random.default_rng(4).normal(0, 0.02, positions.shape)  # bones that change length
+    out = place_bones(stretched, lengths)
+    np.testing.assert_allclose(out[:, JOINT_INDEX["Hips"]], stretched[:, JOINT_INDEX["Hips"]], atol=1e-12)
+    np.testing.assert_allclose(bone_lengths(out)[:, list(BONE_JOINTS)], np.broadcast_to(lengths, (len(out), NUM_BONES)),
+                               atol=1e-12)
+    np.testing.assert_allclose(bone_directions(out), bone_directions(stretched), atol=1e-12)
+    np.testing.assert_allclose(place_bones(positions, lengths), positions, atol=1e-12)  # a rigid take comes back

@@ -151,7 +151,8 @@ def detect_unit_scale(motion: Motion, joint_map: JointMap) -> float:
     return min(UNIT_SCALES.values(), key=lambda s: abs(np.log(height * s / TYPICAL_CHAIN_HEIGHT_M)))
 
 
-_UP_TO_Y = {
+#: Rotation taking a file's up axis (``y`` or ``z``) to Y up: ``positions @ UP_TO_Y[axis].T``.
+UP_TO_Y = {
     "y": np.eye(3),
     "z": np.array([[1.0, 0, 0], [0, 0, 1], [0, -1, 0]]),  # (x, y, z) → (x, z, -y)
 }
@@ -205,7 +206,7 @@ def check_up_axis(positions: np.ndarray, up_axis: str, source: str) -> None:
     axis = int(np.argmax(np.abs(height)))
     if axis != declared and abs(height[axis]) > max(_UP_AXIS_RATIO * abs(height[declared]), _MIN_BODY_HEIGHT_M):
         sign = "+" if height[axis] > 0 else "-"
-        hint = f"set data.up_axis={_AXES[axis]}" if _AXES[axis] in _UP_TO_Y and sign == "+" else \
+        hint = f"set data.up_axis={_AXES[axis]}" if _AXES[axis] in UP_TO_Y and sign == "+" else \
             "check the file's axes"
         warnings.warn(
             f"{source}: read as {up_axis.upper()}-up but the body's height (head above feet) runs along "
@@ -257,8 +258,8 @@ def to_canonical_positions(
         if not np.isfinite(scale) or scale <= 0:
             raise MotionDataError(motion.source, f"unit_scale must be a positive number of metres per file "
                                   f"unit or a unit name ({sorted(UNIT_SCALES)}), got {unit_scale!r}")
-    if up_axis not in _UP_TO_Y:
-        raise MotionDataError(motion.source, f"up_axis must be one of {sorted(_UP_TO_Y)}, got {up_axis!r}")
+    if up_axis not in UP_TO_Y:
+        raise MotionDataError(motion.source, f"up_axis must be one of {sorted(UP_TO_Y)}, got {up_axis!r}")
     if fps is not None:
         if isinstance(fps, bool) or not isinstance(fps, numbers.Real) or not np.isfinite(fps) or fps <= 0:
             raise ValueError(f"{motion.source}: fps must be a positive finite number of frames per second, "
@@ -268,7 +269,7 @@ def to_canonical_positions(
     with np.errstate(over="ignore", invalid="ignore"):  # overflow is reported below, naming the file
         in_file_axes = motion.global_positions()[:, idx] * scale
         _check_finite(in_file_axes, motion, scale)
-        positions = in_file_axes @ _UP_TO_Y[up_axis].T if up_axis != "y" else in_file_axes
+        positions = in_file_axes @ UP_TO_Y[up_axis].T if up_axis != "y" else in_file_axes
         positions = positions.astype(np.float32)
     _check_finite(positions, motion, scale)
     check_up_axis(in_file_axes, up_axis, motion.source)

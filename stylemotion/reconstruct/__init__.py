@@ -12,6 +12,7 @@ from typing import TYPE_CHECKING
 from stylemotion import lazy_exports
 
 if TYPE_CHECKING:
+    from stylemotion.reconstruct.capture import read_c3d, read_capture, resample_tracks
     from stylemotion.reconstruct.keyframes import (
         DynamicMotionGraph,
         FarKeyframeWarning,
@@ -21,6 +22,7 @@ if TYPE_CHECKING:
         NoConnectionError,
         keys_from_motion,
     )
+    from stylemotion.reconstruct.marker_set import SKIN_MARKERS, MarkerSet, SkinMarker, virtual_markers
     from stylemotion.reconstruct.markers import (
         DEFAULT_MARKERS,
         MarkerGapWarning,
@@ -39,6 +41,7 @@ if TYPE_CHECKING:
         marker_frames,
         reconstruct,
     )
+    from stylemotion.reconstruct.subject import Subject, subject_from_motion
     from stylemotion.reconstruct.texture import (
         LEG_JOINTS,
         MotionTexturer,
@@ -56,6 +59,8 @@ __all__ = [
     "DEFAULT_MARKERS", "MarkerGapWarning", "MarkerInputError", "MarkerTracks", "RECONSTRUCT_FEATURE_SETS",
     "Reconstruction", "SparseReconstructor", "fill_gaps", "joint_errors_cm", "marker_frames", "read_markers",
     "reconstruct", "tracks_from_positions", "write_marker_csv",
+    "SKIN_MARKERS", "MarkerSet", "SkinMarker", "virtual_markers", "read_c3d", "read_capture", "resample_tracks",
+    "Subject", "subject_from_motion",
 ]
 
 __getattr__, __dir__ = lazy_exports(__name__, {
@@ -74,6 +79,15 @@ __getattr__, __dir__ = lazy_exports(__name__, {
     "read_markers": "markers",
     "tracks_from_positions": "markers",
     "write_marker_csv": "markers",
+    "SKIN_MARKERS": "marker_set",
+    "MarkerSet": "marker_set",
+    "SkinMarker": "marker_set",
+    "virtual_markers": "marker_set",
+    "read_c3d": "capture",
+    "read_capture": "capture",
+    "resample_tracks": "capture",
+    "Subject": "subject",
+    "subject_from_motion": "subject",
     "RECONSTRUCT_FEATURE_SETS": "sparse",
     "Reconstruction": "sparse",
     "SparseReconstructor": "sparse",

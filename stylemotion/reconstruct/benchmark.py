@@ -172,3 +172,25 @@ def pairs_figures(outcomes: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
                                      "max": float(dur.max())},
                    key_error_cm=float(np.mean([o["key_error_cm"] for o in joined])))
     return out
+
+
+def skin_marker_noise(markers: np.ndarray, rng: np.random.Generator, placement_mm: float = 10.0,
+                      jitter_mm: float = 1.0) -> np.ndarray:
+    """Virtual skin markers ``(frames, m, 3)`` metres with the suite ``markers``' noise model: each marker placed
+    off its nominal spot by a constant drawn once per recording (uniform ± ``placement_mm`` per axis: where a
+    person sticks it) plus per-frame jitter (uniform ± ``jitter_mm`` per axis: the thesis' ± 1 mm)."""
+    markers = np.asarray(markers, np.float64)
+    placement = rng.uniform(-1.0, 1.0, (1,) + markers.shape[1:]) * placement_mm / 1000.0
+    return markers + placement + rng.uniform(-1.0, 1.0, markers.shape) * jitter_mm / 1000.0
+
+
+def bone_length_spread_cm(positions: np.ndarray) -> dict[str, float]:
+    """How much a motion's bones change length over time: per bone the standard deviation over frames (cm), and
+    its mean and maximum over bones; and the largest change of any bone (max − min over frames, cm)."""
+    from stylemotion.bones import BONE_JOINTS
+    from stylemotion.skeleton import bone_lengths
+
+    lengths = bone_lengths(np.asarray(positions, np.float64))[:, list(BONE_JOINTS)] * 100.0
+    sd = lengths.std(axis=0)
+    return {"mean_sd_cm": float(sd.mean()), "max_sd_cm": float(sd.max()),
+            "max_range_cm": float((lengths.max(axis=0) - lengths.min(axis=0)).max())}

@@ -40,6 +40,8 @@ from stylemotion.skeleton import CANONICAL_JOINTS, JOINT_INDEX
 DEFAULT_MARKERS = ("Hand_L", "Hand_R", "Foot_L", "Foot_R", "Head", "Hips")
 #: File suffixes :func:`read_markers` reads.
 MARKER_FORMATS = (".bvh", ".npz", ".csv")
+#: Largest marker CSV read, bytes.
+MAX_CSV_BYTES = 512 * 2**20
 
 
 class MarkerInputError(UserInputError, ValueError):
@@ -203,8 +205,9 @@ def _float(cell: str, path: Path, row: int, column: str) -> float:
         raise MarkerInputError(f"{path}: line {row}, column {column}: {cell!r} is not a number") from None
 
 
-def _csv_header(path: Path, header: list[str]) -> list[str]:
-    """The marker names of a CSV header ``frame,<joint>_x,<joint>_y,<joint>_z,...``."""
+def _csv_header(path: Path, header: list[str], valid: Sequence[str] | None = None) -> list[str]:
+    """The marker names of a CSV header ``frame,<joint>_x,<joint>_y,<joint>_z,...`` (canonical joints, or any of
+    ``valid`` when given)."""
     if not header or header[0].strip() != "frame" or (len(header) - 1) % 3:
         raise MarkerInputError(f"{path}: the header must be frame,<joint>_x,<joint>_y,<joint>_z,…, got {header[:4]}")
     names = []
@@ -214,10 +217,21 @@ def _csv_header(path: Path, header: list[str]) -> list[str]:
         if [col[-2:] for col in cols] != ["_x", "_y", "_z"] or cols[1][:-2] != joint or cols[2][:-2] != joint:
             raise MarkerInputError(f"{path}: columns {cols} must be <joint>_x,<joint>_y,<joint>_z")
         names.append(joint)
-    return list(check_marker_names(names))
+    if valid is None:
+        return list(check_marker_names(names))
+    repeated = sorted({n for n in names if names.count(n) > 1})
+    if repeated:
+        raise MarkerInputError(f"{path}: marker(s) {repeated} have more than one set of columns")
+    return names
 
 
-def _read_csv(path: Path, joints: Sequence[str] | None, fps: float) -> MarkerTracks:
+def read_marker_csv(path: Path, joints: Sequence[str] | None, fps: float,
+                    valid: Sequence[str] | None = None) -> MarkerTracks:
+    """Marker tracks of a CSV (module docstring); ``joints``: the markers to keep (None: all); ``valid``: the
+    marker names allowed besides canonical joints' (a skin-marker set's; columns of other names are ignored)."""
+    if path.stat().st_size > MAX_CSV_BYTES:
+        raise MarkerInputError(f"{path}: {path.stat().st_size:,} bytes, more than the {MAX_CSV_BYTES:,} a marker "
+                               f"CSV may have")
     try:
         lines = path.read_text(encoding="utf-8").splitlines()
     except (OSError, UnicodeDecodeError) as exc:
@@ -232,8 +246,11 @@ def _read_csv(path: Path, joints: Sequence[str] | None, fps: float) -> MarkerTra
     rows = list(csv.reader(lines))
     if len(rows) < 2:
         raise MarkerInputError(f"{path}: no marker rows")
-    names = _csv_header(path, rows[0])
-    wanted = check_marker_names(joints) if joints is not None else tuple(names)
+    names = _csv_header(path, rows[0], valid)
+    if joints is not None:
+        wanted = check_marker_names(joints) if valid is None else tuple(joints)
+    else:
+        wanted = tuple(names)
     absent = [j for j in wanted if j not in names]
     if absent:
         raise MarkerInputError(f"{path}: no columns for marker(s) {absent}; the file has {names}")
@@ -246,6 +263,9 @@ def _read_csv(path: Path, joints: Sequence[str] | None, fps: float) -> MarkerTra
             raise MarkerInputError(f"{path}: line {r}: frame {row[0]!r} must be a whole number ≥ 0")
         if frames and f <= frames[-1]:
             raise MarkerInputError(f"{path}: line {r}: frame {int(f)} does not follow frame {frames[-1]}")
+        if len(frames) and f - frames[0] > 10 * len(rows) + 1000:
+            raise MarkerInputError(f"{path}: line {r}: frame {int(f)} leaves a gap of more than ten times the file's "
+                                   f"{len(rows) - 1} rows after frame {frames[0]}")
         frames.append(int(f))
         values.append([_float(cell, path, r, rows[0][c]) for c, cell in enumerate(row[1:], start=1)])
     table = np.full((frames[-1] - frames[0] + 1, len(names), 3), np.nan)
@@ -281,7 +301,7 @@ def read_markers(path: str | Path, joints: Sequence[str] | None = None, fps: flo
         raise MarkerInputError(f"markers={text}: no such file")
     if suffix == ".npz":
         return _read_npz(file, DEFAULT_MARKERS if joints is None else joints)
-    return _read_csv(file, joints, fps)
+    return read_marker_csv(file, joints, fps)
 
 
 def write_marker_csv(path: str | Path, joints: Sequence[str], positions: np.ndarray, fps: float) -> Path:

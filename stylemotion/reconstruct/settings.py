@@ -24,7 +24,8 @@ class SparseModelSettings:
     ``variance``: fraction of the neighbours' spread the local PCA keeps; ``marker_sd``: metres a marker may miss
     by; ``smooth_sd``: metres a joint may move between frames (body frame); ``prior_weight``: weight of the
     Mahalanobis prior of the local PCA; ``iterations``: k-NN searches per frame for E30/E39/pca* (searched
-    around the synthesized pose); ``weighted``: neighbours weighted by ``1/(feature distance + marker_sd)^2``.
+    around the synthesized pose); ``weighted``: neighbours weighted by ``1/(feature distance + marker_sd)^2``;
+    ``hold_bones``: every output frame's bones set to the subject's lengths (constant over time).
     """
 
     variance: float = 0.99
@@ -33,6 +34,7 @@ class SparseModelSettings:
     prior_weight: float = 1.0
     iterations: int = 1
     weighted: bool = True
+    hold_bones: bool = True
 
 
 @dataclass(frozen=True)
@@ -40,8 +42,15 @@ class ReconstructSettings(MotionFileKeys):
     """Every key of ``stylemotion-reconstruct`` (besides ``data``), with its default.
 
     ``markers``: ``BVH[:start-end]`` | NPZ (as ``stylemotion-convert`` writes) | CSV of marker tracks
-    (``frame,<joint>_x,<joint>_y,<joint>_z,…`` metres, Y up) | a take of the dataset. ``joints``: the markers;
-    None = ``[Hand_L,Hand_R,Foot_L,Foot_R,Head,Hips]`` (a CSV: its columns). ``features``: k-NN feature set
+    (``frame,<marker>_x,<marker>_y,<marker>_z,…`` metres, Y up, any rate: resampled) | C3D | a take of the
+    dataset. ``joints``: the markers at joint centres; None = ``[Hand_L,Hand_R,Foot_L,Foot_R,Head,Hips]`` (a CSV:
+    its columns). ``marker_set``: None/``joints`` (markers at the joint centres ``joints``), ``skin`` (the default
+    skin-marker set, docs/reconstruct.md) or a CSV ``name,segment,x,y,z``; a C3D needs a skin set, a BVH/NPZ/take
+    gets the set's markers put on virtually. ``marker_names``: set marker → the file's label (C3D, default the
+    same name). ``markers_fps``: a CSV's rate when it has no ``# fps:`` line (default the dataset's).
+    ``markers_up_axis``: a C3D's up axis (``z`` or ``y``). ``subject``: whose bones the database is put on and the
+    output holds: ``database`` (its own), ``markers`` (scaled to the subject from the markers) or a BVH of the
+    subject's skeleton (its median bone lengths: a calibration). ``features``: k-NN feature set
     (E15 E30 E39 E15x3 E15x5 pca8 pca16 pca25). ``k``: neighbours of the local linear model per frame; chosen
     on Bandai val takes (suite reconstruct, docs/reconstruct.md). ``noise_mm``: uniform noise of ± ``noise_mm``
     millimetres added to the markers (thesis: 1); ``seed``: of that noise. ``exclude_markers_take``: markers= a
@@ -53,6 +62,11 @@ class ReconstructSettings(MotionFileKeys):
 
     markers: str = MISSING
     joints: list[str] | None = None
+    marker_set: str = "joints"
+    marker_names: dict[str, str] | None = None
+    markers_fps: float | None = None
+    markers_up_axis: str = "z"
+    subject: str = "database"
     features: str = "E15"
     k: int = 512
     noise_mm: float = 0.0

@@ -26,8 +26,19 @@ Per frame ``t`` of the marker tracks:
    (S picks the markers, m their coordinates, σ_i² the PCA variances, x_prev the previous result in this
    frame's marker frame): one linear least-squares solve, then back to world with the marker frame.
 
+Skin markers (:mod:`stylemotion.reconstruct.marker_set`): the markers are a set's virtual markers, put on
+the database's motions as on the query, so features compare like with like; the local model of step 3 is the PCA
+of the neighbours' poses *and* their markers (63 + 3m coordinates), the markers' coordinates are what step 4
+fits. The marker frame of step 1 is built from the markers' segments' names (a wrist marker counts as Hand_L).
+
+Subject and bones (docs/reconstruct.md): ``bones`` (20 bone lengths, metres: a calibration's skeleton, or the
+database's scaled by :func:`subject_scale`) puts every database take on those bones first
+(:func:`stylemotion.bones.retarget_positions`); ``hold_bones`` sets every output frame's bones to those lengths
+(else to the result's own median lengths over its frames), the wrists and ankles kept where the model put them
+(:func:`stylemotion.reconstruct.subject.hold_bone_lengths`: knees and elbows by two-bone IK).
+
 Simplified against Chai & Hodgins: no per-frame optimization of joint angles (the pose is a point of
-the neighbours' linear model in joint positions) and no bone-length constraint.
+the neighbours' linear model in joint positions); bone lengths are held by placing the bones afterwards.
 """
 
 from __future__ import annotations
@@ -38,9 +49,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from stylemotion.reconstruct.marker_set import MarkerSet, joint_marker_set, virtual_markers
 from stylemotion.reconstruct.markers import MarkerInputError, MarkerTracks, check_marker_names
 from stylemotion.reconstruct.settings import ReconstructSettings as _C
 from stylemotion.reconstruct.settings import SparseModelSettings as _M
+from stylemotion.reconstruct.subject import Subject, database_on_subject, hold_bone_lengths
 from stylemotion.search.database import MotionDatabase
 from stylemotion.search.features import feature_spec, stack_window, window_offsets
 from stylemotion.search.index import FrameIndex
@@ -49,6 +62,7 @@ from stylemotion.skeleton import JOINT_INDEX, NUM_JOINTS
 #: Feature sets the reconstruction can search in (windows only over markers; no physics terms).
 RECONSTRUCT_FEATURE_SETS = ("E15", "E30", "E39", "E15x3", "E15x5", "pca8", "pca16", "pca25")
 _EPS = 1e-9
+_LIMB_ENDS = ("Hand_L", "Hand_R", "Foot_L", "Foot_R")
 
 
 def marker_frames(markers: np.ndarray, joints: Sequence[str]) -> tuple[np.ndarray, np.ndarray]:
@@ -113,12 +127,43 @@ def joint_errors_cm(positions: np.ndarray, truth: np.ndarray) -> dict:
             "per_joint_mean_cm": {j: round(float(err[:, i].mean()), 3) for i, j in enumerate(CANONICAL_JOINTS)}}
 
 
+def subject_scale(markers: np.ndarray, marker_set: MarkerSet, database: MotionDatabase) -> float:
+    """The subject's size against the database's, from marker tracks ``(frames, m, 3)`` metres: the median over
+    marker pairs of the ratio of their 95th-percentile distance in the tracks to the same on the database's
+    virtual markers (pairs among the markers off the arms when there are two such, else all pairs)."""
+    arms = ("Shoulder", "UpperArm", "LowerArm", "Hand")
+    body = [i for i, s in enumerate(marker_set.segments) if not s.startswith(arms)]
+    chosen = body if len(body) >= 2 else list(range(len(marker_set.markers)))
+    pairs = [(a, b) for n, a in enumerate(chosen) for b in chosen[n + 1:]]
+    if not pairs:
+        return 1.0
+    step = max(1, database.num_frames // 50_000)
+    ours = np.asarray(markers, np.float64)
+    theirs = virtual_markers(np.asarray(database.positions[::step], np.float64), marker_set)
+
+    def p95(m: np.ndarray, a: int, b: int) -> float:
+        return float(np.percentile(np.linalg.norm(m[:, a] - m[:, b], axis=-1), 95))
+
+    ratios = [p95(ours, a, b) / max(p95(theirs, a, b), _EPS) for a, b in pairs]
+    return float(np.median(ratios))
+
+
+def database_on_bones(database: MotionDatabase, bones: np.ndarray) -> MotionDatabase:
+    """``database`` with every take put on the bone lengths ``bones`` ``(20,)`` metres
+    (:func:`stylemotion.reconstruct.subject.database_on_subject` with lengths only)."""
+    return database_on_subject(database, Subject(np.asarray(bones, np.float64)))
+
+
 class SparseReconstructor:
     """Reconstruction of full poses from the markers ``joints`` with the prior of ``database`` (module docstring).
 
     Args:
         database: the motion database (its fps is the markers' required rate).
-        joints: marker names.  features: one of :data:`RECONSTRUCT_FEATURE_SETS`.  k: neighbours per frame.
+        joints: marker names (joint centres) or a :class:`MarkerSet` (skin markers, marker-only feature sets).
+        bones: ``(20,)`` metres, the subject's bone lengths, or a :class:`~stylemotion.reconstruct.subject.Subject`
+            (lengths and rigid bone directions): the database is put on them first.
+        hold_bones: every output frame's bones set to ``bones`` (else to the result's median bone lengths).
+        features: one of :data:`RECONSTRUCT_FEATURE_SETS`.  k: neighbours per frame.
         variance: fraction of the neighbours' spread the local PCA keeps.  marker_sd: metres a marker may miss
             by.  smooth_sd: metres a joint may move between frames (in the marker frame).  prior_weight: weight
             of the Mahalanobis prior.  iterations: k-NN searches per frame for pose-guided sets.
@@ -126,11 +171,19 @@ class SparseReconstructor:
         engine, workers: the k-NN engine (:class:`FrameIndex`).
     """
 
-    def __init__(self, database: MotionDatabase, joints: Sequence[str], features: str = _C.features, k: int = _C.k,
-                 variance: float = _M.variance, marker_sd: float = _M.marker_sd, smooth_sd: float = _M.smooth_sd,
-                 prior_weight: float = _M.prior_weight, iterations: int = _M.iterations, weighted: bool = _M.weighted,
-                 engine: str = "ckdtree", workers: int = 1):
-        self.joints = check_marker_names(joints)
+    def __init__(self, database: MotionDatabase, joints: Sequence[str] | MarkerSet, features: str = _C.features,
+                 k: int = _C.k, variance: float = _M.variance, marker_sd: float = _M.marker_sd,
+                 smooth_sd: float = _M.smooth_sd, prior_weight: float = _M.prior_weight,
+                 iterations: int = _M.iterations, weighted: bool = _M.weighted, engine: str = "ckdtree",
+                 workers: int = 1, bones: np.ndarray | Subject | None = None, hold_bones: bool = _M.hold_bones):
+        if isinstance(joints, MarkerSet):
+            self.marker_set = joints
+            self.joints = joints.names
+        else:
+            self.joints = check_marker_names(joints)
+            self.marker_set = joint_marker_set(self.joints)
+        self.roles = self.marker_set.segments  # what the marker frame calls each marker
+        self.skin = not self.marker_set.is_joint_centres
         if features not in RECONSTRUCT_FEATURE_SETS:
             raise ValueError(f"features={features} cannot be used for reconstruction; valid: "
                              f"{list(RECONSTRUCT_FEATURE_SETS)}")
@@ -147,16 +200,36 @@ class SparseReconstructor:
         self.variance, self.marker_sd, self.smooth_sd = float(variance), float(marker_sd), float(smooth_sd)
         self.prior_weight, self.iterations = float(prior_weight), max(1, int(iterations))
         self.weighted = bool(weighted)
-        self.marker_idx = [JOINT_INDEX[j] for j in self.joints]
+        self.marker_idx = [JOINT_INDEX[j] for j in self.roles]
         spec = feature_spec(features)
         self.spec = spec
-        self.guided = spec.pca_components > 0 or not set(spec.joints) <= set(self.joints)
+        self.guided = spec.pca_components > 0 or not set(spec.joints) <= set(self.roles)
+        if self.skin and self.guided:
+            raise ValueError(f"features={features}: skin markers need a marker-only feature set (E15, E15x3, E15x5)")
         if self.guided and spec.samples > 1:
             raise ValueError(f"features={features}: a window over joints that are not markers "
                              f"({sorted(set(spec.joints) - set(self.joints))}) is not supported")
         self.feature_joints = [j for j in (spec.joints or ()) if j in JOINT_INDEX]
-        rotation, origin = marker_frames(database.positions[:, self.marker_idx], self.joints)
-        self.local = to_local(np.asarray(database.positions, np.float64), rotation, origin).reshape(-1, 3 * NUM_JOINTS)
+        self.subject = None
+        if bones is not None:
+            from stylemotion.bones import BONE_NAMES
+
+            subject = bones if isinstance(bones, Subject) else Subject(np.asarray(bones, np.float64))
+            lengths = np.asarray(subject.lengths, np.float64)
+            if lengths.shape != (len(BONE_NAMES),) or not np.all(np.isfinite(lengths)) or np.any(lengths < 0):
+                raise ValueError(f"bones must be {len(BONE_NAMES)} lengths ≥ 0 in metres, got shape {lengths.shape}")
+            database = database_on_subject(database, subject)
+            self.database, self.subject, bones = database, subject, lengths
+        self.hold_bones = bool(hold_bones)
+        self.bones = bones  # the subject's, or None: each result's own median bones
+        positions = np.asarray(database.positions, np.float64)
+        db_markers = virtual_markers(positions, self.marker_set)
+        rotation, origin = marker_frames(db_markers, self.roles)
+        self.local = to_local(positions, rotation, origin).reshape(-1, 3 * NUM_JOINTS)
+        # the markers' own coordinates in the marker frame, beside the joints' (skin markers only: for joint
+        # centres they are columns of ``local`` already)
+        self.local_markers = to_local(db_markers, rotation, origin).reshape(len(positions), -1) if self.skin \
+            else np.zeros((len(positions), 0))
         self.mean_pose = self.local.mean(axis=0)
         self._pca: np.ndarray | None = None
         data = self._database_features()
@@ -172,12 +245,20 @@ class SparseReconstructor:
         cols = np.concatenate([3 * JOINT_INDEX[j] + np.arange(3) for j in self.feature_joints])
         return local[:, cols]
 
+    def _frame_marker_features(self) -> np.ndarray:
+        """``(n, d)`` database features of a marker-only set: the feature joints' markers in the marker frame."""
+        if not self.skin:
+            return self._pose_features(self.local)
+        picked = [self.roles.index(j) for j in self.feature_joints]
+        cols = np.concatenate([3 * m + np.arange(3) for m in picked])
+        return self.local_markers[:, cols]
+
     def _database_features(self) -> np.ndarray:
         if self.spec.pca_components:
             centred = self.local - self.mean_pose
             _, _, vt = np.linalg.svd(centred[:: max(1, len(centred) // 20000)], full_matrices=False)
             self._pca = vt[: self.spec.pca_components]
-        frame_features = self._pose_features(self.local)
+        frame_features = self._frame_marker_features()
         if self.spec.samples == 1:
             return frame_features
         offsets = window_offsets(self.spec.samples, self.database.fps)
@@ -187,7 +268,7 @@ class SparseReconstructor:
     def marker_features(self, local_markers: np.ndarray) -> np.ndarray:
         """``(frames, m, 3)`` marker-frame markers → ``(frames, d)`` features of a marker-only set (windows
         over the track, its first frame repeated before it)."""
-        picked = local_markers[:, [self.joints.index(j) for j in self.feature_joints]].reshape(len(local_markers), -1)
+        picked = local_markers[:, [self.roles.index(j) for j in self.feature_joints]].reshape(len(local_markers), -1)
         if self.spec.samples == 1:
             return picked
         return stack_window(picked, window_offsets(self.spec.samples, self.database.fps))
@@ -199,7 +280,7 @@ class SparseReconstructor:
         """The pose ``(63,)`` (marker frame) from the neighbours' global indices and feature distances ``(k,)``,
         this frame's markers ``(m, 3)`` in its marker frame and the previous result ``(63,)`` in the same frame
         (or None)."""
-        poses = self.local[neighbours]
+        poses = np.concatenate([self.local[neighbours], self.local_markers[neighbours]], axis=1)
         weights = np.ones(len(poses))
         if self.weighted:
             weights = 1.0 / (np.asarray(distances, np.float64) + self.marker_sd) ** 2
@@ -207,25 +288,30 @@ class SparseReconstructor:
         mu = weights @ poses
         _, s, vt = np.linalg.svd(np.sqrt(weights)[:, None] * (poses - mu), full_matrices=False)
         var = s ** 2 * len(poses) / max(1, len(poses) - 1)
+        n = 3 * NUM_JOINTS
         if var.sum() <= _EPS:
-            return mu
+            return mu[:n]
         keep = int(np.searchsorted(np.cumsum(var) / var.sum(), self.variance - 1e-12) + 1)
         basis, var = vt[:keep], np.maximum(var[:keep], _EPS)
-        cols = np.concatenate([3 * i + np.arange(3) for i in self.marker_idx])
+        if self.skin:
+            cols = n + np.arange(3 * len(self.joints))
+        else:
+            cols = np.concatenate([3 * i + np.arange(3) for i in self.marker_idx])
         sb = basis[:, cols].T  # (3m, r)
         a = sb.T @ sb / self.marker_sd ** 2 + self.prior_weight * np.diag(1.0 / var)
         b = sb.T @ (markers_local.reshape(-1) - mu[cols]) / self.marker_sd ** 2
         if previous is not None:
-            a += np.eye(keep) / self.smooth_sd ** 2
-            b += basis @ (previous - mu) / self.smooth_sd ** 2
-        return mu + basis.T @ np.linalg.solve(a, b)
+            joints = basis[:, :n]  # the pose part of the basis (orthonormal rows when there are no marker columns)
+            a += joints @ joints.T / self.smooth_sd ** 2
+            b += joints @ (previous - mu[:n]) / self.smooth_sd ** 2
+        return mu[:n] + basis[:, :n].T @ np.linalg.solve(a, b)
 
     def reconstruct(self, tracks: MarkerTracks | np.ndarray) -> Reconstruction:
         """Full poses for marker tracks (a :class:`MarkerTracks` of this reconstructor's joints, at the
         database's fps, or their ``(frames, m, 3)`` positions, metres) → :class:`Reconstruction`."""
         started = time.perf_counter()
         markers = self._check_tracks(tracks)
-        rotation, origin = marker_frames(markers, self.joints)
+        rotation, origin = marker_frames(markers, self.roles)
         local_markers = to_local(markers, rotation, origin)
         knn_s = 0.0
         nearest = np.empty(len(markers), dtype=np.int64)
@@ -255,14 +341,32 @@ class SparseReconstructor:
             out[t] = pose
             previous_world = to_world(pose.reshape(NUM_JOINTS, 3), rotation[t], origin[t])
         positions = to_world(out.reshape(-1, NUM_JOINTS, 3), rotation, origin)
+        if self.hold_bones:
+            positions = self.held(positions, markers)
         total = time.perf_counter() - started
         return Reconstruction(positions, self.settings(), {"knn": knn_s, "total": total}, nearest)
+
+    def held(self, positions: np.ndarray, markers: np.ndarray) -> np.ndarray:
+        """The model's poses ``(frames, 21, 3)`` on the subject's bones (module docstring), moved onto the markers
+        ``(frames, m, 3)``: the whole body by the root marker's miss, each limb end by its marker's remaining miss
+        (the misses measured on the set's virtual markers of the poses)."""
+        from stylemotion.bones import median_bone_lengths
+
+        miss = markers - virtual_markers(positions, self.marker_set)  # (frames, m, 3)
+        if "Hips" in self.roles:
+            root = miss[:, self.roles.index("Hips")]
+            positions = positions + root[:, None]
+            miss = miss - root[:, None]
+        ends = {seg: positions[:, JOINT_INDEX[seg]] + miss[:, m] for m, seg in enumerate(self.roles)
+                if seg in _LIMB_ENDS}
+        lengths = median_bone_lengths(positions) if self.bones is None else self.bones
+        return hold_bone_lengths(positions, lengths, ends)
 
     def nearest_neighbour(self, tracks: MarkerTracks | np.ndarray) -> np.ndarray:
         """Baseline: each frame's nearest database pose (k = 1 in the same features) placed with the markers'
         frame → ``(frames, 21, 3)`` metres."""
         markers = self._check_tracks(tracks)
-        rotation, origin = marker_frames(markers, self.joints)
+        rotation, origin = marker_frames(markers, self.roles)
         local_markers = to_local(markers, rotation, origin)
         if self.guided:
             raise ValueError("the nearest-neighbour baseline needs a marker-only feature set (e.g. E15)")
@@ -275,6 +379,9 @@ class SparseReconstructor:
                 "marker_sd_m": self.marker_sd, "smooth_sd_m": self.smooth_sd, "prior_weight": self.prior_weight,
                 "iterations": self.iterations, "weighted": self.weighted,
                 "search": "pose-guided" if self.guided else "markers",
+                "marker_set": {"name": self.marker_set.name, "markers": self.marker_set.describe()},
+                "hold_bones": self.hold_bones,
+                "subject": None if self.subject is None else self.subject.describe(),
                 "database": {"name": self.database.name, "takes": self.database.num_takes,
                              "frames": self.database.num_frames, "fps": self.database.fps}}
 

@@ -73,3 +73,42 @@ def test_the_console_command_runs_and_refuses_in_one_line(tmp_path, capsys, monk
     done = run_command("reconstruct", *run, f"out={tmp_path / 'p'}", "joints=[Hips,Tail]", capsys=capsys,
                        monkeypatch=monkeypatch, cwd=tmp_path)
     assert done.returncode == 2 and "'Tail'" in done.stderr and "Traceback" not in done.stderr
+
+
+def test_a_c3d_of_skin_markers_at_60_fps(tmp_path, capsys, monkeypatch):
+    import ezc3d
+
+    from stylemotion.reconstruct.marker_set import SKIN_MARKERS, virtual_markers
+
+    take = load_dataset("synthetic", takes_per_pair=1).takes[0]
+    truth = np.asarray(take.positions[:41], np.float64)
+    at_60 = np.repeat(truth, 2, axis=0)[:-1]  # 60 fps: each 30 fps pose twice (linear in between: the mean)
+    at_60[1::2] = 0.5 * (truth[:-1] + truth[1:])
+    markers = virtual_markers(at_60, SKIN_MARKERS)
+    c3d = ezc3d.c3d()
+    c3d["parameters"]["POINT"]["RATE"]["value"] = [60.0]
+    c3d["parameters"]["POINT"]["LABELS"]["value"] = list(SKIN_MARKERS.names)
+    points = np.ones((4, 6, len(markers)))
+    points[:3] = np.stack([markers[..., 0], -markers[..., 2], markers[..., 1]], axis=0).swapaxes(1, 2) * 1000.0
+    c3d["data"]["points"] = points
+    c3d.add_parameter("POINT", "UNITS", "mm")
+    c3d.write(str(tmp_path / "walk.c3d"))
+    summary = reconstruct_command(DATA, str(tmp_path / "walk.c3d"), tmp_path / "out", marker_set="skin",
+                                  subject="markers", gif=False)
+    with np.load(tmp_path / "out" / "motion.npz") as npz:
+        positions = npz["positions"]
+    assert positions.shape == (41, 21, 3)
+    assert np.linalg.norm(positions - truth, axis=-1).mean() < 0.02  # the take is in the database: near exact
+    assert summary["markers"]["marker_set"] == "skin" and summary["markers"]["subject"]["value"] == "markers"
+    assert summary["bone_length_sd_cm"]["max_range_cm"] < 1e-3
+    with pytest.raises(MarkerInputError, match="marker_set=skin"):
+        reconstruct_command(DATA, str(tmp_path / "walk.c3d"), tmp_path / "b")
+    with pytest.raises(ConfigError, match="joints="):
+        reconstruct_command(DATA, str(tmp_path / "walk.c3d"), tmp_path / "b", marker_set="skin", joints=["Hips"])
+    with pytest.raises(ConfigError, match="subject=walk.txt"):
+        reconstruct_command(DATA, str(tmp_path / "walk.c3d"), tmp_path / "b", marker_set="skin", subject="walk.txt")
+    run = [f"markers={tmp_path / 'walk.c3d'}", "marker_set=skin", "data.takes_per_pair=1", "gif=false",
+           f"out={tmp_path / 'c'}", "markers_up_axis=x"]
+    done = run_command("reconstruct", *run, capsys=capsys, monkeypatch=monkeypatch, cwd=tmp_path)
+    assert done.returncode == 2 and "markers_up_axis=x" in done.stderr and "Traceback" not in done.stderr
+    assert not (tmp_path / "b").exists()

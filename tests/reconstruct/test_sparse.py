@@ -19,6 +19,9 @@ from stylemotion.reconstruct import (
     marker_frames,
     tracks_from_positions,
 )
+from stylemotion.reconstruct.benchmark import bone_length_spread_cm
+from stylemotion.reconstruct.marker_set import SKIN_MARKERS, virtual_markers
+from stylemotion.reconstruct.sparse import database_on_bones, subject_scale
 from stylemotion.search.database import MotionDatabase
 
 
@@ -122,3 +125,50 @@ def test_bandai_walk_from_six_markers(tmp_path):
     tolerance = 1.5 * max(errors(take)[0] for take in parts["val"][:2])
     ours, baseline = errors(parts["test"][0])
     assert ours < baseline and ours < tolerance, (ours, baseline, tolerance)
+
+
+@pytest.fixture(scope="module")
+def skin_reconstructor(split):
+    return SparseReconstructor(split[0], SKIN_MARKERS)
+
+
+def test_skin_markers_give_a_database_take_back_and_beat_the_nearest_neighbour(split, skin_reconstructor):
+    take = split[1][3]
+    result = skin_reconstructor.reconstruct(virtual_markers(take.positions, SKIN_MARKERS))
+    assert joint_errors_cm(result.positions, take.positions)["mean_cm"] < 0.1
+    assert result.settings["marker_set"]["name"] == "skin"
+    rng = np.random.default_rng(2)
+    ours, baseline = [], []
+    for held_out in split[2]:
+        markers = virtual_markers(held_out.positions, SKIN_MARKERS) + rng.uniform(-0.001, 0.001, (1, 6, 3))
+        ours.append(joint_errors_cm(skin_reconstructor.reconstruct(markers).positions, held_out.positions)["mean_cm"])
+        baseline.append(joint_errors_cm(skin_reconstructor.nearest_neighbour(markers), held_out.positions)["mean_cm"])
+    assert np.mean(ours) < 0.7 * np.mean(baseline) and np.mean(ours) < 2.0, (ours, baseline)
+
+
+def test_held_bones_are_constant_and_free_ones_are_not(split, skin_reconstructor):
+    take = split[2][0]
+    noise = np.random.default_rng(3).uniform(-0.005, 0.005, (len(take.positions), 6, 3))
+    markers = virtual_markers(take.positions, SKIN_MARKERS) + noise
+    held = skin_reconstructor.reconstruct(markers).positions
+    assert skin_reconstructor.hold_bones and bone_length_spread_cm(held)["max_range_cm"] < 1e-6
+    free = SparseReconstructor(split[0], SKIN_MARKERS, hold_bones=False).reconstruct(markers).positions
+    assert bone_length_spread_cm(free)["max_range_cm"] > 0.01
+
+
+def test_the_subject_scale_of_a_scaled_database_take_and_the_database_on_its_bones(split):
+    from stylemotion.bones import median_bone_lengths
+
+    database, take = split[0], split[1][3]
+    for scale in (0.85, 1.2):
+        grown = take.positions * scale  # a uniformly bigger or smaller person, same motion
+        markers = virtual_markers(grown, SKIN_MARKERS)
+        assert subject_scale(markers, SKIN_MARKERS, database) == pytest.approx(scale, rel=0.06)
+    bones = median_bone_lengths(take.positions) * 1.2
+    moved = database_on_bones(database, bones)
+    np.testing.assert_allclose(median_bone_lengths(moved.positions[:500].astype(np.float64)), bones, atol=1e-4)
+    rec = SparseReconstructor(database, SKIN_MARKERS, bones=bones)
+    grown = take.positions[:60] * 1.2
+    out = rec.reconstruct(virtual_markers(grown, SKIN_MARKERS)).positions
+    np.testing.assert_allclose(median_bone_lengths(out), bones, atol=1e-6)
+    assert joint_errors_cm(out, grown)["mean_cm"] < 3.0
