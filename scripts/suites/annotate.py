@@ -80,11 +80,11 @@ class _Annotated:
     first asked for), re-thresholded cheaply."""
 
     def __init__(self, documents, model):
-        from stylemotion.annotate.features import relational_features
+        from stylemotion.annotate.feature_sets import compute_features
 
         self.documents, self.model = documents, model
         t0 = time.perf_counter()
-        self.features = [relational_features(d.positions, d.fps) for d in documents]
+        self.features = [compute_features(d.positions, d.fps, model.feature_set) for d in documents]
         self.features_s = time.perf_counter() - t0
         self.distances_s = 0.0
         self._variants: dict[tuple[float | None, int], list] = {}
@@ -265,6 +265,49 @@ def _walk_segment_styles(annotated: _Annotated, tensor, tau: float, tol: float |
     return right, total
 
 
+def seed_documents(split, fps: float, seed: int, args: argparse.Namespace) -> dict[str, list]:
+    """A seed's documents: ``val``/``test`` (whole takes) and ``val_cuts``/``test_cuts`` (2–3 s cuts), every drawn
+    take once, in a seeded order (:func:`stylemotion.annotate.documents.partition_documents`)."""
+    from stylemotion.annotate.documents import partition_documents
+
+    rng = np.random.default_rng([seed, 1])
+    docs = {part: partition_documents(_pool(split[part], args.take_fraction, rng), fps, args.seconds, rng,
+                                      args.blend) for part in ("val", "test")}
+    cut_rng = np.random.default_rng([seed, 3])
+    docs.update({f"{part}_cuts": partition_documents(_cuts(_pool(split[part], args.take_fraction, rng), cut_rng),
+                                                     fps, args.seconds, rng, args.blend)
+                 for part in ("val", "test")})
+    return docs
+
+
+def score_candidates(annotated: _Annotated, documents, candidates) -> dict[str, dict[str, float]]:
+    """Pooled Table 3.2 scores of every candidate ``(tau, tol, min_run, sub, z, w)`` on ``documents`` (the raw
+    labels of a ``(sub, tol, tau)`` are computed once and re-thresholded)."""
+    from stylemotion.annotate.annotation import drop_short_runs
+
+    classes = annotated.model.classes
+    out: dict[str, dict[str, float]] = {}
+    groups: dict[tuple, list] = {}
+    for c in candidates:
+        groups.setdefault((c[3], c[1], c[0]), []).append(c)
+    for (sub, tol, tau), group in groups.items():
+        raws = annotated.raw_labels(tau, tol, sub)
+        by_run: dict[int, list] = {}
+        for c in group:
+            by_run.setdefault(c[2], []).append(c)
+        for mr, runs in by_run.items():
+            short = [drop_short_runs(raw, mr) for raw in raws]
+            for c in runs:
+                preds = [_names(lab, classes) for lab in annotated.refined(short, tau, tol, sub, c[4], c[5])]
+                out[_key(*c)] = _pooled(documents, preds)
+    return out
+
+
+def val_objective(val_scores: dict[str, dict[str, list]], key: str, kinds: tuple[str, ...] = KINDS) -> float:
+    """The choice's objective: the mean over seeds and document kinds of (F1 + F2) / 2."""
+    return float(np.mean([(s["F1"] + s["F2"]) / 2 for k in kinds for s in val_scores[k][key]]))
+
+
 def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
     from threadpoolctl import threadpool_limits
 
@@ -273,8 +316,7 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
 
 
 def _run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
-    from stylemotion.annotate.annotation import drop_short_runs
-    from stylemotion.annotate.documents import part_scores, partition_documents
+    from stylemotion.annotate.documents import part_scores
     from stylemotion.annotate.model import learn_model, tensor_examples
     from stylemotion.annotate.tensors import build_tensor
     from stylemotion.evaluation.classifier import StyleClassifier
@@ -289,31 +331,17 @@ def _run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
     per_seed: dict[int, dict[str, Any]] = {}
     for seed in seeds:
         model = learn_model(split["train"], fps, args.per_class, seed, tensors=False)
-        rng = np.random.default_rng([seed, 1])
-        docs = {part: partition_documents(_pool(split[part], args.take_fraction, rng), fps, args.seconds, rng,
-                                          args.blend) for part in ("val", "test")}
-        cut_rng = np.random.default_rng([seed, 3])
-        docs.update({f"{part}_cuts": partition_documents(_cuts(_pool(split[part], args.take_fraction, rng), cut_rng),
-                                                         fps, args.seconds, rng, args.blend)
-                     for part in ("val", "test")})
+        docs = seed_documents(split, fps, seed, args)
         annotated = {part: _Annotated(d, model) for part, d in docs.items()}
         for kind, part in zip(KINDS, ("val", "val_cuts")):
-            for sub in SUB_FRAMES:
-                for tol in KEYFRAME_TOLERANCES if sub == 0 else (None,):
-                    for tau in TAUS:
-                        raws = annotated[part].raw_labels(tau, tol, sub)
-                        for mr in MIN_RUNS:
-                            short = [drop_short_runs(raw, mr) for raw in raws]
-                            for z, w in TURNING:
-                                preds = [_names(lab, model.classes)
-                                         for lab in annotated[part].refined(short, tau, tol, sub, z, w)]
-                                val_scores[kind][_key(tau, tol, mr, sub, z, w)].append(_pooled(docs[part], preds))
+            for key, scores in score_candidates(annotated[part], docs[part], candidates).items():
+                val_scores[kind][key].append(scores)
             annotated[part]._variants.clear()                    # free memory: val is done
         per_seed[seed] = {"model": model, "annotated": annotated["test"], "annotated_cuts": annotated["test_cuts"],
                           "docs": docs}
 
     def objective(key: str, kinds: tuple[str, ...] = KINDS) -> float:
-        return float(np.mean([(s["F1"] + s["F2"]) / 2 for k in kinds for s in val_scores[k][key]]))
+        return val_objective(val_scores, key, kinds)
 
     # the best objective; among equals the first in candidate order (whole templates before windows, key frames
     # off before on, then the smaller τ, then the smaller min_run)

@@ -26,6 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from stylemotion.annotate.feature_sets import FeatureSetError, same_feature_set
 from stylemotion.annotate.settings import AnnotateSettings, KeyframeSettings
 from stylemotion.annotate.subsequence import subsequence_dtw
 from stylemotion.annotate.templates import MotionTemplate, local_cost, sub_templates
@@ -85,7 +86,8 @@ def keyframe_matches(template: MotionTemplate, document: np.ndarray, keys: np.nd
                      tolerance: float) -> np.ndarray:
     """``(keys, frames)`` bool: document frame matches key frame (≤ ``tolerance`` of its consistent entries
     contradicted)."""
-    key_template = MotionTemplate(template.label, template.values[keys], template.examples, template.delta)
+    key_template = MotionTemplate(template.label, template.values[keys], template.examples, template.delta,
+                                  template.feature_set)
     return local_cost(key_template, document) <= tolerance
 
 
@@ -183,6 +185,10 @@ def class_distances(document: np.ndarray, templates: Sequence[MotionTemplate],
     doc = np.asarray(document)
     if not templates:
         raise AnnotationInputError("no class templates to annotate with")
+    try:
+        same_feature_set((t.feature_set for t in templates), "the templates")
+    except FeatureSetError as exc:
+        raise AnnotationInputError(str(exc)) from None
     if doc.ndim != 2 or any(t.values.shape[1] != doc.shape[1] for t in templates):
         raise AnnotationInputError(f"document features {doc.shape} do not fit the templates' "
                                    f"{sorted({t.values.shape[1] for t in templates})} features")

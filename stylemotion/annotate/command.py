@@ -34,7 +34,12 @@ from stylemotion.annotate.annotation import (
     class_distances,
     segments,
 )
-from stylemotion.annotate.features import relational_features
+from stylemotion.annotate.feature_sets import (
+    DEFAULT_FEATURE_SET,
+    FeatureSetError,
+    checked_feature_set,
+    compute_features,
+)
 from stylemotion.annotate.model import AnnotationModel, ModelFolderError, learn_model, load_model, save_model
 from stylemotion.annotate.settings import AnnotateSettings
 from stylemotion.annotate.templates import TemplateInputError
@@ -58,10 +63,14 @@ class AnnotateInputError(UserInputError, ValueError):
 
 def learn(data: Mapping[str, Any], out: str | os.PathLike, *, per_class: int = _D.per_class, seed: int = _D.seed,
           repetitions: int | None = _D.repetitions, tensors: bool = _D.tensors,
-          force: bool = _D.force, command: str = "") -> AnnotationModel:
+          feature_set: str | None = _D.feature_set, force: bool = _D.force, command: str = "") -> AnnotationModel:
     """Learn templates (and tensors) from ``data``'s train split and write the folder ``out`` (the keyword
-    defaults are :class:`~stylemotion.annotate.settings.AnnotateSettings`'s)."""
+    defaults are :class:`~stylemotion.annotate.settings.AnnotateSettings`'s; ``feature_set`` None: ours)."""
     out = check_new_output(out, force)
+    try:
+        feature_set = checked_feature_set(feature_set or DEFAULT_FEATURE_SET)
+    except FeatureSetError as exc:
+        raise AnnotateInputError(str(exc)) from None
     per_class = positive_int(per_class, "per_class")
     if repetitions is not None:
         repetitions = positive_int(repetitions, "repetitions")
@@ -75,14 +84,15 @@ def learn(data: Mapping[str, Any], out: str | os.PathLike, *, per_class: int = _
                           float(split.get("test_fraction", 0.1)))["train"]
     started = time.perf_counter()
     try:
-        model = learn_model(train, takeset.fps, per_class, seed, repetitions, tensors)
+        model = learn_model(train, takeset.fps, per_class, seed, repetitions, tensors, feature_set)
     except TemplateInputError as exc:
         raise AnnotateInputError(f"data={data.get('name')}: {exc}") from None
     extra = {"data": {k: v for k, v in data.items() if k in ("name", "root", "contents", "styles", "split")},
              "learn_s": round(time.perf_counter() - started, 3), "provenance": provenance(command or None)}
     with atomic_folder(out, on_exists=lambda: check_new_output(out, force)) as tmp:
         save_model(model, tmp, extra)
-    log.info(f"{len(model.templates)} templates ({', '.join(model.classes)}) and {len(model.tensors)} tensors from "
+    log.info(f"{len(model.templates)} templates ({', '.join(model.classes)}; feature set {feature_set}) and "
+             f"{len(model.tensors)} tensors from "
              f"{takeset.name}'s train takes written to {out}")
     for label, reason in model.record["tensors_skipped"].items():
         log.info(f"no tensor for {label}: {reason}")
@@ -112,7 +122,8 @@ def annotate_positions(positions: np.ndarray, model: AnnotationModel,
     from stylemotion.annotate.turning import refine_annotation
 
     settings = settings or AnnotationSettings()
-    distances = class_distances(relational_features(positions, model.fps), model.templates, settings)
+    distances = class_distances(compute_features(positions, model.fps, model.feature_set), model.templates,
+                                settings)
     annotation = annotate_distances(distances, settings.tau, settings.keyframes, settings.min_run)
     annotation = refine_annotation(annotation, distances, positions, model.fps, model.templates,
                                    model.record.get("turning"), settings.tau, settings.turning_z,
@@ -133,8 +144,9 @@ def annotate_positions(positions: np.ndarray, model: AnnotationModel,
 
 def annotate(document: str, templates: str | os.PathLike, out: str | os.PathLike, *,
              settings: AnnotationSettings | None = None, conversion: Mapping[str, Any] | None = None,
-             force: bool = _D.force, command: str = "") -> dict[str, Any]:
-    """Annotate ``document`` with the model in ``templates`` and write the folder ``out`` (module docstring)."""
+             feature_set: str | None = _D.feature_set, force: bool = _D.force, command: str = "") -> dict[str, Any]:
+    """Annotate ``document`` with the model in ``templates`` and write the folder ``out`` (module docstring).
+    ``feature_set``: None, or the set the folder must have been learned with (another is refused)."""
     started = time.perf_counter()
     settings = settings or AnnotationSettings()
     out = check_new_output(out, force)
@@ -150,7 +162,10 @@ def annotate(document: str, templates: str | os.PathLike, out: str | os.PathLike
                                  "features a matching frame may contradict)")
     try:
         model = load_model(templates)
-    except ModelFolderError as exc:
+        if feature_set is not None and checked_feature_set(feature_set) != model.feature_set:
+            raise AnnotateInputError(f"feature_set={feature_set}: templates={templates} were learned with feature set "
+                                     f"{model.feature_set!r}; drop the key or learn templates with {feature_set!r}")
+    except (ModelFolderError, FeatureSetError) as exc:
         raise AnnotateInputError(str(exc)) from None
     positions, record = load_document(document, model.fps, conversion)
     shortest = min(model.templates, key=lambda t: t.num_frames)
@@ -163,7 +178,7 @@ def annotate(document: str, templates: str | os.PathLike, out: str | os.PathLike
     except AnnotationInputError as exc:
         raise AnnotateInputError(f"document={document}: {exc}") from None
     report = {"document": {"value": str(document), **record}, "templates": str(templates),
-              "classes": list(model.classes), "tensors": sorted(model.tensors),
+              "classes": list(model.classes), "feature_set": model.feature_set, "tensors": sorted(model.tensors),
               "settings": {"tau": settings.tau, "keyframes": settings.keyframes,
                            "keyframe_count": settings.keyframe_count,
                            "keyframe_tolerance": settings.keyframe_tolerance, "min_run": settings.min_run,
@@ -193,7 +208,7 @@ def annotate_from_config(cfg: DictConfig, command: str = "") -> Any:
     data, s = settings_from_config(cfg, AnnotateSettings, "annotate")
     if not s.document:
         return learn(data, s.out, per_class=s.per_class, seed=s.seed, repetitions=s.repetitions, tensors=s.tensors,
-                     force=s.force, command=command)
+                     feature_set=s.feature_set, force=s.force, command=command)
     if not s.templates:
         raise AnnotateInputError("document= needs templates=<folder> (learn one with stylemotion-annotate "
                                  "data=<dataset> out=<folder>)")
@@ -203,4 +218,4 @@ def annotate_from_config(cfg: DictConfig, command: str = "") -> Any:
                                   sub_frames=s.sub_frames, turning_z=s.turning_z,
                                   turning_window_s=s.turning_window_s)
     return annotate(str(s.document), s.templates, s.out, settings=settings, conversion=conversion_keys(vars(s)),
-                    force=s.force, command=command)
+                    feature_set=s.feature_set, force=s.force, command=command)

@@ -58,18 +58,36 @@ def body_units(positions: np.ndarray) -> tuple[float, float]:
     return float(np.median(upper)), float(np.median(shoulders))
 
 
-def _angle(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray:
+def joint_angle(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray:
     """Angle at ``b`` between ``a − b`` and ``c − b`` in degrees, ``(frames,)``."""
     u, v = a - b, c - b
     cos = (u * v).sum(-1) / np.maximum(np.linalg.norm(u, axis=-1) * np.linalg.norm(v, axis=-1), 1e-9)
     return np.degrees(np.arccos(np.clip(cos, -1.0, 1.0)))
 
 
-def _rate(x: np.ndarray, fps: float) -> np.ndarray:
+def time_rate(x: np.ndarray, fps: float) -> np.ndarray:
     """Central-difference time derivative along axis 0 (per second); one frame gives zeros."""
     if x.shape[0] < 2:
         return np.zeros_like(x)
     return np.gradient(x, axis=0) * fps
+
+
+def checked_motion(positions: np.ndarray, fps: float) -> tuple[np.ndarray, float, float]:
+    """``(positions as float64, h, w)`` of a motion every feature set can be computed on.
+
+    Raises:
+        FeatureInputError: a wrong shape, non-finite positions, ``fps`` ≤ 0 or a zero-size body.
+    """
+    try:
+        p = checked_positions(positions)
+    except ValueError as exc:
+        raise FeatureInputError(str(exc)) from None
+    if not fps > 0:
+        raise FeatureInputError(f"fps={fps} must be positive")
+    h, w = body_units(p)
+    if not (h > 1e-4 and w > 1e-4):
+        raise FeatureInputError(f"degenerate body: humerus {h:.3g} m, shoulder width {w:.3g} m")
+    return p, h, w
 
 
 def relational_features(positions: np.ndarray, fps: float) -> np.ndarray:
@@ -85,15 +103,7 @@ def relational_features(positions: np.ndarray, fps: float) -> np.ndarray:
     Raises:
         FeatureInputError: a wrong shape, non-finite positions or a zero-size body (naming the value).
     """
-    try:
-        p = checked_positions(positions)
-    except ValueError as exc:
-        raise FeatureInputError(str(exc)) from None
-    if not fps > 0:
-        raise FeatureInputError(f"fps={fps} must be positive")
-    h, w = body_units(p)
-    if not (h > 1e-4 and w > 1e-4):
-        raise FeatureInputError(f"degenerate body: humerus {h:.3g} m, shoulder width {w:.3g} m")
+    p, h, w = checked_motion(positions, fps)
     yaw = facing_yaw(p, fps)
     fwd, left = facing_direction(yaw), left_direction(yaw)          # (frames, 2) as (x, z)
 
@@ -110,7 +120,7 @@ def relational_features(positions: np.ndarray, fps: float) -> np.ndarray:
         ofoot = p[:, J[f"Foot_{other}"]]
         ahead = ground(hand - chest, fwd)
         outward = ground(hand - shoulder, left) * (1.0 if side == "L" else -1.0)
-        v = _rate(hand - hips, fps)                                   # hand velocity relative to the root
+        v = time_rate(hand - hips, fps)                                   # hand velocity relative to the root
         hand_vel[s] = v
         cols[f"{s}hand_in_front"] = ahead > 0.5 * h
         cols[f"{s}hand_behind"] = ahead < -0.3 * h
@@ -118,31 +128,31 @@ def relational_features(positions: np.ndarray, fps: float) -> np.ndarray:
         cols[f"{s}hand_above_head"] = hand[:, 1] > head[:, 1] + 0.2 * h
         cols[f"{s}hand_sideways"] = outward > 0.8 * h
         cols[f"{s}hand_low"] = hand[:, 1] < hips[:, 1]
-        cols[f"{s}elbow_bent"] = _angle(shoulder, elbow, hand) < 110.0
-        cols[f"{s}arm_stretched"] = _angle(shoulder, elbow, hand) > 160.0
+        cols[f"{s}elbow_bent"] = joint_angle(shoulder, elbow, hand) < 110.0
+        cols[f"{s}arm_stretched"] = joint_angle(shoulder, elbow, hand) > 160.0
         cols[f"{s}hand_fast"] = np.linalg.norm(v, axis=-1) > 2.0 * h
         cols[f"{s}hand_moving_up"] = v[:, 1] > 1.5 * h
         cols[f"{s}hand_moving_down"] = v[:, 1] < -1.5 * h
         cols[f"{s}hand_moving_sideways"] = np.abs(ground(v, left)) > 1.5 * h
         cols[f"{s}foot_in_front"] = ground(foot - ofoot, fwd) > 0.5 * h
         cols[f"{s}foot_raised"] = foot[:, 1] - ofoot[:, 1] > 0.2 * h
-        cols[f"{s}foot_fast"] = np.linalg.norm(_rate(foot, fps), axis=-1) > 3.0 * h
-        cols[f"{s}knee_bent"] = _angle(hip, knee, foot) < 150.0
+        cols[f"{s}foot_fast"] = np.linalg.norm(time_rate(foot, fps), axis=-1) > 3.0 * h
+        cols[f"{s}knee_bent"] = joint_angle(hip, knee, foot) < 150.0
         cols[f"{s}foot_sideways"] = np.abs(ground(foot - hips, left)) > 0.9 * w
         cols[f"{s}hand_near_head"] = np.linalg.norm(hand - head, axis=-1) < 0.8 * h
     hands = np.linalg.norm(p[:, J["Hand_L"]] - p[:, J["Hand_R"]], axis=-1)
     cols["hands_apart"] = hands > 2.0 * w
     cols["hands_close"] = hands < 0.6 * h
-    root_speed = np.linalg.norm(_rate(hips[:, [0, 2]], fps), axis=-1)
+    root_speed = np.linalg.norm(time_rate(hips[:, [0, 2]], fps), axis=-1)
     cols["root_fast"] = root_speed > 2.5 * h
     cols["root_very_fast"] = root_speed > 7.0 * h
-    yaw_rate = _unwrapped_rate(facing_yaw(p, fps, smooth_seconds=TURN_SMOOTH_S), fps)
+    yaw_rate = unwrapped_rate(facing_yaw(p, fps, smooth_seconds=TURN_SMOOTH_S), fps)
     cols["root_turning_left"] = yaw_rate > TURN_RATE
     cols["root_turning_right"] = yaw_rate < -TURN_RATE
     return np.stack([cols[name] for name in FEATURE_NAMES], axis=1)
 
 
-def _unwrapped_rate(yaw: np.ndarray, fps: float) -> np.ndarray:
+def unwrapped_rate(yaw: np.ndarray, fps: float) -> np.ndarray:
     """Yaw rate in rad/s (positive: turning towards the body's left), robust to the ±π wrap."""
-    return _rate(np.unwrap(wrap_angle(yaw)), fps)
+    return time_rate(np.unwrap(wrap_angle(yaw)), fps)
 

@@ -1,9 +1,10 @@
 """Learning an annotation model from a labelled dataset, and its folder on disk.
 
 A model is the class motion templates (one per content label) plus, where a class has at least two styles of
-two or more train takes, its class motion tensor. The folder holds ``model.json`` (classes, feature names,
-fps, settings, the takes used, provenance), ``templates.npz`` (``<class>``: ``(frames, features)`` values) and
-``tensors.npz`` (``<class>/core``, ``<class>/U1..U4``, ``<class>/reference``; styles in ``model.json``).
+two or more train takes, its class motion tensor. The folder holds ``model.json`` (classes, the feature set and
+its feature names, fps, settings, the takes used, provenance), ``templates.npz`` (``<class>``: ``(frames,
+features)`` values) and ``tensors.npz`` (``<class>/core``, ``<class>/U1..U4``, ``<class>/reference``; styles in
+``model.json``).
 """
 
 from __future__ import annotations
@@ -16,7 +17,14 @@ from typing import Any
 
 import numpy as np
 
-from stylemotion.annotate.features import FEATURE_NAMES, relational_features
+from stylemotion.annotate.feature_sets import (
+    DEFAULT_FEATURE_SET,
+    FeatureSetError,
+    checked_feature_set,
+    compute_features,
+    feature_names,
+    same_feature_set,
+)
 from stylemotion.annotate.templates import DELTA, MotionTemplate, TemplateInputError, learn_template
 from stylemotion.annotate.tensors import MotionTensor, TensorInputError, build_tensor
 from stylemotion.annotate.turning import speed_statistics, turning_statistics
@@ -46,6 +54,11 @@ class AnnotationModel:
     @property
     def classes(self) -> tuple[str, ...]:
         return tuple(t.label for t in self.templates)
+
+    @property
+    def feature_set(self) -> str:
+        """The one relational feature set of the templates (:class:`FeatureSetError` if they mix sets)."""
+        return same_feature_set((t.feature_set for t in self.templates), "the model's templates")
 
 
 def choose_examples(takes: Sequence[Take], per_class: int, seed: int) -> dict[str, list[Take]]:
@@ -79,19 +92,22 @@ def tensor_examples(takes: Sequence[Take], content: str, repetitions: int | None
 
 
 def learn_model(train: Sequence[Take], fps: float, per_class: int = 9, seed: int = 0,
-                tensor_repetitions: int | None = None, tensors: bool = True) -> AnnotationModel:
-    """Templates from ``per_class`` train takes of each content; tensors from the train takes of a content
+                tensor_repetitions: int | None = None, tensors: bool = True,
+                feature_set: str = DEFAULT_FEATURE_SET) -> AnnotationModel:
+    """Templates (of relational features in ``feature_set``, :mod:`.feature_sets`) from ``per_class`` train takes
+    of each content; tensors from the train takes of a content
     (``tensor_repetitions`` per style, None: as many as every style has, drawn with ``seed``:
     :func:`tensor_examples`; a class with under two styles of two takes gets no tensor).
 
     Raises:
         TemplateInputError: a content with fewer than two train takes (naming it and the count).
     """
+    feature_set = checked_feature_set(feature_set)
     examples = choose_examples(train, per_class, seed)
     if not examples:
         raise TemplateInputError("no train takes to learn templates from")
-    templates = [learn_template(c, [relational_features(t.positions, fps) for t in takes])
-                 for c, takes in examples.items()]
+    templates = [learn_template(c, [compute_features(t.positions, fps, feature_set) for t in takes],
+                                feature_set=feature_set) for c, takes in examples.items()]
     learned: dict[str, MotionTensor] = {}
     skipped: dict[str, str] = {}
     if tensors:
@@ -124,8 +140,10 @@ def save_model(model: AnnotationModel, folder: Path, extra: dict[str, Any] | Non
         tensors[f"{label}/reference"] = tensor.reference
         for n, f in enumerate(tensor.factors, 1):
             tensors[f"{label}/U{n}"] = f
+    feature_set = model.feature_set
     meta = {
-        "format": MODEL_FORMAT, "fps": model.fps, "features": list(FEATURE_NAMES), "delta": DELTA,
+        "format": MODEL_FORMAT, "fps": model.fps, "feature_set": feature_set,
+        "features": list(feature_names(feature_set)), "delta": DELTA,
         "classes": [{"label": t.label, "frames": t.num_frames, "examples": t.examples} for t in model.templates],
         "tensors": {label: {"styles": list(t.styles), "repetitions": t.repetitions, "ranks": list(t.ranks),
                             "frames": t.frames} for label, t in model.tensors.items()},
@@ -151,15 +169,24 @@ def load_model(folder: str | Path) -> AnnotationModel:
                      f"data=<dataset> out={folder})")
     if not isinstance(meta, dict):
         raise ModelFolderError(f"{meta_path}: holds a {type(meta).__name__}, not an object; learn the model again")
-    if meta.get("format") != MODEL_FORMAT or meta.get("features") != list(FEATURE_NAMES):
+    try:   # folders from before feature sets hold ours
+        feature_set = checked_feature_set(meta.get("feature_set", DEFAULT_FEATURE_SET), f"{meta_path}: feature_set")
+    except FeatureSetError as exc:
+        raise ModelFolderError(str(exc)) from None
+    names = list(feature_names(feature_set))
+    if meta.get("format") != MODEL_FORMAT or meta.get("features") != names:
         raise ModelFolderError(f"{meta_path}: format {meta.get('format')!r} with {len(meta.get('features') or [])} "
-                               f"features; this version reads format {MODEL_FORMAT} with {len(FEATURE_NAMES)}")
+                               f"features; this version reads format {MODEL_FORMAT} with the {len(names)} of "
+                               f"feature set {feature_set!r}")
     arrays = load_npz(folder / "templates.npz", "annotation templates")  # NpzFileError: names the file
     npz = load_npz(folder / "tensors.npz", "annotation tensors")
     try:
         fps = float(meta["fps"])
         templates = [MotionTemplate(c["label"], np.array(arrays[c["label"]]), int(c["examples"]),
-                                    float(meta["delta"])) for c in meta["classes"]]
+                                    float(meta["delta"]), feature_set) for c in meta["classes"]]
+        wrong = [t.label for t in templates if t.values.ndim != 2 or t.values.shape[1] != len(names)]
+        if wrong:
+            raise ValueError(f"templates {wrong} do not have the {len(names)} columns of feature set {feature_set!r}")
         tensors = {}
         for label, info in meta.get("tensors", {}).items():
             tensors[label] = MotionTensor(label, tuple(info["styles"]), int(info["repetitions"]),

@@ -53,6 +53,11 @@ class AnnotateSettings(MotionFileKeys):
     ``walk-turn-left`` becomes ``walk``); 0 = off; ``turning_window_s``: the layer decides runs in pieces of about
     this many seconds (0: whole runs).
 
+    ``feature_set``: the relational features of the templates (:mod:`stylemotion.annotate.feature_sets`):
+    ``ours`` (42 features, :mod:`~stylemotion.annotate.features`) or ``mueller_roeder`` (Müller & Röder's 39 with
+    hysteresis, and Krüger's root angular velocity); None = ``ours`` when learning and the templates folder's set
+    when annotating (naming another set than the folder's is refused). benchmarks/annotate.md compares the two.
+
     ``joint_map``, ``unit_scale``, ``up_axis``: the document's (:class:`~stylemotion.config.MotionFileKeys`).
     ``out``: a new folder (an existing one is refused unless ``force``).
     """
@@ -69,5 +74,6 @@ class AnnotateSettings(MotionFileKeys):
     sub_frames: int = 0
     turning_z: float = 1.0
     turning_window_s: float = 4.0
+    feature_set: str | None = None
     out: str = "runs/annotate/${now:%Y-%m-%d_%H-%M-%S}"
     force: bool = False

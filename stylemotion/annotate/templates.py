@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 from dtaidistance import dtw_ndim
 
+from stylemotion.annotate.feature_sets import DEFAULT_FEATURE_SET
 from stylemotion.io.errors import UserInputError
 from stylemotion.morphable.warping import resample
 
@@ -37,12 +38,14 @@ class MotionTemplate:
         values: ``(frames, features)`` float in ``[0, 1]``.
         examples: number of training motions averaged.
         delta: quantization threshold.
+        feature_set: the relational feature set of the columns (:mod:`.feature_sets`).
     """
 
     label: str
     values: np.ndarray
     examples: int
     delta: float = DELTA
+    feature_set: str = DEFAULT_FEATURE_SET
 
     @property
     def num_frames(self) -> int:
@@ -80,12 +83,13 @@ def warp_to(reference: np.ndarray, example: np.ndarray) -> np.ndarray:
 
 
 def learn_template(label: str, examples: Sequence[np.ndarray], iterations: int = 4,
-                   delta: float = DELTA) -> MotionTemplate:
+                   delta: float = DELTA, feature_set: str = DEFAULT_FEATURE_SET) -> MotionTemplate:
     """Learn the template of class ``label`` from its examples' feature matrices.
 
     Args:
         examples: ``γ ≥ 2`` arrays ``(frames_k, features)`` (bool or float in ``[0, 1]``).
         iterations: warping-and-averaging rounds.
+        feature_set: the set the examples' features come from (recorded in the template).
 
     Raises:
         TemplateInputError: fewer than two examples, or examples of different feature counts.
@@ -103,7 +107,7 @@ def learn_template(label: str, examples: Sequence[np.ndarray], iterations: int =
     template = resample_length(xs[start], length)
     for _ in range(iterations):
         template = np.mean([warp_to(template, x) for x in xs], axis=0)
-    return MotionTemplate(label, np.clip(template, 0.0, 1.0), len(xs), delta)
+    return MotionTemplate(label, np.clip(template, 0.0, 1.0), len(xs), delta, feature_set)
 
 
 def sub_templates(template: MotionTemplate, frames: int) -> list[MotionTemplate]:
@@ -116,8 +120,8 @@ def sub_templates(template: MotionTemplate, frames: int) -> list[MotionTemplate]
     starts = list(range(0, n - frames + 1, max(frames // 2, 1)))
     if starts[-1] != n - frames:
         starts.append(n - frames)
-    return [MotionTemplate(template.label, template.values[a:a + frames], template.examples, template.delta)
-            for a in starts]
+    return [MotionTemplate(template.label, template.values[a:a + frames], template.examples, template.delta,
+                           template.feature_set) for a in starts]
 
 
 def local_cost(template: MotionTemplate, document: np.ndarray) -> np.ndarray:
