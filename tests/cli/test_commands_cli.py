@@ -29,7 +29,7 @@ COMMANDS = {  # module → (console script, a phrase of its description, a key o
     "style": ("stylemotion-style", "add a new style to a finished stylemotion-reproduce run", "example=<BVH>"),
     "search": ("stylemotion-search", "find the segments of a motion database most similar", "query=<BVH>"),
     "reconstruct": ("stylemotion-reconstruct", "reconstruct full 21-joint poses from a few marker tracks",
-                    "markers=<BVH[:start-end]|NPZ|CSV|take>"),
+                    "markers=<BVH[:start-end]|NPZ|CSV|C3D|take>"),
     "texture": ("stylemotion-texture", "complete or texture a motion with a motion database",
                 "motion=<BVH[:start-end]|NPZ|take>"),
     "keyframes": ("stylemotion-keyframes", "a motion through a few keyframes", "keys=<keys.json>"),
