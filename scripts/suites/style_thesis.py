@@ -62,7 +62,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--styles", type=int, default=2, help="CVAE styles, a seeded choice (default_rng(0))")
     parser.add_argument("--arms", nargs="+", choices=sorted(ARMS), default=[a for a in ARMS if a != "thesis_our_lr"],
                         help="arms (default: all but thesis_our_lr)")
-    parser.add_argument("--epochs", type=int, default=30,
+    parser.add_argument("--epochs", type=int, default=15,
                         help="epochs of every CVAE (the reproduction's budget: 60; the thesis: 1000)")
     parser.add_argument("--vae-epochs", type=int, default=30,
                         help="epochs of the neutral VAE (the reproduction's: 100)")
