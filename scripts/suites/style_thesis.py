@@ -60,8 +60,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="folder of the trainings (reused when the suite runs again)")
     parser.add_argument("--primitive", default="walk_leftStance", help="the stance primitive")
     parser.add_argument("--styles", type=int, default=2, help="CVAE styles, a seeded choice (default_rng(0))")
-    parser.add_argument("--arms", nargs="+", choices=sorted(ARMS), default=[a for a in ARMS if a != "thesis_our_lr"],
-                        help="arms (default: all but thesis_our_lr)")
+    parser.add_argument("--arms", nargs="+", choices=sorted(ARMS), default=list(ARMS),
+                        help="arms (default: all)")
     parser.add_argument("--epochs", type=int, default=15,
                         help="epochs of every CVAE (the reproduction's budget: 60; the thesis: 1000)")
     parser.add_argument("--vae-epochs", type=int, default=30,
@@ -176,7 +176,7 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
                 str(folder))
             for arm in args.arms:
                 for s in styles:
-                    folder = base / arm / f"seed{seed}" / s
+                    folder = base / f"cvae_e{args.epochs}" / arm / f"seed{seed}" / s
                     train_cfg = stage_train_config(arm_overrides(cvae_stage, arm, args.epochs),
                                                    {"primitive": args.primitive, "style": s}, data_cfg, folder, seed,
                                                    1, ae_ckpt)
