@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import re
 from pathlib import Path
 from typing import Any
 
@@ -287,7 +288,10 @@ def render(record: dict[str, Any]) -> dict[str, str]:
     prov = provenance_line(record)
     seeds = len(record.get("seeds", []))
     s = r["summary"]
-    narrowed = "**Narrowed to fit the machine** (not the thesis' setup): " + "; ".join(r["narrowed"]) + "."
+    items = r["narrowed"]
+    if not {"lr1e-5", "thesis"} & set(r["arms"]):  # results recorded before the list named only the arms run
+        items = [re.sub(r", the thesis preset's 1000 too \(lr 1e-5 arms .*?epochs\)", "", n) for n in items]
+    narrowed = "**Narrowed to fit the machine** (not the thesis' setup): " + "; ".join(items) + "."
     rows = []
     for arm, entry in s.items():
         what = "neutral VAE (the reproduction's stage)" if arm == "neutral" else r["arms"][arm]["what"]
