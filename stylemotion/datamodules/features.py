@@ -17,7 +17,8 @@ Items are dicts:
 
 The feature normalization statistics (each channel's mean over the train split's clips and time
 steps, and one common scale for all channels — or per-channel scales with ``feature_scale:
-channel``) and the log-duration statistics are computed here and copied into the model's buffers,
+channel``; none with ``feature_scale: none``, the thesis' raw features, preset ``experiment=style_cvae_thesis``)
+and the log-duration statistics are computed here and copied into the model's buffers,
 so they travel in the model's checkpoint. The common scale keeps the channels' relative sizes, as
 the thesis' unnormalized features do: per-channel z-scores make a channel that neutral walking
 barely uses, but a style does, very expensive to change, so the style term can hardly move it.
@@ -65,7 +66,7 @@ log = logging.getLogger(__name__)
 
 SPLITS = ("train", "val", "test")
 EXAMPLE_LENGTHS = ("canonical", "natural")
-FEATURE_SCALES = ("global", "channel")
+FEATURE_SCALES = ("global", "channel", "none")
 #: Default minimum of training clips of a primitive: fewer and a 2,000-dimensional VAE just
 #: memorizes them (the thesis trains on hundreds of neutral clips per primitive).
 MIN_TRAIN_CLIPS = 32
@@ -204,7 +205,8 @@ class FeatureDataModule(SplitDataModule):
         min_train_clips: fewest training clips accepted (validation needs at least one clip).
         feature_scale: ``global`` (every channel centred on its mean and divided by one common
             scale, the root mean channel variance: the features keep their relative sizes, as the
-            thesis' unnormalized features) or ``channel`` (z-scores per channel; see the module doc).
+            thesis' unnormalized features), ``channel`` (z-scores per channel; see the module doc) or ``none``
+            (mean 0, scale 1: the raw features, as the thesis' VAE models ``Y = Φ(X)``).
         std_floor: smallest feature scale.
         split: split settings; None = ``data.split``.
     """
@@ -330,11 +332,14 @@ class FeatureDataModule(SplitDataModule):
             self.datasets[part] = FeatureDataset(clips[part], encode_frames(ae, source.frames), channels, steps)
         train = self.datasets["train"]
         flat = train.features.transpose(1, 2).reshape(-1, channels).double()
-        self.feature_mean = flat.mean(0).float()
-        std = flat.std(0, unbiased=False)
-        if self.feature_scale == "global":  # one scale for every channel: the root mean variance
-            std = torch.full_like(std, float(std.square().mean().sqrt()))
-        self.feature_std = std.clamp_min(self.std_floor).float()
+        if self.feature_scale == "none":  # the raw features: no centre, no scale
+            self.feature_mean, self.feature_std = torch.zeros(channels), torch.ones(channels)
+        else:
+            self.feature_mean = flat.mean(0).float()
+            std = flat.std(0, unbiased=False)
+            if self.feature_scale == "global":  # one scale for every channel: the root mean variance
+                std = torch.full_like(std, float(std.square().mean().sqrt()))
+            self.feature_std = std.clamp_min(self.std_floor).float()
         logs = train.duration_s.double().log()
         self.duration_stats = torch.tensor([logs.mean(), logs.std(unbiased=False).clamp_min(1e-3),
                                             train.duration_s.min(), train.duration_s.max()], dtype=torch.float32)

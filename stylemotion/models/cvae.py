@@ -31,6 +31,14 @@ recognizable — is not pinned to the example's. On Bandai neither keeps both th
 variation: the margin keeps the style only where it is as strong as the default, the centred term
 keeps the variation and loses the style.
 
+Options for the strict replication arm (preset ``experiment=style_cvae_thesis``, suite ``style_thesis``; defaults
+leave the model as above): ``gram_normalization=sum`` takes eq. 5.9 as written (``Σ_t y_t y_tᵀ``, ``T`` times ours,
+so the same α pulls ``T`` times harder); ``style_channels=pose`` compares Gram matrices of pose-only features
+(:func:`pose_features`: the features decoded by the frozen autoencoder, root ground velocity and yaw rate set to
+their data mean, encoded again), which frees speed and turning from the example; it costs a decode and an encode
+per style decode, so ``style_subset`` = k > 0 takes the style term's mean over a random k of the decodes of each
+step (an unbiased estimate of the same mean; 0 = all).
+
 One model per (primitive, style). The style, the example clip(s) (take, frame range, primitive,
 duration) and how they were encoded are recorded in ``hparams.spec``; the target Gram matrix is a
 buffer, so the checkpoint is self-contained.
@@ -43,13 +51,16 @@ from typing import Any
 import torch
 
 from stylemotion.models.autoencoder import IncompatibleModelError
-from stylemotion.models.style import feature_style_distance, gram_factor, mean_gram
+from stylemotion.models.style import GRAM_NORMALIZATIONS, feature_style_distance, gram_factor, mean_gram
 from stylemotion.models.vae import PrimitiveVAE
+from stylemotion.representation import VELOCITY_DIMS, YAW_RATE_DIM
 
 #: Which latent codes the style term decodes (see :class:`StyleCVAE`).
 STYLE_LATENTS = ("posterior", "prior", "both")
 #: How the style distance enters the loss (see :class:`StyleCVAE`).
 STYLE_TERMS = ("distance", "margin")
+#: Which motion channels the style term's Gram sees (see :class:`StyleCVAE`).
+STYLE_CHANNELS = ("all", "pose")
 
 
 class StyleCVAE(PrimitiveVAE):
@@ -59,11 +70,16 @@ class StyleCVAE(PrimitiveVAE):
     Args:
         style_weight: α (5; the thesis uses 200, see the module doc).
         style_latents: ``posterior``, ``prior`` or ``both`` (see the module doc).
+        style_term, style_margin, style_centred: see the module doc.
+        gram_normalization: ``mean`` (÷ T) or ``sum`` (eq. 5.9 as written).
+        style_channels: ``all`` or ``pose`` (root velocity and yaw rate left out, :func:`pose_features`).
+        style_subset: the style term's mean over a random this many decodes per step (0 = all).
         **kwargs: :class:`PrimitiveVAE` arguments.
     """
 
     def __init__(self, style_weight: float = 5.0, style_latents: str = "both", style_term: str = "distance",
-                 style_margin: float = 1.0, style_centred: bool = False, **kwargs: Any):
+                 style_margin: float = 1.0, style_centred: bool = False, gram_normalization: str = "mean",
+                 style_channels: str = "all", style_subset: int = 0, **kwargs: Any):
         super().__init__(**kwargs)
         if not style_weight >= 0:
             raise ValueError(f"style_weight must be ≥ 0, got {style_weight}")
@@ -73,9 +89,17 @@ class StyleCVAE(PrimitiveVAE):
             raise ValueError(f"style_term must be one of {STYLE_TERMS}, got {style_term!r}")
         if not style_margin > 0:
             raise ValueError(f"style_margin must be > 0, got {style_margin}")
+        if gram_normalization not in GRAM_NORMALIZATIONS:
+            raise ValueError(f"gram_normalization must be one of {GRAM_NORMALIZATIONS}, got {gram_normalization!r}")
+        if style_channels not in STYLE_CHANNELS:
+            raise ValueError(f"style_channels must be one of {STYLE_CHANNELS}, got {style_channels!r}")
+        if isinstance(style_subset, bool) or int(style_subset) != style_subset or style_subset < 0:
+            raise ValueError(f"style_subset must be an integer ≥ 0 (0 = every decode), got {style_subset!r}")
         self.save_hyperparameters({**dict(self.hparams), "style_weight": float(style_weight),
                                    "style_latents": str(style_latents), "style_term": str(style_term),
-                                   "style_margin": float(style_margin), "style_centred": bool(style_centred)})
+                                   "style_margin": float(style_margin), "style_centred": bool(style_centred),
+                                   "gram_normalization": str(gram_normalization),
+                                   "style_channels": str(style_channels), "style_subset": int(style_subset)})
 
     def _build(self, spec: dict[str, Any]) -> None:
         super()._build(spec)
@@ -100,12 +124,35 @@ class StyleCVAE(PrimitiveVAE):
         super()._install_stats(datamodule)
         if not datamodule.style_features:
             raise ValueError(f"the datamodule has no style example for style {datamodule.style!r}")
-        self.style_gram.copy_(mean_gram([self._style_features(f) for f in datamodule.style_features]))
-        self.content_spread.fill_(content_spread(self._style_features(datamodule.datasets["train"].features)))
+        if self.style_channels == "pose":  # the pose-only features need the autoencoder now
+            self.attach_autoencoder(datamodule.autoencoder)
+        with torch.no_grad():
+            self.style_gram.copy_(mean_gram([self._style_features(f) for f in datamodule.style_features],
+                                            self.gram_normalization))
+            self.content_spread.fill_(content_spread(self._style_features(datamodule.datasets["train"].features),
+                                                     self.gram_normalization))
+
+    @property
+    def gram_normalization(self) -> str:
+        return str(self.hparams.get("gram_normalization", "mean"))
+
+    @property
+    def style_channels(self) -> str:
+        return str(self.hparams.get("style_channels", "all"))
+
+    @property
+    def plain_gram(self) -> bool:
+        """Whether :attr:`style_gram` is the plain Gram of eq. 5.12 (÷ T, every channel, not centred), the one
+        Table 5.1 recomputes from the example."""
+        return (not self.hparams.get("style_centred", False) and self.gram_normalization == "mean"
+                and self.style_channels == "all")
 
     def _style_features(self, features: torch.Tensor) -> torch.Tensor:
-        """The features ``(..., C, T')`` the style term's Gram is taken of: as they are (the thesis), or
-        centred over time (``style_centred``: a covariance, blind to each channel's mean over the clip)."""
+        """The features ``(..., C, T')`` the style term's Gram is taken of: as they are (the thesis), pose-only
+        (``style_channels=pose``, :func:`pose_features`), and/or centred over time (``style_centred``: a
+        covariance, blind to each channel's mean over the clip)."""
+        if self.style_channels == "pose":
+            features = pose_features(self.autoencoder, features)
         if self.hparams.get("style_centred", False):
             return features - features.mean(-1, keepdim=True)
         return features
@@ -136,7 +183,8 @@ class StyleCVAE(PrimitiveVAE):
         if getattr(self, "_factor_key", None) != version:  # the factor of the (fixed) target, cached
             object.__setattr__(self, "_factor", gram_factor(self.style_gram))
             object.__setattr__(self, "_factor_key", version)
-        return feature_style_distance(self._style_features(features), target_factor=self._factor)
+        return feature_style_distance(self._style_features(features), target_factor=self._factor,
+                                      normalization=self.gram_normalization)
 
     def _extra_losses(self, recon: torch.Tensor, generator: torch.Generator | None = None
                       ) -> dict[str, tuple[torch.Tensor, float]]:
@@ -147,7 +195,11 @@ class StyleCVAE(PrimitiveVAE):
             count = recon.shape[0] * recon.shape[1]
             z = torch.randn(count, self.hparams.latent_dim, generator=generator, device=recon.device, dtype=recon.dtype)
             outputs.append(self.net.decode(z))
-        features, _ = self.denormalize(torch.cat(outputs), clamp=False)
+        decoded = torch.cat(outputs)
+        subset = int(self.hparams.get("style_subset", 0))
+        if 0 < subset < decoded.shape[0]:  # a random subset of the decodes (module doc)
+            decoded = decoded[torch.randperm(decoded.shape[0], generator=generator, device=decoded.device)[:subset]]
+        features, _ = self.denormalize(decoded, clamp=False)
         distance = self.style_distance(features)
         if self.hparams.style_term == "margin":  # the distance is logged, the excess optimized
             return {"style": (distance.mean(), 0.0),
@@ -155,11 +207,24 @@ class StyleCVAE(PrimitiveVAE):
         return {"style": (distance.mean(), self.hparams.style_weight)}
 
 
-def content_spread(features: torch.Tensor) -> float:
+def content_spread(features: torch.Tensor, normalization: str = "mean") -> float:
     """Median Gram distance of feature sequences ``(n, C, T')`` to their mean Gram: how far the clips of
-    one style (the content data) typically sit from its centre, in Gram units."""
-    centre = mean_gram(list(features))
-    return float(feature_style_distance(features, centre).median())
+    one style (the content data) typically sit from its centre, in Gram units (``normalization``: see
+    :func:`stylemotion.models.style.gram`)."""
+    centre = mean_gram(list(features), normalization)
+    return float(feature_style_distance(features, centre, normalization=normalization).median())
+
+
+def pose_features(autoencoder, features: torch.Tensor) -> torch.Tensor:
+    """Pose-only features ``(..., C, T')`` of raw features ``(..., C, T')``: decoded by the autoencoder to its
+    z-scored frames, the root ground velocity and yaw rate set to 0 (their data mean), encoded again — as if the
+    encoder had no weights for those channels. Differentiable in ``features`` (the autoencoder stays frozen)."""
+    net = autoencoder.net
+    frames = net.decode_normalized(features)  # (..., 2T', 66) z-scores
+    keep = torch.ones(frames.shape[-1], dtype=frames.dtype, device=frames.device)
+    keep[VELOCITY_DIMS] = 0
+    keep[YAW_RATE_DIM] = 0
+    return net.encode_normalized(frames * keep)
 
 
 def margin_excess(distance: torch.Tensor, radius: float) -> torch.Tensor:

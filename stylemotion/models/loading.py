@@ -201,8 +201,8 @@ def load_model(path: str | Path, neutral_style: str = "normal", autoencoder=None
                      examples=[dict(e) for e in spec.get("style_examples") or []] if styled else [],
                      autoencoder=dict(spec["autoencoder"]), checkpoint=str(path),
                      timeline_frames=int(spec["timeline_frames"]),
-                     # a centred style term keeps a covariance, not the thesis' Gram that Table 5.1 recomputes
-                     target_gram=(model.style_gram.detach().clone()
-                                  if styled and not model.hparams.get("style_centred", False) else None),
+                     # a centred, summed or pose-only style term keeps another matrix than the Gram that Table 5.1
+                     # recomputes
+                     target_gram=(model.style_gram.detach().clone() if styled and model.plain_gram else None),
                      dataset=spec.get("dataset"), example_length=spec.get("example_length") or "canonical",
                      kind="cvae" if styled else "vae")

@@ -16,6 +16,10 @@ weight α for clips of one fixed length. Several examples are combined by averag
 matrices (:func:`mean_gram`), i.e. each example counts equally whatever its length.
 
 The style distance is the Frobenius norm ``‖G₁ − G₂‖_F`` (not squared), as in eq. 5.10.
+
+``normalization="sum"`` (the style CVAE's ``gram_normalization``, preset ``experiment=style_cvae_thesis``) takes
+eq. 5.9 as written, ``Σ_t y_t y_tᵀ``: ``T`` times the default; several examples still average their Gram matrices
+(§5.4.1: "averaged by the calculation of gram matrix").
 """
 
 from __future__ import annotations
@@ -24,36 +28,48 @@ from collections.abc import Sequence
 
 import torch
 
+#: How a Gram matrix is normalized over time: ``mean`` (÷ T, the default) or ``sum`` (eq. 5.9 as written).
+GRAM_NORMALIZATIONS = ("mean", "sum")
 
-def gram(features: torch.Tensor) -> torch.Tensor:
-    """Gram matrix over time, normalized by the number of time steps.
+
+def gram_divisor(steps: int, normalization: str = "mean") -> int:
+    """What a Gram matrix of ``steps`` time steps is divided by: ``steps`` (``mean``) or 1 (``sum``)."""
+    if normalization not in GRAM_NORMALIZATIONS:
+        raise ValueError(f"Gram normalization must be one of {GRAM_NORMALIZATIONS}, got {normalization!r}")
+    return int(steps) if normalization == "mean" else 1
+
+
+def gram(features: torch.Tensor, normalization: str = "mean") -> torch.Tensor:
+    """Gram matrix over time, normalized by the number of time steps (``normalization="sum"``: not normalized).
 
     Args:
         features: ``(..., channels, time)`` autoencoder features (any leading batch dims), time ≥ 1.
+        normalization: ``mean`` or ``sum`` (:data:`GRAM_NORMALIZATIONS`).
 
     Returns:
-        ``(..., channels, channels)``: ``features @ features.T / time``.
+        ``(..., channels, channels)``: ``features @ features.T / time`` (``sum``: ``features @ features.T``).
     """
     if features.dim() < 2:
         raise ValueError(f"features must be (..., channels, time), got shape {tuple(features.shape)}")
     steps = features.shape[-1]
     if steps < 1:
         raise ValueError("cannot take the Gram matrix of features with no time step")
-    return features @ features.transpose(-1, -2) / steps
+    return features @ features.transpose(-1, -2) / gram_divisor(steps, normalization)
 
 
-def mean_gram(examples: Sequence[torch.Tensor]) -> torch.Tensor:
+def mean_gram(examples: Sequence[torch.Tensor], normalization: str = "mean") -> torch.Tensor:
     """Average of the Gram matrices of several feature sequences of any lengths.
 
     Args:
         examples: feature tensors ``(channels, time_i)`` (or ``(1, channels, time_i)``).
+        normalization: of each Gram matrix (see :func:`gram`).
 
     Returns:
         ``(channels, channels)``.
     """
     if not examples:
         raise ValueError("mean_gram needs at least one feature sequence")
-    grams = [gram(e.reshape(e.shape[-2], e.shape[-1])) for e in examples]
+    grams = [gram(e.reshape(e.shape[-2], e.shape[-1]), normalization) for e in examples]
     shapes = {tuple(g.shape) for g in grams}
     if len(shapes) != 1:
         raise ValueError(f"feature sequences have different channel counts: {sorted(shapes)}")
@@ -82,7 +98,7 @@ def gram_factor(target_gram: torch.Tensor, rtol: float = 1e-7) -> torch.Tensor:
 
 
 def feature_style_distance(features: torch.Tensor, target_gram: torch.Tensor | None = None,
-                           target_factor: torch.Tensor | None = None) -> torch.Tensor:
+                           target_factor: torch.Tensor | None = None, normalization: str = "mean") -> torch.Tensor:
     """``style_distance(gram(features), target_gram)``: distance of feature sequences to a style.
 
     Computed without forming a ``channels × channels`` matrix per sequence (the training loss
@@ -101,6 +117,7 @@ def feature_style_distance(features: torch.Tensor, target_gram: torch.Tensor | N
             (e.g. cached by a model) instead. A factor with leading dims ``(..., channels, rank)`` gives one
             target per sequence (broadcast against the features' leading dims), e.g. the features of each
             sequence's own example scaled by ``1/sqrt(time)``.
+        normalization: of the features' Gram matrices (:func:`gram`; ``sum``: ``T`` reads 1 above).
 
     Returns:
         ``(...)``.
@@ -115,7 +132,7 @@ def feature_style_distance(features: torch.Tensor, target_gram: torch.Tensor | N
     dtype = features.dtype
     features = features.double()
     target_factor = target_factor.to(features)
-    steps = features.shape[-1]
+    steps = gram_divisor(features.shape[-1], normalization)
     ff = features.transpose(-1, -2) @ features  # (..., T, T)
     wf = target_factor.transpose(-1, -2) @ features  # (..., rank, T)
     ww = target_factor.transpose(-1, -2) @ target_factor

@@ -63,3 +63,21 @@ def test_bad_example_clips_are_refused(ae_ckpt, kwargs, message) -> None:
 def test_example_clips_at_another_frame_rate_are_refused(ae_ckpt) -> None:
     with pytest.raises(ValueError, match=r"is at 60 fps, the data at 30 fps"):
         feature_module(ae_ckpt, style="tired", example_clips=outside_clips(fps=60.0))
+
+
+def test_feature_scale_none_gives_the_models_the_raw_features(ae_ckpt) -> None:
+    """feature_scale=none (preset style_cvae_thesis): no centre and no scale, so the VAE models Y = Φ(X) itself."""
+    from stylemotion.models.vae import PrimitiveVAE
+
+    dm = feature_module(ae_ckpt, feature_scale="none")
+    assert torch.equal(dm.feature_mean, torch.zeros_like(dm.feature_mean))
+    assert torch.equal(dm.feature_std, torch.ones_like(dm.feature_std))
+    model = PrimitiveVAE(spec=dm.model_spec())
+    model._install_stats(dm)
+    train = dm.datasets["train"]
+    y = model.normalize(train.features[:3], train.duration_s[:3])
+    torch.testing.assert_close(y[:, :-1], train.features[:3].flatten(-2))
+    glob = feature_module(ae_ckpt)  # the default centres every channel
+    assert not torch.allclose(glob.feature_mean, torch.zeros_like(glob.feature_mean))
+    with pytest.raises(ValueError, match="feature_scale"):
+        feature_module(ae_ckpt, feature_scale="raw")

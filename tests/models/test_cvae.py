@@ -199,3 +199,83 @@ def test_the_gram_target_of_k_examples_is_the_mean_gram_of_all_their_clips(ae_ck
     first = [g for g, i in zip(grams, cut.origin[primitive]) if i == 1]
     np.testing.assert_allclose(mean_gram(single.style_features).double().numpy(), np.mean(first, axis=0),
                                rtol=1e-5, atol=1e-6 * np.abs(expected).max())
+
+
+def _gram_by_hand(features: np.ndarray, normalization: str) -> np.ndarray:
+    """Σ_t y_t y_tᵀ (÷ T for ``mean``) of ``(C, T)`` features, a loop over time in float64."""
+    out = sum(np.outer(features[:, t], features[:, t]) for t in range(features.shape[1]))
+    return out / features.shape[1] if normalization == "mean" else out
+
+
+def test_the_summed_gram_option_trains_on_eq_5_9_as_written(elderly) -> None:
+    """gram_normalization=sum (preset style_cvae_thesis): the target is the example's Σ_t y yᵀ and the term the
+    Frobenius distance of each decode's Σ_t y yᵀ to it, both against numpy by hand; Table 5.1's recomputed Gram is
+    not this matrix, so the evaluation is given none."""
+    model = StyleCVAE(spec=elderly.model_spec(), gram_normalization="sum")
+    model._install_stats(elderly)
+    [example] = elderly.style_features
+    target = _gram_by_hand(example.double().numpy().reshape(example.shape[-2], -1), "sum")
+    np.testing.assert_allclose(model.style_gram.double().numpy(), target, rtol=1e-5, atol=1e-6 * np.abs(target).max())
+    train = elderly.datasets["train"].features[:3]
+    expected = [np.linalg.norm(_gram_by_hand(f.double().numpy(), "sum") - target) for f in train]
+    np.testing.assert_allclose(model.style_distance(train).double().numpy(), expected, rtol=1e-4)
+    default = StyleCVAE(spec=elderly.model_spec())
+    default._install_stats(elderly)
+    assert default.plain_gram and not model.plain_gram
+    mean_target = _gram_by_hand(example.double().numpy().reshape(example.shape[-2], -1), "mean")
+    np.testing.assert_allclose(default.style_gram.double().numpy(), mean_target, rtol=1e-5,
+                               atol=1e-6 * np.abs(mean_target).max())
+    with pytest.raises(ValueError, match="gram_normalization"):
+        StyleCVAE(gram_normalization="max")
+
+
+def test_the_pose_only_gram_leaves_root_velocity_and_yaw_rate_out(elderly) -> None:
+    """style_channels=pose: the features decoded, root velocity and yaw rate zeroed, encoded again — equal to an
+    encoder whose weights for those three channels are removed; the target is the Gram of the example's pose-only
+    features; bad values are refused."""
+    model = StyleCVAE(spec=elderly.model_spec(), style_channels="pose")
+    model._install_stats(elderly)
+    train = elderly.datasets["train"].features[:4]
+    net = elderly.autoencoder.net
+    reference = torch.nn.Conv1d(net.encoder.in_channels, net.encoder.out_channels, net.encoder.kernel_size[0],
+                                padding="same")
+    with torch.no_grad():
+        reference.weight.copy_(net.encoder.weight)
+        reference.weight[:, 63:66, :] = 0  # no weight for root ground velocity (2) and yaw rate (1)
+        reference.bias.copy_(net.encoder.bias)
+        frames = net.decode_normalized(train)
+        expected = torch.nn.functional.avg_pool1d(torch.relu(reference(frames.transpose(-1, -2))), 2)
+        got = model._style_features(train)
+    torch.testing.assert_close(got, expected, rtol=1e-5, atol=1e-6)
+    # changing only the root channels of the decoded frames changes nothing the pose-only encoder sees
+    with torch.no_grad():
+        moved = frames.clone()
+        moved[..., 63:66] += 5.0
+        shifted = torch.nn.functional.avg_pool1d(torch.relu(reference(moved.transpose(-1, -2))), 2)
+    torch.testing.assert_close(shifted, expected)
+    [example] = elderly.style_features
+    with torch.no_grad():
+        pose_example = model._style_features(example.reshape(1, *example.shape[-2:]))[0].double().numpy()
+    target = _gram_by_hand(pose_example, "mean")
+    np.testing.assert_allclose(model.style_gram.double().numpy(), target, rtol=1e-4, atol=1e-6 * np.abs(target).max())
+    assert not model.plain_gram
+    with pytest.raises(ValueError, match="style_channels"):
+        StyleCVAE(style_channels="root")
+
+
+def test_the_style_subset_takes_the_mean_over_k_random_decodes(elderly) -> None:
+    """style_subset=k: the term is the mean distance of k of the decodes (the ones a seeded permutation picks);
+    k ≥ their number, or 0, is every decode."""
+    model = StyleCVAE(spec=elderly.model_spec(), style_latents="posterior", style_subset=3)
+    model._install_stats(elderly)
+    train = elderly.datasets["train"]
+    y = model.normalize(train.features[:4], train.duration_s[:4])[None].repeat(2, 1, 1)  # (L=2, 4, D)
+    distances = model.style_distance(model.denormalize(y.flatten(0, 1), clamp=False)[0])
+    picked = torch.randperm(8, generator=torch.Generator().manual_seed(3))[:3]
+    term = model._extra_losses(y, torch.Generator().manual_seed(3))["style"][0]
+    torch.testing.assert_close(term, distances[picked].mean())
+    every = StyleCVAE(spec=elderly.model_spec(), style_latents="posterior", style_subset=8)
+    every._install_stats(elderly)
+    torch.testing.assert_close(every._extra_losses(y)["style"][0], distances.mean())
+    with pytest.raises(ValueError, match="style_subset"):
+        StyleCVAE(style_subset=-1)

@@ -22,3 +22,31 @@ def test_a_batched_target_factor_gives_each_sequence_its_own_target() -> None:
     shared = feature_style_distance(features, target_gram=gram(examples[0]))
     broadcast = (examples[0] / 7 ** 0.5).expand(5, -1, -1)
     assert torch.allclose(shared, feature_style_distance(features, target_factor=broadcast), rtol=1e-5)
+
+
+def test_the_summed_gram_is_eq_5_9_as_written() -> None:
+    """``normalization="sum"``: Σ_t y_t y_tᵀ and its Frobenius distance, against a loop over time steps in numpy."""
+    import numpy as np
+
+    generator = torch.Generator().manual_seed(1)
+    features = torch.randn(3, 5, 7, generator=generator, dtype=torch.float64)
+    example = torch.randn(5, 9, generator=generator, dtype=torch.float64)
+    y = features.numpy()
+    by_hand = np.zeros((3, 5, 5))
+    for i in range(3):
+        for t in range(7):
+            by_hand[i] += np.outer(y[i, :, t], y[i, :, t])
+    target = sum(np.outer(example.numpy()[:, t], example.numpy()[:, t]) for t in range(9))
+    np.testing.assert_allclose(gram(features, "sum").numpy(), by_hand, rtol=1e-12)
+    np.testing.assert_allclose(gram(features).numpy(), by_hand / 7, rtol=1e-12)  # the default: ÷ T
+    expected = np.sqrt(((by_hand - target) ** 2).sum((-1, -2)))
+    got = feature_style_distance(features, gram(example, "sum"), normalization="sum")
+    np.testing.assert_allclose(got.numpy(), expected, rtol=1e-9)
+    # several examples average their summed Grams
+    from stylemotion.models.style import mean_gram
+
+    np.testing.assert_allclose(mean_gram([example, 2 * example], "sum").numpy(), 2.5 * target, rtol=1e-12)
+    import pytest
+
+    with pytest.raises(ValueError, match="normalization"):
+        gram(features, "max")
