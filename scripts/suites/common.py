@@ -144,3 +144,41 @@ def bandai_arguments(base: Any) -> Callable[[argparse.ArgumentParser], None]:
         parser.set_defaults(data="bandai")
 
     return add_arguments
+
+
+def train_job(container: dict[str, Any], folder: str) -> dict[str, Any]:
+    """Train one model (a resolved ``train`` config) into ``folder``, or reuse a finished one; returns its
+    ``metrics.json`` ``val`` figures (best epoch), epochs, training seconds and whether it was reused. Runs in a
+    worker process."""
+    import time
+
+    from omegaconf import OmegaConf
+
+    from stylemotion.io.jsonfile import read_json_object
+    from stylemotion.training.fit import run as train_run
+
+    path = Path(folder)
+    t0 = time.perf_counter()
+    reused = (path / "metrics.json").is_file()
+    if not reused:
+        train_run(OmegaConf.create(container))
+    metrics = read_json_object(path / "metrics.json", "a suite training's metrics", f"delete {path}")
+    return {"val": dict(metrics.get("val") or {}), "epochs": metrics.get("epoch"),
+            "seconds": round(time.perf_counter() - t0, 1), "reused": reused}
+
+
+def run_jobs(jobs: dict[Any, tuple[dict[str, Any], str]], workers: int, shown: Sequence[str] = ("val/mpjpe",)
+             ) -> dict[Any, dict[str, Any]]:
+    """:func:`train_job` of every ``{key: (container, folder)}``, ``workers`` at once in spawned processes; prints
+    each job's ``shown`` validation figures as it finishes."""
+    from concurrent.futures import ProcessPoolExecutor
+    from multiprocessing import get_context
+
+    out = {}
+    with ProcessPoolExecutor(max_workers=max(1, workers), mp_context=get_context("spawn")) as pool:
+        futures = {key: pool.submit(train_job, *job) for key, job in jobs.items()}
+        for key, future in futures.items():
+            out[key] = future.result()
+            figures = ", ".join(f"{k} {out[key]['val'].get(k)}" for k in shown)
+            print(f"[{key}] trained: {figures}, {out[key]['seconds']} s", flush=True)
+    return out

@@ -38,14 +38,14 @@ from __future__ import annotations
 
 import argparse
 import math
-from concurrent.futures import ProcessPoolExecutor
-from multiprocessing import get_context
 from pathlib import Path
 from typing import Any
 
 from suites import style
-from suites.common import fmt, md_table, progress_printed, provenance_line, spread
+from suites.common import fmt, md_table, progress_printed, provenance_line, run_jobs, spread
 
+#: Validation figures printed as each training finishes.
+SHOWN = ("val/mpjpe", "val/contact")
 DESCRIPTION = ("foot-contact velocity loss weight of the autoencoder, VAE, CVAE and zero-shot network, chosen on "
                "Bandai validation clips; raw sample skating against real clips of the style on test")
 DEFAULT_SEEDS = (0, 1, 2)
@@ -78,37 +78,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 # ---------------------------------------------------------------------------------------------
 # training (worker processes)
-
-
-def train_job(container: dict[str, Any], folder: str) -> dict[str, Any]:
-    """Train one model (a resolved ``train`` config) into ``folder``, or reuse a finished one; returns its
-    ``metrics.json`` ``val`` figures (best epoch) and training seconds. Runs in a worker process."""
-    import time
-
-    from omegaconf import OmegaConf
-
-    from stylemotion.io.jsonfile import read_json_object
-    from stylemotion.training.fit import run as train_run
-
-    path = Path(folder)
-    t0 = time.perf_counter()
-    reused = (path / "metrics.json").is_file()
-    if not reused:
-        train_run(OmegaConf.create(container))
-    metrics = read_json_object(path / "metrics.json", "a contact_loss training's metrics", f"delete {path}")
-    return {"val": dict(metrics.get("val") or {}), "epochs": metrics.get("epoch"),
-            "seconds": round(time.perf_counter() - t0, 1), "reused": reused}
-
-
-def run_jobs(jobs: dict[Any, tuple[dict[str, Any], str]], workers: int) -> dict[Any, dict[str, Any]]:
-    out = {}
-    with ProcessPoolExecutor(max_workers=max(1, workers), mp_context=get_context("spawn")) as pool:
-        futures = {key: pool.submit(train_job, *job) for key, job in jobs.items()}
-        for key, future in futures.items():
-            out[key] = future.result()
-            print(f"[{key}] trained: val/mpjpe {out[key]['val'].get('val/mpjpe')}, val/contact "
-                  f"{out[key]['val'].get('val/contact')}, {out[key]['seconds']} s", flush=True)
-    return out
 
 
 def _replace(overrides: list[str], **values: Any) -> list[str]:
@@ -310,7 +279,7 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
         ae_jobs = {("autoencoder", w, first): job("autoencoder", w, first, None) for w in ae_weights}
     finally:
         GlobalHydra.instance().clear()
-    trained = run_jobs(ae_jobs, args.workers)
+    trained = run_jobs(ae_jobs, args.workers, SHOWN)
     ae_ckpt = str(folder("autoencoder", 0.0, first) / "checkpoints" / "best.ckpt")
 
     cfg = style.compose_reproduce(style.reproduce_overrides(args.data, first, base / "reproduce", 1,
@@ -319,7 +288,7 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
         first_jobs = {(kind, w, first): job(kind, w, first, ae_ckpt) for kind in MODELS for w in weights}
     finally:
         GlobalHydra.instance().clear()
-    trained |= run_jobs(first_jobs, args.workers)
+    trained |= run_jobs(first_jobs, args.workers, SHOWN)
 
     from stylemotion.models.loading import load_generative
 
@@ -362,7 +331,7 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
                  for w in sorted({0.0, choice[kind]["chosen"]})}
     finally:
         GlobalHydra.instance().clear()
-    trained |= run_jobs(later, args.workers)
+    trained |= run_jobs(later, args.workers, SHOWN)
     for seed in seeds[1:]:
         per_seed[str(seed)] = {kind: {f"{w:g}": figures_of(kind, w, seed)
                                       for w in sorted({0.0, choice[kind]["chosen"]})} for kind in MODELS}

@@ -29,7 +29,7 @@ from pathlib import Path
 from typing import Any
 
 from suites import style
-from suites.common import fmt, md_table, progress_printed, provenance_line, spread
+from suites.common import fmt, md_table, progress_printed, provenance_line, run_jobs, spread
 
 DESCRIPTION = ("Du's style CVAE trained as the thesis writes it (preset style_cvae_thesis) beside ours and the path "
                "between them one change at a time, plus a pose-only Gram: Tables 5.1-5.3 figures on Bandai walks")
@@ -71,40 +71,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--samples", type=int, default=300,
                         help="samples per model for Table 5.1, recognition, diversity and skating")
     parser.add_argument("--workers", type=int, default=2, help="trainings at once (one thread each)")
-
-
-def train_job(container: dict[str, Any], folder: str) -> dict[str, Any]:
-    """Train one model (a resolved ``train`` config) into ``folder``, or reuse a finished one; returns its best
-    epoch's validation figures and its training seconds. Runs in a worker process."""
-    import time
-
-    from omegaconf import OmegaConf
-
-    from stylemotion.io.jsonfile import read_json_object
-    from stylemotion.training.fit import run as train_run
-
-    path = Path(folder)
-    t0 = time.perf_counter()
-    reused = (path / "metrics.json").is_file()
-    if not reused:
-        train_run(OmegaConf.create(container))
-    metrics = read_json_object(path / "metrics.json", "a style_thesis training's metrics", f"delete {path}")
-    return {"val": dict(metrics.get("val") or {}), "epochs": metrics.get("epoch"),
-            "seconds": round(time.perf_counter() - t0, 1), "reused": reused}
-
-
-def run_jobs(jobs: dict[Any, tuple[dict[str, Any], str]], workers: int) -> dict[Any, dict[str, Any]]:
-    from concurrent.futures import ProcessPoolExecutor
-    from multiprocessing import get_context
-
-    out = {}
-    with ProcessPoolExecutor(max_workers=max(1, workers), mp_context=get_context("spawn")) as pool:
-        futures = {key: pool.submit(train_job, *job) for key, job in jobs.items()}
-        for key, future in futures.items():
-            out[key] = future.result()
-            print(f"[{key}] val/mpjpe {out[key]['val'].get('val/mpjpe')}, val/style {out[key]['val'].get('val/style')}"
-                  f", {out[key]['seconds']} s", flush=True)
-    return out
 
 
 def arm_overrides(stage: list[str], arm: str, epochs: int) -> list[str]:
@@ -184,7 +150,7 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
                     jobs[(arm, s, seed)] = (OmegaConf.to_container(train_cfg, resolve=True), str(folder))
     finally:
         GlobalHydra.instance().clear()
-    trained = run_jobs(jobs, args.workers)
+    trained = run_jobs(jobs, args.workers, ("val/mpjpe", "val/style"))
 
     takeset = build_dataset(data_cfg)
     autoencoder = load_autoencoder(ae_ckpt)
