@@ -211,6 +211,32 @@ def test_budget_precision_follows_the_cpu(tmp_path) -> None:
     assert f"trainer.precision={cpu_precision()}" in list(cfg.stages.autoencoder)
 
 
+def test_what_runs_alone_gets_every_core_unless_told() -> None:
+    from stylemotion.training.reproduction import alone_threads
+
+    assert alone_threads(None) == len(os.sched_getaffinity(0))
+    assert alone_threads(3) == 3
+    with pytest.raises(ValueError, match="alone_threads must be a whole number ≥ 1"):
+        alone_threads(0)
+
+
+def test_the_autoencoder_stage_trains_with_the_alone_threads(tmp_path: Path, monkeypatch) -> None:
+    import stylemotion.training.fit as fit_module
+    from stylemotion.training.reproduction import Reproduction
+
+    seen: list[int] = []
+    original = fit_module.set_torch_threads
+    monkeypatch.setattr(fit_module, "set_torch_threads", lambda value, *a: seen.append(value) or original(value, *a))
+
+    def stop(*args, **kwargs):
+        raise RuntimeError("stop after the autoencoder stage")
+
+    monkeypatch.setattr(Reproduction, "run_stages_in_parallel", stop)
+    with pytest.raises(RuntimeError, match="stop after the autoencoder stage"):
+        reproduce(tiny_overrides(tmp_path / "run") + ["alone_threads=2"], [])
+    assert seen == [2]  # the stage ran in this process with 2 threads, not the run's threads=1
+
+
 @pytest.mark.parametrize("override", ["workers=0", "workers=-2", "workers=two", "workers=1.5", "threads=abc",
                                       "threads=0"])
 def test_bad_workers_or_threads_value_is_refused_before_any_work(tmp_path: Path, override) -> None:

@@ -24,7 +24,9 @@ Unbatched ``(T, 66)`` / ``(H, T')`` inputs work too. The Gram matrices of §5.3.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
+from functools import partial
 from typing import Any
 
 import lightning.pytorch as pl
@@ -35,7 +37,14 @@ from torch import nn
 from stylemotion.io.errors import UserInputError
 from stylemotion.models.contact_loss import contact_velocity_loss, window_contacts
 from stylemotion.models.normalization import Normalizer
-from stylemotion.representation import FRAME_DIM, JOINT_DIMS, REPRESENTATION, frames_to_positions
+from stylemotion.representation import (
+    FRAME_DIM,
+    JOINT_DIMS,
+    REPRESENTATION,
+    VELOCITY_DIMS,
+    YAW_RATE_DIM,
+    frames_to_positions,
+)
 from stylemotion.skeleton import CANONICAL_JOINTS, CANONICAL_PARENTS, NUM_JOINTS
 
 POOLING = ("avg", "max")
@@ -123,6 +132,31 @@ class ConvAutoencoder(nn.Module):
                              f"got {tuple(frames.shape)}")
 
 
+#: learning-rate schedules of :class:`MotionAutoencoder`
+LR_SCHEDULES = ("exponential", "cosine")
+
+
+def cosine_factor(step: int, total: int, warmup: int, final: float) -> float:
+    """The learning rate's factor at optimizer ``step`` of ``total``: linear from 0 to 1 over ``warmup`` steps,
+    then half a cosine from 1 down to ``final`` at the last step (``final`` after it)."""
+    if step < warmup:
+        return (step + 1) / warmup
+    span = max(1, total - warmup - 1)
+    progress = min(1.0, (step - warmup) / span)
+    return final + (1.0 - final) * 0.5 * (1.0 + math.cos(math.pi * progress))
+
+
+def weighted_mse(recon: torch.Tensor, target: torch.Tensor, root_weight: float) -> torch.Tensor:
+    """MSE of ``(..., T, 66)`` frames with the root velocity and yaw-rate channels weighted ``root_weight``
+    (the others 1), divided by the mean weight; ``root_weight`` 1 is :func:`torch.nn.functional.mse_loss`."""
+    if root_weight == 1.0:
+        return F.mse_loss(recon, target)
+    weights = torch.ones(recon.shape[-1], dtype=recon.dtype, device=recon.device)
+    weights[VELOCITY_DIMS] = root_weight
+    weights[YAW_RATE_DIM] = root_weight
+    return ((recon - target).square() * weights).mean() / weights.mean()
+
+
 def _unbatched(fn, x: torch.Tensor, unbatched: bool) -> torch.Tensor:
     return fn(x.unsqueeze(0)).squeeze(0) if unbatched else fn(x)
 
@@ -169,7 +203,16 @@ class MotionAutoencoder(pl.LightningModule):
         contact_weight: weight of the foot-contact velocity loss (m²/s², see
             :mod:`stylemotion.models.contact_loss`; 0 = off): contacts detected on each input window.
         lr: Adam learning rate. weight_decay: Adam's L2 weight decay.
-        lr_gamma: the learning rate is multiplied by this after every epoch (1 = constant).
+        lr_gamma: with ``lr_schedule="exponential"``, the learning rate is multiplied by this after every
+            epoch (1 = constant).
+        lr_schedule: ``exponential`` (per epoch, ``lr_gamma``) or ``cosine``: per step, a linear warm-up over
+            ``warmup_epochs`` from 0 to ``lr``, then half a cosine down to ``lr × lr_final`` at the last step
+            of ``trainer.max_epochs`` (a schedule that fits the epochs it is given; docs/style.md).
+        warmup_epochs, lr_final: the cosine schedule's warm-up length (epochs, may be fractional) and final
+            learning rate as a share of ``lr``.
+        root_weight: weight of the root's ground velocity and yaw-rate channels in the training MSE, relative to
+            the other channels (1 = plain MSE, the thesis'); the loss is divided by the mean weight, so its scale
+            stays. Those three channels integrate into the whole trajectory (the root-integrated MPJPE).
         fps: frame rate of the frames the model is trained on (velocities are per second).
         frame_dim: values per frame. representation: frame layout id (see
             :data:`stylemotion.representation.REPRESENTATION`).
@@ -190,6 +233,10 @@ class MotionAutoencoder(pl.LightningModule):
         lr: float = 1e-3,
         weight_decay: float = 0.0,
         lr_gamma: float = 1.0,
+        lr_schedule: str = "exponential",
+        warmup_epochs: float = 0.0,
+        lr_final: float = 0.01,
+        root_weight: float = 1.0,
         fps: float = 30.0,
         frame_dim: int = FRAME_DIM,
         representation: str = REPRESENTATION,
@@ -213,11 +260,16 @@ class MotionAutoencoder(pl.LightningModule):
         if not sparsity >= 0 or not lr > 0 or not weight_decay >= 0 or not fps > 0 or not 0 < lr_gamma <= 1:
             raise ValueError(f"need sparsity ≥ 0, lr > 0, weight_decay ≥ 0, 0 < lr_gamma ≤ 1, fps > 0; got "
                              f"{sparsity}, {lr}, {weight_decay}, {lr_gamma}, {fps}")
+        if lr_schedule not in LR_SCHEDULES or not warmup_epochs >= 0 or not 0 <= lr_final <= 1 or not root_weight > 0:
+            raise ValueError(f"need lr_schedule in {LR_SCHEDULES}, warmup_epochs ≥ 0, 0 ≤ lr_final ≤ 1, "
+                             f"root_weight > 0; got {lr_schedule!r}, {warmup_epochs}, {lr_final}, {root_weight}")
         self.save_hyperparameters({
             "hidden_units": int(hidden_units), "kernel_size": int(kernel_size), "pooling": str(pooling),
             "input_dropout": float(input_dropout), "sparsity": float(sparsity),
             "contact_weight": float(contact_weight), "lr": float(lr),
             "weight_decay": float(weight_decay), "lr_gamma": float(lr_gamma), "fps": float(fps),
+            "lr_schedule": str(lr_schedule), "warmup_epochs": float(warmup_epochs), "lr_final": float(lr_final),
+            "root_weight": float(root_weight),
             "frame_dim": int(frame_dim),
             "representation": str(representation), "joint_names": [str(j) for j in joint_names],
             "joint_parents": [int(p) for p in joint_parents],
@@ -273,6 +325,14 @@ class MotionAutoencoder(pl.LightningModule):
 
     def configure_optimizers(self):
         optimizer = torch.optim.Adam(self.parameters(), lr=self.hparams.lr, weight_decay=self.hparams.weight_decay)
+        if self.hparams.get("lr_schedule", "exponential") == "cosine":
+            total = int(self.trainer.estimated_stepping_batches)
+            epochs = self.trainer.max_epochs
+            per_epoch = total / epochs if epochs and epochs > 0 else self.trainer.num_training_batches
+            warmup = int(round(float(self.hparams.warmup_epochs) * (per_epoch if math.isfinite(per_epoch) else 0)))
+            factor = partial(cosine_factor, total=total, warmup=warmup, final=float(self.hparams.lr_final))
+            schedule = torch.optim.lr_scheduler.LambdaLR(optimizer, factor)
+            return {"optimizer": optimizer, "lr_scheduler": {"scheduler": schedule, "interval": "step"}}
         if self.hparams.lr_gamma == 1.0:
             return optimizer
         schedule = torch.optim.lr_scheduler.ExponentialLR(optimizer, gamma=self.hparams.lr_gamma)
@@ -284,7 +344,8 @@ class MotionAutoencoder(pl.LightningModule):
         features = net.encode_normalized(net.corrupt(z) if split == "train" else z)
         recon = net.decode_normalized(features, frames.shape[-2])
         mse = F.mse_loss(recon, z)
-        loss = mse + self.hparams.sparsity * features.abs().mean() if self.hparams.sparsity else mse
+        fit = mse if split != "train" else weighted_mse(recon, z, float(self.hparams.get("root_weight", 1.0)))
+        loss = fit + self.hparams.sparsity * features.abs().mean() if self.hparams.sparsity else fit
         weight = float(self.hparams.get("contact_weight", 0.0))
         contact = None
         if weight > 0 or split != "train":

@@ -43,6 +43,7 @@ import hashlib
 import json
 import logging
 import multiprocessing
+import os
 import sys
 import time
 from collections import Counter
@@ -279,15 +280,16 @@ class Reproduction:
         shown = ", ".join(f"{k} {v:.4g}" for k, v in test.items() if isinstance(v, float))
         log.info(f"    {stage.name} done in {stage.seconds / 60:.1f} min" + (f": {shown}" if shown else ""))
 
-    def run_stage(self, index: int, stage: Stage) -> None:
-        """Train ``stage`` in this process (or reuse/resume it)."""
+    def run_stage(self, index: int, stage: Stage, threads: Any = None) -> None:
+        """Train ``stage`` in this process (or reuse/resume it), with ``threads`` torch threads (None: the run's
+        ``threads``)."""
         from stylemotion.training.fit import run as train_run
 
         resume = self.prepare_stage(index, stage)
         if resume is None:
             return
         t0 = time.perf_counter()
-        result = train_run(self.train_config(stage, resume))
+        result = train_run(self.train_config(stage, resume, threads))
         self.finish_stage(stage, result["metrics"], resume, time.perf_counter() - t0)
 
     def run_stages_in_parallel(self, indexed: Sequence[tuple[int, Stage]], workers: int) -> None:
@@ -325,10 +327,12 @@ class Reproduction:
                 cfg.callbacks.progress_bar = None
         return OmegaConf.to_container(cfg, resolve=True)
 
-    def train_config(self, stage: Stage, resume: bool) -> DictConfig:
-        """The ``train`` config of ``stage``: its overrides, this run's data, seed, threads and folder."""
+    def train_config(self, stage: Stage, resume: bool, threads: Any = None) -> DictConfig:
+        """The ``train`` config of ``stage``: its overrides, this run's data, seed, threads (``threads``, else the
+        run's ``threads``) and folder."""
         return stage_train_config(stage.overrides, stage.values, self.data_cfg, stage.folder, int(self.cfg.seed),
-                                  self.cfg.get("threads"), stage.parent.checkpoint if stage.parent else None)
+                                  threads if threads is not None else self.cfg.get("threads"),
+                                  stage.parent.checkpoint if stage.parent else None)
 
     def evaluation_stage(self) -> dict[str, Any]:
         """Evaluate every trained model into ``<out>/report`` (or reuse the report of the same stages)."""
@@ -523,14 +527,27 @@ def _data_choice() -> str | None:
     return None
 
 
+def alone_threads(value: Any) -> int:
+    """Torch threads of the steps that run with nothing beside them (the autoencoder stage, every stage when
+    ``workers=1``, the evaluation): ``value``, or every core this process may use when it is None
+    (benchmarks/autoencoder.md: two threads train the autoencoder 2.2× faster than one on two free cores)."""
+    if value is not None:
+        return positive_int(value, "alone_threads")
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except AttributeError:  # not Linux
+        return max(1, os.cpu_count() or 1)
+
+
 def reproduce(cfg: DictConfig) -> dict[str, Any]:
     """Run (or resume) every stage; returns the summary written to ``<out>/reproduce.json``.
 
     Must be called with Hydra's global config search initialized (inside ``stylemotion-reproduce``,
     or within ``hydra.initialize_config_dir``), since the training stages compose the ``train`` config.
     """
-    set_torch_threads(cfg.get("threads"), "threads")  # the evaluation's too, so reruns compute alike
+    set_torch_threads(cfg.get("threads"), "threads")
     workers = positive_int(cfg.get("workers", 1), "workers")
+    alone = alone_threads(cfg.get("alone_threads"))
     # a bad evaluation value is named now, not after hours of training
     settings_from_config(cfg.get("evaluation") or {}, int(cfg.get("seed") or 0))
     engine = executor_engine(cfg)
@@ -543,11 +560,12 @@ def reproduce(cfg: DictConfig) -> dict[str, Any]:
     parallel = workers > 1 or engine != "pool"
     in_process = 1 if parallel else len(indexed)  # stage 1 is the autoencoder the others need
     for index, stage in indexed[:in_process]:
-        repro.run_stage(index, stage)
+        repro.run_stage(index, stage, alone)  # nothing else runs beside it
         if stage.status != "reused":
             write_json(repro.out / "reproduce.json", repro.summary())
     if indexed[in_process:]:
         repro.run_stages_in_parallel(indexed[in_process:], workers)
+    set_torch_threads(alone, "alone_threads")  # the evaluation runs alone too
     results = repro.evaluation_stage()
     summary = repro.summary()
     summary["report"] = repro.recorded(repro.out / "report")

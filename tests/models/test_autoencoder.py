@@ -266,6 +266,44 @@ def test_learning_rate_decays_per_epoch():
         MotionAutoencoder(lr_gamma=0.0)
 
 
+def test_cosine_schedule_warms_up_then_falls_to_its_final_share_at_the_last_step():
+    from stylemotion.models.autoencoder import cosine_factor
+
+    total, warmup, final = 100, 10, 0.01
+    factors = [cosine_factor(step, total, warmup, final) for step in range(total)]
+    assert factors[0] == pytest.approx(0.1) and factors[9] == pytest.approx(1.0)
+    assert factors[10] == pytest.approx(1.0) and factors[-1] == pytest.approx(final)
+    # the cosine's midpoint halfway between warm-up end and the last step
+    assert cosine_factor(10 + 89 // 2, total, warmup, final) == pytest.approx(final + (1 - final) * 0.5, abs=0.02)
+    assert all(a >= b for a, b in zip(factors[9:], factors[10:]))
+
+
+def test_cosine_schedule_steps_per_batch_over_the_trainers_epochs():
+    dm = MotionWindowDataModule(takeset=toy_takeset(takes=6), batch_size=64)  # one batch per epoch
+    model = MotionAutoencoder(hidden_units=8, lr=1e-2, lr_schedule="cosine", warmup_epochs=1, lr_final=0.1)
+    trainer = fit(model, dm, steps=4, max_epochs=4)  # 4 epochs of one step: warm-up 1 step, cosine over the other 3
+    assert trainer.optimizers[0].param_groups[0]["lr"] == pytest.approx(1e-2 * 0.1)
+    with pytest.raises(ValueError, match="lr_schedule"):
+        MotionAutoencoder(lr_schedule="linear")
+
+
+def test_root_weight_weighs_the_root_channels_and_keeps_the_scale():
+    from stylemotion.models.autoencoder import weighted_mse
+    from stylemotion.representation import VELOCITY_DIMS, YAW_RATE_DIM
+
+    target = torch.zeros(2, 4, 66)
+    recon = target.clone()
+    recon[..., 0] = 1.0  # a joint channel off by 1
+    assert weighted_mse(recon, target, 1.0) == pytest.approx(1 / 66)
+    assert weighted_mse(recon, target, 5.0) == pytest.approx(1 / (63 + 3 * 5))  # 1 / sum of weights
+    root = target.clone()
+    root[..., VELOCITY_DIMS.start] = 1.0
+    root[..., YAW_RATE_DIM] = 1.0
+    assert weighted_mse(root, target, 5.0) == pytest.approx(10 / (63 + 15))
+    with pytest.raises(ValueError, match="root_weight"):
+        MotionAutoencoder(root_weight=0.0)
+
+
 def test_nan_loss_stops_naming_the_batch():
     takes = toy_takeset(takes=3).takes
     windows = torch.stack([torch.as_tensor(t.frames[:60]) for t in takes for _ in range(4)])  # 12 windows
