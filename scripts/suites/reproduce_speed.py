@@ -19,6 +19,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -60,6 +61,42 @@ def stage_seconds(out: Path) -> dict[str, float]:
     return stages
 
 
+STEP = re.compile(r"^\[(?P<when>[\d-]+ [\d:,]+)\]\[[^]]+\]\[INFO\] - (?:\[(?P<k>\d+)/(?P<n>\d+)\] (?P<what>\S+)|"
+                  r"(?P<done>done in ))")
+
+
+def phases(out: Path) -> dict[str, float] | None:
+    """Minutes of the reproduction's phases from its own log (``<out>/hydra/*/reproduce.log``): data, autoencoder
+    (alone), the VAE/CVAE stages (in parallel), evaluation. None without a log."""
+    from datetime import datetime
+
+    logs = sorted(out.glob("hydra/*/reproduce.log"))
+    if not logs:
+        return None
+    marks: dict[str, datetime] = {}
+    for line in logs[-1].read_text(errors="replace").splitlines():
+        m = STEP.match(line)
+        if not m:
+            continue
+        when = datetime.strptime(m["when"], "%Y-%m-%d %H:%M:%S,%f")
+        if m["done"]:
+            marks["done"] = when
+        elif m["k"] == "1":
+            marks.setdefault("start", when)
+        elif m["k"] == "2":
+            marks.setdefault("autoencoder", when)
+        elif m["k"] == "3":
+            marks.setdefault("stages", when)
+        elif m["k"] == m["n"]:
+            marks.setdefault("evaluation", when)
+    order = ["autoencoder", "stages", "evaluation", "done"]
+    if any(k not in marks for k in order):
+        return None
+    return {name: round((marks[b] - marks[a]).total_seconds() / 60, 2)
+            for name, a, b in [("autoencoder", "autoencoder", "stages"), ("vae_cvae_stages", "stages", "evaluation"),
+                               ("evaluation", "evaluation", "done")]}
+
+
 def table_figures(report: dict[str, Any]) -> dict[str, Any]:
     """What the faster command must keep: Table 5.1's diagonal rows per primitive, styled recognition, the
     autoencoder's test MPJPE."""
@@ -75,18 +112,27 @@ def table_figures(report: dict[str, Any]) -> dict[str, Any]:
             "autoencoder_test_local_mpjpe_m": ae.get("test_local_mpjpe_m")}
 
 
-def earlier_runs(label: str) -> dict[str, Any]:
+def run_folder(parent: Path, label: str, cpu_kind: str, seed: int) -> Path:
+    return parent / f"{label}_{cpu_kind}_seed{seed}"
+
+
+def earlier_runs(label: str, parent: Path) -> dict[str, Any]:
     """Entries of other labels in the committed results file, kept with their own provenance."""
     if not RESULTS.is_file():
         return {}
     record = json.loads(RESULTS.read_text())
-    return {k: v for k, v in record.get("results", {}).get("runs", {}).items() if k != label}
+    runs = {k: v for k, v in record.get("results", {}).get("runs", {}).items() if k != label}
+    for name, entry in runs.items():  # phases of entries recorded before the suite read them from the run's log
+        folder = run_folder(parent, name, entry["cpu_kind"], entry["seed"])
+        if "phases_min" not in entry and folder.is_dir():
+            entry["phases_min"] = phases(folder)
+    return runs
 
 
 def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
     env_extra, kind_overrides = CPU_KINDS[args.cpu_kind]
     seed = seeds[0]
-    out = args.runs / f"{args.label}_{args.cpu_kind}_seed{seed}"
+    out = run_folder(args.runs, args.label, args.cpu_kind, seed)
     if out.exists():
         shutil.rmtree(out)
     command = [str(Path(sys.executable).parent / "stylemotion-reproduce"), "data=bandai", f"seed={seed}",
@@ -101,10 +147,10 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
         "label": args.label, "cpu_kind": args.cpu_kind, "env": env_extra, "command": " ".join(command[1:]),
         "commit": _commit(), "started": started, "load_before": [round(x, 2) for x in load_before],
         "load_after": [round(x, 2) for x in os.getloadavg()], "exit": completed.returncode,
-        "wall_s": round(wall, 1), "stages_s": stage_seconds(out), "seed": seed}
+        "wall_s": round(wall, 1), "stages_s": stage_seconds(out), "phases_min": phases(out), "seed": seed}
     if completed.returncode == 0:
         entry.update(table_figures(json.loads((out / "report" / "report.json").read_text())))
-    runs = {**earlier_runs(args.label), args.label: entry}
+    runs = {**earlier_runs(args.label, args.runs), args.label: entry}
     return {"runs": runs, "aim_minutes": AIM_MINUTES,
             "splits": {"kind": "the reproduction's own take split (data.split, seed 0); nothing is chosen here",
                        "report": "Table 5.1 and recognition as the report computes them; autoencoder on test windows"}}
@@ -129,12 +175,13 @@ def group_stages(stages: dict[str, float]) -> dict[str, float]:
 
 def render(record: dict[str, Any]) -> dict[str, str]:
     runs = record["results"]["runs"]
-    kinds = sorted({k for e in runs.values() for k in group_stages(e["stages_s"])})
-    header = ["run", "CPU kind", "commit", "wall (min)", *[f"{k} (min, summed)" for k in kinds],
-              "Table 5.1 diagonal rows", "recognition styled mean (min)", "AE test MPJPE int. / local (cm)"]
+    header = ["run", "CPU kind", "commit", "wall (min)", "autoencoder (min)", "VAE + CVAE stages, 2 at a time (min)",
+              "evaluation (min)", "stage minutes summed: VAE / CVAE", "Table 5.1 diagonal rows",
+              "recognition styled mean (min)", "AE test MPJPE int. / local (cm)"]
     rows = []
     for label, e in runs.items():
         grouped = group_stages(e["stages_s"])
+        ph = e.get("phases_min") or {}
         diag = ", ".join(f"{p.split('_')[-1]} {d['rows']}/{d['models']}"
                          for p, d in e.get("table_5_1_diagonal", {}).items()) or f"exit {e['exit']}"
         rec = (f"{fmt(e['recognition_styled_mean'], 3)} ({fmt(e['recognition_styled_min'], 3)})"
@@ -142,14 +189,16 @@ def render(record: dict[str, Any]) -> dict[str, str]:
         ae = (f"{fmt(100 * e['autoencoder_test_mpjpe_m'], 2)} / {fmt(100 * e['autoencoder_test_local_mpjpe_m'], 2)}"
               if e.get("autoencoder_test_mpjpe_m") is not None else "—")
         rows.append([label, e["cpu_kind"], e["commit"][:12], fmt(e["wall_s"] / 60, 1),
-                     *[fmt(grouped.get(k, 0.0) / 60, 1) for k in kinds], diag, rec, ae])
-    notes = "; ".join(f"{label}: `stylemotion-reproduce {e['command'].split(' ', 1)[1] if ' ' in e['command'] else ''}`"
+                     *[fmt(ph.get(k), 1) for k in ("autoencoder", "vae_cvae_stages", "evaluation")],
+                     f"{fmt(grouped.get('vae', 0.0) / 60, 1)} / {fmt(grouped.get('cvae', 0.0) / 60, 1)}",
+                     diag, rec, ae])
+    notes = "; ".join(f"{label}: `stylemotion-reproduce {e['command']}`"
                       f"{' with ' + ', '.join(f'{k}={v}' for k, v in e['env'].items()) if e['env'] else ''}"
-                      f" ({e['started'][:10]}, load {e['load_before'][0]} → {e['load_after'][0]})"
+                      f" ({e['started'][:16].replace('T', ' ')}, load {e['load_before'][0]} → {e['load_after'][0]})"
                       for label, e in runs.items())
     text = (f"`stylemotion-reproduce data=bandai` (all takes, seed 0), each run alone in a fresh folder; aim ≤ "
-            f"{record['results']['aim_minutes']:g} min. Stage minutes are summed over the stages of a kind (the VAE "
-            "and CVAE stages run two at a time, so their sums exceed their share of the wall clock).\n\n"
+            f"{record['results']['aim_minutes']:g} min. Phases from the run's own log; the data stage (cached "
+            "conversion) is the rest of the wall clock.\n\n"
             + md_table(header, rows) + f"\n\nRuns: {notes}. Command: `python scripts/benchmarks.py run "
             "reproduce_speed --label <run> --cpu-kind <kind>` (machine "
             f"{record['machine']['cpu']}, {record['machine']['cores']} cores).")
