@@ -86,7 +86,8 @@ def style_distances(autoencoder, normalized_frames: np.ndarray | torch.Tensor, g
     out = []
     for i in range(0, len(frames), chunk):
         features = autoencoder.encode(frames[i:i + chunk])  # (b, C, T')
-        out.append(torch.stack([feature_style_distance(features, target_factor=w) for w in factors], -1).double())
+        features = features.double()  # the table's distances in float64, as the report has always given them
+        out.append(torch.stack([feature_style_distance(features, target_factor=w) for w in factors], -1))
     return torch.cat(out).numpy() if out else np.zeros((0, len(factors)))
 
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import torch
 
-from stylemotion.models.style import feature_style_distance, gram, style_distance
+from stylemotion.models.style import feature_style_distance, gram, gram_factor, style_distance
 
 
 def test_a_batched_target_factor_gives_each_sequence_its_own_target() -> None:
@@ -50,3 +50,33 @@ def test_the_summed_gram_is_eq_5_9_as_written() -> None:
 
     with pytest.raises(ValueError, match="normalization"):
         gram(features, "max")
+
+
+def test_float32_distances_near_the_target_match_the_float64_direct_formula() -> None:
+    """Near its target (where the expanded three-term form cancelled and needed float64), the float32 distance
+    matches the direct float64 ``‖FFᵀ/T − S‖_F`` to 1e-5 of ``‖S‖``, and far from it relatively."""
+    generator = torch.Generator().manual_seed(2)
+    example = torch.randn(256, 18, generator=generator, dtype=torch.float64) * 3.0
+    target = gram(example)
+    near = example[None] + 1e-3 * torch.randn(64, 256, 18, generator=generator, dtype=torch.float64)
+    far = torch.randn(64, 256, 18, generator=generator, dtype=torch.float64)
+    scale = torch.linalg.matrix_norm(target).item()
+    for features in (near, far):
+        direct = style_distance(gram(features), target)
+        fast = feature_style_distance(features.float(), target_factor=gram_factor(target).float())
+        assert fast.dtype == torch.float32
+        assert torch.allclose(fast.double(), direct, rtol=1e-4, atol=1e-5 * scale), (fast - direct).abs().max()
+    # the float64 path agrees with the direct formula to rounding
+    exact = feature_style_distance(near, target_gram=target)
+    assert torch.allclose(exact, style_distance(gram(near), target), rtol=1e-9, atol=1e-11 * scale)
+
+
+def test_the_distance_has_the_direct_formulas_gradient() -> None:
+    generator = torch.Generator().manual_seed(3)
+    example = torch.randn(16, 6, generator=generator, dtype=torch.float64)
+    features = torch.randn(4, 16, 9, generator=generator, dtype=torch.float64, requires_grad=True)
+    fast = feature_style_distance(features, target_gram=gram(example)).sum()
+    (grad_fast,) = torch.autograd.grad(fast, features)
+    direct = style_distance(gram(features), gram(example)).sum()
+    (grad_direct,) = torch.autograd.grad(direct, features)
+    assert torch.allclose(grad_fast, grad_direct, rtol=1e-8, atol=1e-10)
