@@ -32,7 +32,9 @@ CANDIDATES: dict[str, list[str]] = {
     **{f"cos_lr{lr}_e{epochs}" + ("" if root == 1 else f"_root{root}"):
        [f"trainer.max_epochs={epochs}", "model.lr_schedule=cosine", "model.warmup_epochs=1", f"model.lr={float(lr)}",
         f"model.root_weight={root}"]
-       for lr, epochs, root in [("2e-3", 20, 1), ("2e-3", 30, 1), ("4e-3", 30, 1), ("2e-3", 20, 5), ("2e-3", 30, 5)]},
+       for lr, epochs, root in [("2e-3", 20, 1), ("2e-3", 30, 1), ("4e-3", 30, 1), ("2e-3", 20, 5), ("2e-3", 30, 5),
+                                # added after the first five: none kept both val figures at ≤ 30 epochs
+                                ("2e-3", 40, 1), ("2e-3", 30, 2), ("2e-3", 40, 2)]},
 }
 METRICS = ("val/mpjpe", "val/mpjpe_local")
 SCHEDULE_KEYS = ("trainer.max_epochs=", "model.lr_schedule=", "model.lr_gamma=", "model.lr=", "model.warmup_epochs=",
@@ -56,14 +58,19 @@ def epochs_of(overrides: list[str]) -> int:
 
 
 def choose_schedule(values: dict[str, dict[str, float | None]], epochs: dict[str, int]) -> str:
-    """The rule of the module doc: the fewest epochs among candidates no worse than the reference on val/mpjpe."""
+    """The rule of the module doc: the fewest epochs among candidates no worse than the reference on both val
+    figures (root-integrated and root-local)."""
     def score(name: str) -> float:
         value = values[name].get(METRICS[0])
         return float(value) if value is not None and math.isfinite(float(value)) else math.inf
 
     if not math.isfinite(score(REFERENCE)):
         raise ValueError(f"the reference candidate {REFERENCE} failed: no finite val/mpjpe")
-    fit = [n for n in values if score(n) <= score(REFERENCE)]
+    def local(name: str) -> float:
+        value = values[name].get(METRICS[1])
+        return float(value) if value is not None and math.isfinite(float(value)) else math.inf
+
+    fit = [n for n in values if score(n) <= score(REFERENCE) and local(n) <= local(REFERENCE)]
     return min(fit, key=lambda n: (epochs[n], score(n)))
 
 
@@ -99,8 +106,8 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
             "train_seconds": {n: trained[n]["seconds"] for n in names},
             "reused": {n: trained[n]["reused"] for n in names},
             "chosen": choose_schedule(values, epochs), "reference": REFERENCE,
-            "rule": f"the fewest epochs among candidates whose val/mpjpe is no worse than {REFERENCE}'s "
-                    "(ties: the lower val/mpjpe)",
+            "rule": f"the fewest epochs among candidates whose val MPJPE, root-integrated and root-local, is no worse "
+                    f"than {REFERENCE}'s (ties: the lower root-integrated)",
             "splits": {"choose": "validation windows of the reproduction's take split (data.split seed "
                                  f"{seeds[0]}); no test window is read",
                        "seed": f"candidates trained with seed {args.choice_seed}, not a reported seed"}}
