@@ -101,20 +101,18 @@ def feature_style_distance(features: torch.Tensor, target_gram: torch.Tensor | N
                            target_factor: torch.Tensor | None = None, normalization: str = "mean") -> torch.Tensor:
     """``style_distance(gram(features), target_gram)``: distance of feature sequences to a style.
 
-    Computed without forming a ``channels × channels`` matrix per sequence (the training loss evaluates it for
-    thousands of decoded samples per step) and without cancellation, so float32 is as good as the direct formula.
-    With ``F = features``, ``S = target_gram = W Wᵀ`` (:func:`gram_factor`), ``W = Q R`` (reduced QR), ``T`` time
-    steps, ``P = QᵀF`` (the part of F inside the target's span) and ``E = F − QP`` (the rest)::
+    Computed without forming a ``channels × channels`` matrix per sequence (the training loss
+    evaluates it for thousands of decoded samples per step), from the identity, with
+    ``F = features``, ``S = target_gram = W Wᵀ`` (:func:`gram_factor`) and ``T`` time steps::
 
-        ‖FFᵀ/T − S‖²_F = ‖PPᵀ/T − RRᵀ‖²_F + (2 ‖PEᵀ‖²_F + ‖EᵀE‖²_F) / T²
+        ‖FFᵀ/T − S‖²_F = ‖FᵀF‖²_F / T² − 2 ‖WᵀF‖²_F / T + ‖WᵀW‖²_F
 
-    The first term subtracts small ``rank × rank`` matrices entry by entry; the others are sums of squares. The
-    expanded form ``‖FᵀF‖²/T² − 2‖WᵀF‖²/T + ‖WᵀW‖²`` (three terms of ``‖S‖²`` that cancel near the target) needed
-    float64; this one costs ``O(channels · T · (T + rank))`` per sequence in the features' precision. Distances
-    below 1e-6 of ``‖S‖_F`` are reported as that floor, with zero gradient.
+    which costs ``O(channels · T · (T + rank))`` per sequence instead of ``O(channels² · T)``.
+    Equal to the direct formula up to float rounding (relative to ``‖S‖²``); distances that
+    round below 1e-6 of ``‖S‖_F`` are reported as that floor, with zero gradient.
 
     Args:
-        features: ``(..., channels, time)``; computed in their dtype (at least float32).
+        features: ``(..., channels, time)``.
         target_gram: ``(channels, channels)``; or give its factor ``target_factor`` ``(channels, rank)``
             (e.g. cached by a model) instead. A factor with leading dims ``(..., channels, rank)`` gives one
             target per sequence (broadcast against the features' leading dims), e.g. the features of each
@@ -122,23 +120,22 @@ def feature_style_distance(features: torch.Tensor, target_gram: torch.Tensor | N
         normalization: of the features' Gram matrices (:func:`gram`; ``sum``: ``T`` reads 1 above).
 
     Returns:
-        ``(...)``, in the features' dtype.
+        ``(...)``.
     """
     if target_factor is None:
         if target_gram is None:
             raise ValueError("give target_gram or target_factor")
         target_factor = gram_factor(target_gram)
+    # float64: the three terms are each ~‖S‖² and cancel near the target; in float32 the rounding of
+    # the products alone leaves ~1e-3·‖S‖ of spurious distance (BLAS-dependent). The extra cost is small
+    # (channels · T · (T + rank) per sequence).
     dtype = features.dtype
-    work = torch.promote_types(dtype, torch.float32)
-    features = features.to(work)
-    basis, triangle = torch.linalg.qr(target_factor.to(features))  # (..., C, r), (..., r, r)
+    features = features.double()
+    target_factor = target_factor.to(features)
     steps = gram_divisor(features.shape[-1], normalization)
-    inside = basis.transpose(-1, -2) @ features  # (..., r, T)
-    outside = features - basis @ inside  # (..., C, T), orthogonal to the target's span
-    target_small = triangle @ triangle.transpose(-1, -2)  # S in the basis (..., r, r)
-    in_span = (inside @ inside.transpose(-1, -2) / steps - target_small).square().sum((-1, -2))
-    outside_gram = outside.transpose(-1, -2) @ outside  # (..., T, T)
-    cross = ((inside.transpose(-1, -2) @ inside) * outside_gram).sum((-1, -2))  # ‖PEᵀ‖²
-    squared = in_span + (2 * cross + outside_gram.square().sum((-1, -2))) / steps**2
-    target_sq = target_small.square().sum((-1, -2))
+    ff = features.transpose(-1, -2) @ features  # (..., T, T)
+    wf = target_factor.transpose(-1, -2) @ features  # (..., rank, T)
+    ww = target_factor.transpose(-1, -2) @ target_factor
+    target_sq = ww.square().sum((-1, -2))
+    squared = ff.square().sum((-1, -2)) / steps**2 - 2 * wf.square().sum((-1, -2)) / steps + target_sq
     return squared.clamp_min(1e-12 * target_sq.clamp_min(1e-30)).sqrt().to(dtype)

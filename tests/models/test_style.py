@@ -53,8 +53,8 @@ def test_the_summed_gram_is_eq_5_9_as_written() -> None:
 
 
 def test_float32_distances_near_the_target_match_the_float64_direct_formula() -> None:
-    """Near its target (where the expanded three-term form cancelled and needed float64), the float32 distance
-    matches the direct float64 ``‖FFᵀ/T − S‖_F`` to 1e-5 of ``‖S‖``, and far from it relatively."""
+    """Near its target (where the expanded three-term form cancels, so it is computed in float64), the distance of
+    float32 features matches the direct float64 ``‖FFᵀ/T − S‖_F`` to 1e-5 of ``‖S‖``, and far from it relatively."""
     generator = torch.Generator().manual_seed(2)
     example = torch.randn(256, 18, generator=generator, dtype=torch.float64) * 3.0
     target = gram(example)
