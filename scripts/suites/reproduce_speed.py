@@ -130,6 +130,8 @@ def earlier_runs(label: str, parent: Path) -> dict[str, Any]:
 
 
 def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
+    from stylemotion.provenance import git_commit
+
     env_extra, kind_overrides = CPU_KINDS[args.cpu_kind]
     seed = seeds[0]
     out = run_folder(args.runs, args.label, args.cpu_kind, seed)
@@ -145,7 +147,7 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
     wall = time.perf_counter() - t0
     entry: dict[str, Any] = {
         "label": args.label, "cpu_kind": args.cpu_kind, "env": env_extra, "command": " ".join(command[1:]),
-        "commit": _commit(), "started": started, "load_before": [round(x, 2) for x in load_before],
+        "commit": git_commit(ROOT), "started": started, "load_before": [round(x, 2) for x in load_before],
         "load_after": [round(x, 2) for x in os.getloadavg()], "exit": completed.returncode,
         "wall_s": round(wall, 1), "stages_s": stage_seconds(out), "phases_min": phases(out), "seed": seed}
     if completed.returncode == 0:
@@ -154,14 +156,6 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
     return {"runs": runs, "aim_minutes": AIM_MINUTES,
             "splits": {"kind": "the reproduction's own take split (data.split, seed 0); nothing is chosen here",
                        "report": "Table 5.1 and recognition as the report computes them; autoencoder on test windows"}}
-
-
-def _commit() -> str:
-    try:
-        return subprocess.run(["git", "rev-parse", "HEAD"], cwd=ROOT, capture_output=True, text=True,
-                              check=True).stdout.strip()
-    except (OSError, subprocess.CalledProcessError):
-        return "unknown"
 
 
 def group_stages(stages: dict[str, float]) -> dict[str, float]:
