@@ -36,12 +36,15 @@ from typing import Any
 import numpy as np
 from suites.common import DATA_ROOT, fmt, md_table, provenance_line, quantiles, take_split_record
 
+from stylemotion.search.index import FLOAT64_ENGINES
+
 DESCRIPTION = ("k-NN engines per feature set on Bandai: build, memory, 16-NN ms per query (1 thread / all cores), "
                "approximate recall, ≥ 5 M-frame scale run (run alone)")
 DEFAULT_SEEDS = (0,)
 #: Engines measured (``auto`` is one of the exact ones, marked in the tables).
-MEASURED_ENGINES = ("ckdtree", "pykdtree", "faiss", "faiss-hnsw", "faiss-ivf")
-KD_TREES = ("ckdtree", "pykdtree")
+MEASURED_ENGINES = ("ckdtree", "ckdtree-pca", "pykdtree", "faiss", "faiss-hnsw", "faiss-ivf")
+#: Engines that take their thread count at construction (scipy's ``workers``): built twice, once per count.
+SCIPY_ENGINES = ("ckdtree", "ckdtree-pca")
 #: Aims of issue 29: every set's 16-NN with the default engine, and the approximate engines' recall.
 AIM_MS = 0.5
 AIM_RECALL = 0.99
@@ -60,7 +63,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--ivf-breadths", type=int, nargs="+", default=[8, 16, 32, 64, 128], help="nprobe")
     parser.add_argument("--scale-frames", type=int, default=5_000_000, help="scale run's frames (0: skip it)")
     parser.add_argument("--scale-features", nargs="+", default=["E15", "E15x5"])
-    parser.add_argument("--scale-engines", nargs="+", default=["ckdtree", "pykdtree", "faiss", "faiss-ivf"],
+    parser.add_argument("--scale-engines", nargs="+", default=["ckdtree", "ckdtree-pca", "pykdtree", "faiss",
+                                                                "faiss-ivf"],
                         choices=MEASURED_ENGINES, help="(faiss-hnsw: its graph over 5 M frames takes long)")
     parser.add_argument("--scale-clips", type=int, default=4, help="query clips per seed of the scale run")
     parser.add_argument("--scale-single", type=int, default=32, help="frames queried alone in the scale run")
@@ -96,28 +100,35 @@ def true_distances(features: np.ndarray, queries: np.ndarray, indices: np.ndarra
     return np.where(indices < 0, np.inf, d)
 
 
-def implied_rule(dims: Sequence[int], ms: Sequence[dict[str, float]]) -> dict[str, Any]:
-    """The ``auto`` rule "kd-tree ``kd`` up to ``limit`` dimensions, ``faiss`` above" closest to the fastest exact
-    engine of every set: per candidate (``limit`` ∈ {0} ∪ dims ∪ {∞}, kd ∈ :data:`KD_TREES` measured) the geometric
-    mean over sets of its engine's time over the set's fastest, the smallest winning (ties: the larger limit, then
-    cKDTree). ``ms[i]``: exact engine → ms per query of set ``i`` (dimension ``dims[i]``).
+def implied_rule(dims: Sequence[int], ms: Sequence[dict[str, float]],
+                 candidates: Sequence[str] = FLOAT64_ENGINES) -> dict[str, Any]:
+    """The ``auto`` rule "engine ``low`` up to ``limit`` dimensions, ``high`` above" (``low``, ``high`` among
+    ``candidates``, by default the float64 exact engines ``auto`` may pick) closest to the fastest exact engine of
+    every set: per candidate rule (``limit`` ∈ {0} ∪ dims ∪ {∞}) the geometric mean over sets of its engine's time
+    over the set's fastest measured exact engine; the smallest wins (ties: the larger limit, then the earlier
+    candidates). ``ms[i]``: exact engine → ms per query of set ``i`` (dimension ``dims[i]``).
 
-    Returns ``{"limit": int | None (None: every dimension), "kd": str, "geomean": float, "per_set": [engine…]}``.
+    Returns ``{"limit": int | None, "low": str, "high": str, "geomean": float, "per_set": [engine…]}``; a rule
+    naming one engine for every set has ``limit`` None and ``low == high``.
     """
-    def score(limit: float, kd: str) -> tuple[float, list[str]]:
-        chosen = [kd if d <= limit else "faiss" for d in dims]
+    def score(chosen: list[str]) -> float:
         if any(e not in times for e, times in zip(chosen, ms)):
-            return math.inf, chosen
+            return math.inf
         logs = [math.log(times[e] / min(times.values())) for e, times in zip(chosen, ms)]
-        return math.exp(sum(logs) / len(logs)), chosen
+        return math.exp(sum(logs) / len(logs))
 
-    candidates = []
-    for kd in KD_TREES:
-        for limit in sorted({0, *dims, math.inf}, reverse=True):
-            value, chosen = score(limit, kd)
-            candidates.append((value, -limit, KD_TREES.index(kd), limit, kd, chosen))
-    value, _, _, limit, kd, chosen = min(candidates, key=lambda c: c[:3])
-    return {"limit": None if math.isinf(limit) else int(limit), "kd": kd, "geomean": value, "per_set": chosen}
+    ranked = []
+    for li, low in enumerate(candidates):
+        for hi, high in enumerate(candidates):
+            for limit in sorted({0, *dims, math.inf}, reverse=True):
+                chosen = [low if d <= limit else high for d in dims]
+                ranked.append((score(chosen), -limit, li, hi, limit, low, high, chosen))
+    value, _, _, _, limit, low, high, chosen = min(ranked, key=lambda c: c[:4])
+    if len(set(chosen)) == 1:
+        limit, low = math.inf, chosen[0]
+        high = low
+    return {"limit": None if math.isinf(limit) else int(limit), "low": low, "high": high, "geomean": value,
+            "per_set": chosen}
 
 
 def library_rule_engines(dims: Sequence[int]) -> list[str]:
@@ -167,7 +178,8 @@ def rotated(items: Sequence[Any], shift: int) -> list[Any]:
 
 def _stats(values: Sequence[float]) -> dict[str, float | None]:
     q = quantiles(values, (50, 95))
-    return {"p50": q["p50"], "p95": q["p95"], "n": len(values)}
+    return {"p50": q["p50"], "p95": q["p95"], "mean": float(np.mean(values)) if len(values) else None,
+            "n": len(values)}
 
 
 # ---------------------------------------------------------------------------------------------
@@ -283,13 +295,14 @@ def measure_set(database: Any, feature_set: str, test_takes: Sequence[Any], clip
                            "auto": auto_engine(int(features.shape[1])), "engines": {}, "breadths": {}}
     indexes: dict[str, Any] = {}
     for engine in args.engines:
-        index, seconds, memory = _build(database, feature_set, features, fitted, engine, 1 if engine == "ckdtree"
-                                        else -1)
+        index, seconds, memory = _build(database, feature_set, features, fitted, engine,
+                                        1 if engine in SCIPY_ENGINES else -1)
         indexes[engine] = index
         row["engines"][engine] = {"build_s": seconds, **memory, **_exactness(index, flat_queries, args.k, ref_d)}
     all_cores = dict(indexes)
-    if "ckdtree" in indexes:  # cKDTree takes its thread count at construction; not timed or measured
-        all_cores["ckdtree"] = FrameIndex(database, feature_set, features, fitted, engine="ckdtree", workers=-1)
+    for engine in SCIPY_ENGINES:  # scipy takes its thread count at construction; these builds are not measured
+        if engine in indexes:
+            all_cores[engine] = FrameIndex(database, feature_set, features, fitted, engine=engine, workers=-1)
     for threads, group in (("1", indexes), ("all", all_cores)):
         times = time_queries(group, queries, args.k, args.single_per_clip, threads)
         for engine, t in times.items():
@@ -371,7 +384,8 @@ def _scale_engine(database: Any, feature_set: str, features: np.ndarray, fitted:
     from stylemotion.search import FrameIndex
     from stylemotion.search.index import APPROXIMATE_ENGINES
 
-    index, seconds, memory = _build(database, feature_set, features, fitted, engine, 1 if engine == "ckdtree" else -1)
+    index, seconds, memory = _build(database, feature_set, features, fitted, engine,
+                                    1 if engine in SCIPY_ENGINES else -1)
     if "queries" not in ref:
         ref["queries"] = np.stack(clip_features(index, test_takes, clips, args.clip_frames))
     queries = ref["queries"]
@@ -382,10 +396,10 @@ def _scale_engine(database: Any, feature_set: str, features: np.ndarray, fitted:
     if "d" in ref:
         entry.update(_exactness(index, flat_queries, args.k, ref["d"]))
     for threads in THREADS:
-        if engine == "ckdtree" and threads == "all":  # scipy takes its thread count at construction
+        if engine in SCIPY_ENGINES and threads == "all":  # scipy takes its thread count at construction
             index = None  # free the 1-thread tree first
             gc.collect()
-            index = FrameIndex(database, feature_set, features, fitted, engine="ckdtree", workers=-1)
+            index = FrameIndex(database, feature_set, features, fitted, engine=engine, workers=-1)
         with thread_limit(threads):
             index.query(queries[0], args.k)
             batched = [timed_ms(lambda: index.query(c, args.k)) / len(c) for c in queries]  # noqa: B023
@@ -509,8 +523,8 @@ def _choice(r: dict[str, Any]) -> str:
                      f"{have} (× {fmt(t[have] / t[fastest], 2)})" if have in t else f"{have} (not measured)"])
     logs = [math.log(t[e] / min(t.values())) for e, t in zip(library, times) if e in t]
     library_geo = math.exp(sum(logs) / len(logs)) if logs else None
-    rule = ("faiss for every dimension" if implied["limit"] == 0 else f"{implied['kd']} for every dimension"
-            if implied["limit"] is None else f"{implied['kd']} for ≤ {implied['limit']} dimensions, faiss above")
+    rule = (f"{implied['low']} for every dimension" if implied["limit"] is None else
+            f"{implied['low']} for ≤ {implied['limit']} dimensions, {implied['high']} above")
     same = implied["per_set"] == library
     verdict = ("the library's rule picks the same engine for every set measured" if same else
                "**the library's rule differs: set `AUTO_ENGINES` in stylemotion/search/index.py to the measured "
@@ -518,8 +532,9 @@ def _choice(r: dict[str, Any]) -> str:
     rules = ", ".join(f"≤ {'∞' if lim is None else lim}: {e}" for lim, e in r["auto_rule"])
     return (_quick_note(r) + md_table(["set (dims)", "fastest exact (batched, 1 thread)", "measured rule's engine",
                                        "library rule's engine"], rows) +
-            f"\n\nMeasured rule (kd-tree up to D dimensions, faiss above; the D and kd-tree whose engines are on "
-            f"geometric mean closest to each set's fastest exact engine): **{rule}** (× {fmt(implied['geomean'], 2)} "
+            f"\n\nMeasured rule (one engine up to D dimensions, another above, both among the float64 exact engines "
+            f"`auto` may pick: {', '.join(FLOAT64_ENGINES)}; the D and engines whose times are on geometric mean "
+            f"closest to each set's fastest exact engine of any kind): **{rule}** (× {fmt(implied['geomean'], 2)} "
             f"the fastest). Library (`AUTO_ENGINES`: {rules}): × {fmt(library_geo, 2)}; {verdict}.")
 
 
@@ -563,14 +578,16 @@ def _headline(r: dict[str, Any]) -> str:
         v = row["engines"].get(row["auto"])
         if v is None:
             continue
-        p50 = v["1"]["batched"]["p50"]
+        p50, mean = v["1"]["batched"]["p50"], v["1"]["batched"].get("mean")
         approx = [b for sweep in row["breadths"].values() for b in sweep if b["default"]]
         rows.append([f"{row['features']} ({row['dim']})", row["auto"], f"{fmt(p50, 3)}{_mark(p50, AIM_MS)}",
+                     "—" if mean is None else f"{fmt(mean, 3)}{_mark(mean, AIM_MS)}",
                      fmt(v["all"]["batched"]["p50"], 3), fmt(v["1"]["single"]["p50"], 3),
                      ", ".join(f"{b['recall']:.3f}{_mark(b['recall'], AIM_RECALL, below=False)}" for b in approx)
                      or "—"])
-    return (_quick_note(r) + md_table(["set (dims)", "auto's engine", f"16-NN ms/query, batched, 1 thread (aim ≤ "
-                                       f"{AIM_MS})", f"batched, {r['cores']} cores", "single, 1 thread",
+    return (_quick_note(r) + md_table(["set (dims)", "auto's engine", f"16-NN ms/query, batched, 1 thread, median "
+                                       f"over clips (aim ≤ {AIM_MS})", "mean over clips",
+                                       f"batched, {r['cores']} cores", "single, 1 thread",
                                        "HNSW, IVF recall@16 at default breadth (aim ≥ 0.99)"], rows))
 
 

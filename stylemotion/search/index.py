@@ -4,9 +4,12 @@
 engine that answers k-NN queries on them (Euclidean distance in feature space):
 
 * ``"auto"`` (default, exact): the exact engine :func:`auto_engine` picks for the features' dimension from
-  :data:`AUTO_ENGINES` (a kd-tree for few dimensions, faiss' brute force for many; scipy's cKDTree when faiss
-  is not installed), a rule read off the table ``python scripts/benchmarks.py run engines`` measures;
+  :data:`AUTO_ENGINES` (a kd-tree for few dimensions, the projected kd-tree for many), a rule read off the table
+  ``python scripts/benchmarks.py run engines`` measures;
 * ``"ckdtree"`` (exact): :class:`scipy.spatial.cKDTree`;
+* ``"ckdtree-pca"`` (exact): filter and refine — a cKDTree over a low-dimensional embedding whose distances never
+  exceed the true ones (the principal-axis coordinates keeping :data:`PROJECTION_VARIANCE` of the variance, plus the
+  norm of the rest), then exact float64 distances of every frame embedded within the k-th candidate's true distance;
 * ``"pykdtree"`` (exact): the ``pykdtree`` package, float32, OpenMP-parallel over queries;
 * ``"faiss"`` (exact): ``faiss.IndexFlatL2`` brute force (optional extra ``search``);
 * ``"faiss-hnsw"`` (approximate, no ε guarantee): ``faiss.IndexHNSWFlat`` graph (:data:`HNSW_M` links per node,
@@ -63,8 +66,10 @@ from stylemotion.search.features import (
 #: Bump when the features or the cache layout change, to invalidate cached indexes.
 SEARCH_FORMAT = 2  # 2: physics terms scaled by a 0.3 s interval and a 73 kg body
 #: Engines by name: ``auto``, the exact ones, the approximate ones.
-ENGINES = ("auto", "ckdtree", "pykdtree", "faiss", "faiss-hnsw", "faiss-ivf")
-EXACT_ENGINES = ("ckdtree", "pykdtree", "faiss")
+ENGINES = ("auto", "ckdtree", "ckdtree-pca", "pykdtree", "faiss", "faiss-hnsw", "faiss-ivf")
+EXACT_ENGINES = ("ckdtree", "ckdtree-pca", "pykdtree", "faiss")
+#: Exact engines whose distances are float64 (the others compute in float32): those ``auto`` may pick.
+FLOAT64_ENGINES = ("ckdtree", "ckdtree-pca")
 APPROXIMATE_ENGINES = ("faiss-hnsw", "faiss-ivf")
 #: Engines whose built index is slow enough to build that :meth:`FrameIndex.build` caches it too.
 STORED_ENGINES = ("faiss-hnsw",)
@@ -74,16 +79,24 @@ HNSW_M = 32
 HNSW_EF_SEARCH = 64
 #: Default cells an IVF search scans (faiss' ``nprobe``).
 IVF_NPROBE = 32
+#: Share of the features' variance the embedding of engine ``ckdtree-pca`` keeps on its principal axes (the rest
+#: enters as one coordinate, the residual's norm). Not tuned: any share gives exact answers, only the speed moves.
+PROJECTION_VARIANCE = 0.95
+#: Frames (a seeded sample) the principal axes of ``ckdtree-pca`` are fitted on; rows embedded per chunk.
+PROJECTION_SAMPLE = 50_000
+_EMBED_CHUNK = 100_000
 #: Training points per IVF cell (k-means on a seeded sample of the database; faiss wants ≥ 39).
 IVF_TRAIN_PER_LIST = 40
 #: ``engine="auto"``: ``(largest feature dimension, exact engine)`` rows in ascending order; features of dimension
-#: ``d`` use the engine of the first row whose dimension is ≥ ``d``. Chosen by ``python scripts/benchmarks.py run
-#: engines --scale-frames 0`` (alone, all of Bandai: 16-NN of held-out test frames against the 346,527 train + val
-#: frames, batched, one thread; benchmarks/engines.md, block ``engines/choice``): a kd-tree for every set; faiss'
-#: brute force was 24–76× slower at every dimension (up to 117). The table's fastest kd-tree is pykdtree (1.00–1.15×
-#: the fastest exact engine) but it returns float32 distances, which put an LNG path's cost below exact DTW's on
-#: Bandai (tests/search/test_search_bandai_slice.py); cKDTree (float64, 1.00–1.84×) is the fastest that keeps it.
-AUTO_ENGINES: tuple[tuple[float, str], ...] = ((math.inf, "ckdtree"),)
+#: ``d`` use the engine of the first row whose dimension is ≥ ``d``. Only the float64 engines (:data:`FLOAT64_ENGINES`)
+#: are candidates: pykdtree's and faiss' float32 distances put an LNG path's cost below exact DTW's on Bandai
+#: (tests/search/test_search_bandai_slice.py). The rule is read off ``python scripts/benchmarks.py run engines``
+#: (alone, all of Bandai: 16-NN of held-out test frames against the train + val frames, batched, one thread;
+#: benchmarks/engines.md, block ``engines/choice``, which says whether this rule agrees with the measured one):
+#: cKDTree for the sets of up to 45 dimensions, the projected cKDTree above (the windowed 75–117-dimensional sets,
+#: whose frames lie near a ~15-dimensional subspace). faiss' brute force was 24–76× slower than a kd-tree at
+#: every dimension measured.
+AUTO_ENGINES: tuple[tuple[float, str], ...] = ((45, "ckdtree"), (math.inf, "ckdtree-pca"))
 #: The exact engine ``auto`` falls back to when the one its rule names is not installed.
 AUTO_FALLBACK = "ckdtree"
 _INSTALL_HINT = {"pykdtree": "pip install pykdtree", "faiss": "pip install 'stylemotion[search]' (faiss-cpu)"}
@@ -118,6 +131,69 @@ class _PyKDTree:
         bound_arg = None if np.isinf(bound) else float(bound)
         d, i = self.tree.query(x, k=k, eps=eps, distance_upper_bound=bound_arg)
         return np.reshape(d, (len(x), k)).astype(np.float64), np.reshape(i, (len(x), k)).astype(np.int64)
+
+
+class _ProjectedKDTree:
+    """Exact k-NN by filter and refine (the lower-bounding embedding of Faloutsos et al.'s GEMINI).
+
+    Each frame ``x`` is embedded as ``z(x) = [Vᵀ(x − μ), ‖(I − VVᵀ)(x − μ)‖]`` with ``V`` ``(d, p)`` the principal
+    axes keeping :data:`PROJECTION_VARIANCE` of a seeded sample's variance; ``‖z(x) − z(y)‖ ≤ ‖x − y‖`` (Pythagoras
+    and the reverse triangle inequality), so a frame farther than r in the embedding is farther than r. A query
+    takes its k nearest in the embedding, their true distances give r (≥ the true k-th distance), every frame
+    embedded within r is a candidate, and the candidates are ranked by float64 distances (ties by index). ε is not
+    used: the answer is exact.
+    """
+
+    def __init__(self, data: np.ndarray, workers: int):
+        from scipy.spatial import cKDTree
+
+        n, d = data.shape
+        rows = np.sort(np.random.default_rng(0).choice(n, size=min(n, PROJECTION_SAMPLE), replace=False))
+        sample = data[rows].astype(np.float64)
+        self.mean = sample.mean(axis=0)
+        _, singular, axes = np.linalg.svd(sample - self.mean, full_matrices=False)
+        share = np.cumsum(singular**2) / max(float(np.sum(singular**2)), np.finfo(float).tiny)
+        p = min(int(np.searchsorted(share, PROJECTION_VARIANCE)) + 1, len(axes))
+        self.axes = axes[:p].T  # (d, p), orthonormal columns
+        self.data = data
+        self.workers = workers
+        self.tree = cKDTree(np.concatenate([self.embed(data[i:i + _EMBED_CHUNK])
+                                            for i in range(0, n, _EMBED_CHUNK)]))
+
+    def embed(self, x: np.ndarray) -> np.ndarray:
+        """``(m, p + 1)`` float64 embedding of frames ``(m, d)``."""
+        centred = x.astype(np.float64) - self.mean
+        projected = centred @ self.axes
+        residual = np.linalg.norm(centred - projected @ self.axes.T, axis=1)
+        return np.column_stack([projected, residual])
+
+    def _distances(self, x: np.ndarray, owner: np.ndarray, rows: np.ndarray) -> np.ndarray:
+        return np.sqrt(np.sum((self.data[rows].astype(np.float64) - x[owner].astype(np.float64)) ** 2, axis=1))
+
+    def query(self, x: np.ndarray, k: int, eps: float, bound: float) -> tuple[np.ndarray, np.ndarray]:
+        m, n = len(x), len(self.data)
+        z = self.embed(x)
+        _, near = self.tree.query(z, k=k, workers=self.workers)
+        near = np.reshape(near, (m, k))
+        upper = self._distances(x, np.repeat(np.arange(m), k), near.ravel()).reshape(m, k).max(axis=1)
+        radius = np.minimum(upper, bound)
+        # a hair wider than r, so that rounding in the embedding cannot drop a frame at exactly r
+        found = self.tree.query_ball_point(z, radius * (1.0 + 1e-9) + 1e-9, workers=self.workers)
+        counts = np.fromiter((len(f) for f in found), dtype=np.int64, count=m)
+        rows = np.fromiter((i for f in found for i in f), dtype=np.int64, count=int(counts.sum()))
+        owner = np.repeat(np.arange(m), counts)
+        dist = self._distances(x, owner, rows)
+        keep = dist <= bound
+        owner, rows, dist = owner[keep], rows[keep], dist[keep]
+        order = np.lexsort((rows, dist, owner))  # by query, then distance, then frame index
+        owner, rows, dist = owner[order], rows[order], dist[order]
+        starts = np.searchsorted(owner, np.arange(m))
+        rank = np.arange(len(owner)) - starts[owner]
+        first = rank < k
+        distances, indices = np.full((m, k), np.inf), np.full((m, k), n, dtype=np.int64)
+        distances[owner[first], rank[first]] = dist[first]
+        indices[owner[first], rank[first]] = rows[first]
+        return distances, indices
 
 
 def _import_faiss() -> Any:
@@ -202,6 +278,8 @@ def auto_engine(dim: int) -> str:
 def _make_engine(engine: str, data: np.ndarray, workers: int, state: np.ndarray | None = None) -> Any:
     if engine == "ckdtree":
         return _CKDTree(data, workers)
+    if engine == "ckdtree-pca":
+        return _ProjectedKDTree(data, workers)
     if engine == "pykdtree":
         return _PyKDTree(data, workers)
     kinds = {"faiss": "flat", "faiss-hnsw": "hnsw", "faiss-ivf": "ivf"}

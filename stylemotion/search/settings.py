@@ -60,9 +60,10 @@ class SearchSettings(MotionFileKeys):
     ``top``: most matches reported (non-overlapping, best first).
     ``eps``: approximate k-NN: each distance within ``(1 + eps)`` of the true one; 0 = exact.
     ``radius``: fixed-radius k-NN (feature units): only neighbours within it; None = the k nearest.
-    ``engine``: k-NN engine: auto (exact: a kd-tree for few feature dimensions, faiss' brute force for many, by the
+    ``engine``: k-NN engine: auto (exact: a kd-tree for few feature dimensions, a projected kd-tree for many, by the
     rule :data:`stylemotion.search.index.AUTO_ENGINES` that ``python scripts/benchmarks.py run engines`` measures;
-    docs/search.md, "Engines and scale") | ckdtree | pykdtree | faiss (exact) | faiss-hnsw | faiss-ivf (approximate).
+    docs/search.md, "Engines and scale") | ckdtree | ckdtree-pca | pykdtree | faiss (exact) | faiss-hnsw |
+    faiss-ivf (approximate).
     ``normalize``: reported cost: none (the thesis' accumulated distance) | length | query.
     ``exclude_query_take``: a take query: leave its own take out of the results.
     ``retarget_query``: a BVH query: put it on the dataset's skeleton (``data.retarget``'s, else the median bones

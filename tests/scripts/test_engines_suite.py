@@ -37,19 +37,24 @@ def test_recall_counts_frames_within_the_exact_kth_distance(suite):
     np.testing.assert_array_equal(d, [[5.0, 0.0, np.inf]])
 
 
-@pytest.mark.parametrize("times, want", [
-    # kd-trees faster up to 45 dimensions, faiss above: the rule's limit is 45, with the faster kd-tree
-    ([{"ckdtree": 0.1, "pykdtree": 0.2, "faiss": 1.0}, {"ckdtree": 0.3, "pykdtree": 0.4, "faiss": 1.0},
-      {"ckdtree": 2.0, "pykdtree": 3.0, "faiss": 1.0}], {"limit": 45, "kd": "ckdtree", "per_set":
-                                                        ["ckdtree", "ckdtree", "faiss"]}),
+@pytest.mark.parametrize("times, candidates, want", [
+    # one engine faster up to 45 dimensions, another above: the rule's limit is 45
+    ([{"ckdtree": 0.1, "ckdtree-pca": 0.2, "faiss": 1.0}, {"ckdtree": 0.3, "ckdtree-pca": 0.4, "faiss": 1.0},
+      {"ckdtree": 2.0, "ckdtree-pca": 0.5, "faiss": 1.0}], ("ckdtree", "ckdtree-pca"),
+     {"limit": 45, "low": "ckdtree", "high": "ckdtree-pca", "per_set": ["ckdtree", "ckdtree", "ckdtree-pca"]}),
+    # the fastest engine (pykdtree) is no candidate: the closest candidate rule, one engine for all
     ([{"ckdtree": 0.2, "pykdtree": 0.1, "faiss": 1.0}, {"ckdtree": 0.4, "pykdtree": 0.3, "faiss": 1.0},
-      {"ckdtree": 0.4, "pykdtree": 0.3, "faiss": 1.0}], {"limit": None, "kd": "pykdtree", "per_set":
-                                                        ["pykdtree"] * 3}),
+      {"ckdtree": 0.4, "pykdtree": 0.3, "faiss": 1.0}], ("ckdtree", "faiss"),
+     {"limit": None, "low": "ckdtree", "high": "ckdtree", "per_set": ["ckdtree"] * 3}),
     ([{"ckdtree": 2.0, "faiss": 1.0}, {"ckdtree": 2.0, "faiss": 1.0}, {"ckdtree": 2.0, "faiss": 1.0}],
-     {"limit": 0, "kd": "ckdtree", "per_set": ["faiss"] * 3}),
+     ("ckdtree", "faiss"), {"limit": None, "low": "faiss", "high": "faiss", "per_set": ["faiss"] * 3}),
+    # a candidate not measured on some set is never chosen for it
+    ([{"ckdtree": 1.0}, {"ckdtree": 1.0, "ckdtree-pca": 0.5}, {"ckdtree": 1.0, "ckdtree-pca": 0.5}],
+     ("ckdtree", "ckdtree-pca"), {"limit": 15, "low": "ckdtree", "high": "ckdtree-pca",
+                                  "per_set": ["ckdtree", "ckdtree-pca", "ckdtree-pca"]}),
 ])
-def test_the_implied_rule(suite, times, want):
-    got = suite.implied_rule([15, 45, 75], times)
+def test_the_implied_rule(suite, times, candidates, want):
+    got = suite.implied_rule([15, 45, 75], times, candidates)
     assert {key: got[key] for key in want} == want
     fastest = [min(t.values()) for t in times]
     logs = [math.log(t[e] / f) for t, e, f in zip(times, want["per_set"], fastest)]
@@ -84,6 +89,7 @@ def test_a_quick_run_on_synthetic_data_and_its_render(suite):
         for engine, v in row["engines"].items():
             assert v["1"]["batched"]["n"] == r["clips"] and v["1"]["single"]["n"] == r["clips"] * r["single_per_clip"]
             assert v["build_s"] >= 0 and v["1"]["batched"]["p50"] > 0
+            assert v["1"]["batched"]["mean"] > 0
             if engine.startswith("faiss"):  # a faiss index holds every vector as float32 (HNSW and IVF add more)
                 assert v["index_mb"] * 2**20 >= r["frames"] * row["dim"] * 4
             else:

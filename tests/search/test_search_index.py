@@ -20,6 +20,7 @@ from stylemotion.search.index import (
     AUTO_ENGINES,
     AUTO_FALLBACK,
     EXACT_ENGINES,
+    FLOAT64_ENGINES,
     SEARCH_FORMAT,
     auto_engine,
     faiss_available,
@@ -27,7 +28,7 @@ from stylemotion.search.index import (
     ivf_lists,
 )
 
-ENGINES_HERE = ["ckdtree"] + [e for e, module in (("pykdtree", "pykdtree"), ("faiss", "faiss"))
+ENGINES_HERE = ["ckdtree", "ckdtree-pca"] + [e for e, module in (("pykdtree", "pykdtree"), ("faiss", "faiss"))
                               if importlib.util.find_spec(module) is not None]
 
 
@@ -53,7 +54,7 @@ def _check_exact(index: FrameIndex, queries: np.ndarray, k: int, engine: str) ->
     true_d, true_i = brute_force(index.features, queries, k + 1)  # one more, to see ties at the k-th place
     after, true_d, true_i = true_d[:, k:], true_d[:, :k], true_i[:, :k]
     assert dist.shape == idx.shape == (len(queries), k)
-    tol = 1e-12 if engine == "ckdtree" else 1e-5  # float32 arithmetic in pykdtree / faiss
+    tol = 1e-12 if engine in FLOAT64_ENGINES else 1e-5  # float32 arithmetic in pykdtree / faiss
     np.testing.assert_allclose(dist, true_d, rtol=tol, atol=tol)
     # Every returned frame really lies at the returned distance (indices agree up to exact ties).
     own = np.linalg.norm(index.features[idx].astype(np.float64) - queries[:, None, :], axis=-1)
@@ -81,6 +82,28 @@ def test_exact_search_equals_brute_force_on_random_data(database, engine):
     assert d1.shape == i1.shape == (5,)
     np.testing.assert_array_equal(i1, i_batch[3])
     np.testing.assert_allclose(d1, d_batch[3])
+
+
+def test_projected_engine_is_exact_where_the_projection_drops_dimensions(database):
+    """``ckdtree-pca`` on features of low intrinsic dimension (its embedding drops most axes, so the filter
+    matters) with duplicated rows: the same answers as numpy brute force; its embedding never lengthens a
+    distance."""
+    rng = np.random.default_rng(7)
+    latent = rng.normal(size=(database.num_frames, 6)) * np.array([3.0, 2.0, 1.0, 0.5, 0.2, 0.1])
+    features = (latent @ rng.normal(size=(6, 75)) + rng.normal(0, 0.01, (database.num_frames, 75))).astype(np.float32)
+    features[1::5] = features[::5][:len(features[1::5])]
+    index = FrameIndex(database, "E15x5", features, engine="ckdtree-pca")
+    engine = index._engine
+    assert engine.axes.shape[1] < 75  # the projection drops axes
+    queries = np.concatenate([features[::53][:20] + rng.normal(0, 0.05, (20, 75)), features[::91][:10]])
+    queries = queries.astype(np.float32)
+    for k in (1, 16):
+        _check_exact(index, queries, k, "ckdtree-pca")
+    pairs = rng.choice(len(features), size=(500, 2))
+    a, b = features[pairs[:, 0]], features[pairs[:, 1]]
+    true = np.linalg.norm(a.astype(np.float64) - b, axis=1)
+    embedded = np.linalg.norm(engine.embed(a) - engine.embed(b), axis=1)
+    assert np.all(embedded <= true * (1 + 1e-12) + 1e-12) and np.mean(embedded / np.maximum(true, 1e-9)) > 0.5
 
 
 @pytest.mark.parametrize("feature_set", ["E15", "E15x3", "pca8", "EP19"])
