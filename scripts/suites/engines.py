@@ -45,6 +45,8 @@ DEFAULT_SEEDS = (0,)
 MEASURED_ENGINES = ("ckdtree", "ckdtree-pca", "pykdtree", "faiss", "faiss-hnsw", "faiss-ivf")
 #: Engines that take their thread count at construction (scipy's ``workers``): built twice, once per count.
 SCIPY_ENGINES = ("ckdtree", "ckdtree-pca")
+#: The exact engines among :data:`MEASURED_ENGINES`.
+EXACT_ENGINES_MEASURED = ("ckdtree", "ckdtree-pca", "pykdtree", "faiss")
 #: Aims of issue 29: every set's 16-NN with the default engine, and the approximate engines' recall.
 AIM_MS = 0.5
 AIM_RECALL = 0.99
@@ -591,9 +593,48 @@ def _headline(r: dict[str, Any]) -> str:
                                        "HNSW, IVF recall@16 at default breadth (aim ≥ 0.99)"], rows))
 
 
+def _summary(r: dict[str, Any]) -> str:
+    """One paragraph for BENCHMARKS.md: the aims with ``auto``'s engine, the approximate recall, the scale run."""
+    rows = [row for row in r["sets"] if row["auto"] in row["engines"]]
+    p50 = {row["features"]: row["engines"][row["auto"]]["1"]["batched"]["p50"] for row in rows}
+    mean = {row["features"]: row["engines"][row["auto"]]["1"]["batched"].get("mean") for row in rows}
+    over_mean = [f"{name} {fmt(v, 3)} ms" for name, v in mean.items() if v is not None and v > AIM_MS]
+    recalls = [b["recall"] for row in r["sets"] for sweep in row["breadths"].values() for b in sweep if b["default"]]
+    gains = []
+    for row in rows:
+        e = row["engines"]
+        if row["auto"] == "ckdtree-pca" and "ckdtree" in e and e["ckdtree"]["1"]["batched"].get("mean"):
+            gains.append(e["ckdtree"]["1"]["batched"]["mean"] / e["ckdtree-pca"]["1"]["batched"]["mean"])
+    text = (f"16-NN per query frame with `engine=auto` against all {r['frames']:,} train + val frames of Bandai "
+            f"(batched, 1 thread): median over clips {fmt(min(p50.values()), 3)}–{fmt(max(p50.values()), 3)} ms, "
+            f"{sum(v <= AIM_MS for v in p50.values())} of {len(p50)} sets within the {AIM_MS} ms aim on the median, "
+            f"{sum(v is not None and v <= AIM_MS for v in mean.values())} of {len(mean)} on the mean over clips"
+            + (f" ({', '.join(over_mean)})" if over_mean else "") + ".")
+    if gains:
+        text += (f" On the windowed sets the projected kd-tree `ckdtree-pca` is × {fmt(min(gains), 1)}–"
+                 f"{fmt(max(gains), 1)} faster than cKDTree on the mean over clips.")
+    if recalls:
+        text += f" HNSW and IVF at their default breadth: recall@16 ≥ {min(recalls):.3f}."
+    scale = r.get("scale")
+    if scale:
+        parts = []
+        for row in scale["sets"]:
+            e = row["engines"]
+            exact = min((v["1"]["batched"]["p50"], name) for name, v in e.items() if name in EXACT_ENGINES_MEASURED)
+            part = f"{row['features']} fastest exact {exact[1]} {fmt(exact[0], 2)} ms"
+            if "faiss-ivf" in e:
+                v = e["faiss-ivf"]
+                part += f", IVF {fmt(v['1']['batched']['p50'], 2)} ms at recall {v.get('recall', float('nan')):.4f}"
+            parts.append(part)
+        text += (f" At {scale['frames']:,} frames (jittered copies; median, 1 thread): {'; '.join(parts)}; peak "
+                 f"resident set {fmt(scale['peak_rss_mb'] / 1024, 1)} GB.")
+    return _quick_note(r) + text + " ([benchmarks/engines.md](benchmarks/engines.md))"
+
+
 def render(record: dict[str, Any]) -> dict[str, str]:
     r = record["results"]
     line = provenance_line(record)
-    return {"headline": f"{_headline(r)}\n\n{line}", "table": f"{_table(r)}\n\n{line}",
+    return {"summary": f"{_summary(r)} {line}", "headline": f"{_headline(r)}\n\n{line}",
+            "table": f"{_table(r)}\n\n{line}",
             "choice": f"{_choice(r)}\n\n{line}", "approximate": f"{_approximate(r)}\n\n{line}",
             "scale": f"{_scale(r)}\n\n{line}"}

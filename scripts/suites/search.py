@@ -55,6 +55,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="k_max candidates of the growth (capped at the database's frames)")
     parser.add_argument("--grow-stable-for", type=int, nargs="+", default=[1, 2, 3],
                         help="stable_for candidates of grow=stable: doublings in a row the best segment must hold")
+    parser.add_argument("--refine", type=int, nargs="+", default=[0, 8, 32],
+                        help="refine candidates (LNG candidates re-ranked by exact DTW in windows; 0: none), chosen "
+                             "on val with the growth")
     parser.add_argument("--eps", type=float, nargs="+", default=[0.1, 0.5], help="ε-approximate k-NN evaluated")
     parser.add_argument("--radii", type=float, nargs="+", default=[0.2], help="fixed radii (E15 units) evaluated")
     parser.add_argument("--approx-lengths-s", type=float, nargs="+", default=[1.0, 3.0],
@@ -82,19 +85,24 @@ def _choose_k(val: dict[int, list[float]], ks: list[int]) -> tuple[int, str]:
                                                     f"highest share")
 
 
-#: The command's growth (grow, k_max, stable_for) before issue 28's stricter stop: run on test beside the chosen.
-PREVIOUS_GROWTH = ("stable", 16384, 1)
+#: The command's growth (grow, k_max, stable_for, refine) before issue 28's stricter stop: run on test beside the
+#: chosen.
+PREVIOUS_GROWTH = ("stable", 16384, 1, 0)
 
 
-def _growth_name(grow: str, k_max: int, stable_for: int = 1) -> str:
-    """Key of a growth rule in the results: ``grow <rule> to <k_max>``, ``grow stable over <n> to <k_max>``
-    when the best segment must hold over n > 1 doublings."""
-    return f"grow {grow} to {k_max}" if stable_for == 1 else f"grow {grow} over {stable_for} to {k_max}"
+def _growth_name(grow: str, k_max: int, stable_for: int = 1, refine: int = 0) -> str:
+    """Key of a search rule in the results: ``grow <rule> to <k_max>``, ``grow stable over <n> to <k_max>``
+    when the best segment must hold over n > 1 doublings, `` + refine <N>`` when the LNG's N best candidates
+    are re-ranked by exact DTW."""
+    name = f"grow {grow} to {k_max}" if stable_for == 1 else f"grow {grow} over {stable_for} to {k_max}"
+    return name + (f" + refine {refine}" if refine else "")
 
 
-def _rule(chosen: list[Any] | tuple[Any, ...]) -> tuple[str, int, int]:
-    """``(grow, k_max, stable_for)`` of a recorded rule (a results file before ``stable_for``: 1)."""
-    return str(chosen[0]), int(chosen[1]), int(chosen[2]) if len(chosen) > 2 else 1
+def _rule(chosen: list[Any] | tuple[Any, ...]) -> tuple[str, int, int, int]:
+    """``(grow, k_max, stable_for, refine)`` of a recorded rule (a results file before ``stable_for``: 1, before
+    ``refine``: 0)."""
+    return (str(chosen[0]), int(chosen[1]), int(chosen[2]) if len(chosen) > 2 else 1,
+            int(chosen[3]) if len(chosen) > 3 else 0)
 
 
 def _val_share(per: dict[Any, list], seeds: list[int], lengths: list[float], ks: list[int]) -> dict[int, list[float]]:
@@ -105,21 +113,21 @@ def _val_share(per: dict[Any, list], seeds: list[int], lengths: list[float], ks:
 
 
 def _choose_growth(per: dict[Any, list], used: dict[Any, list], seeds: list[int], lengths: list[float],
-                   candidates: list[tuple[str, int, int]], start_k: int) -> dict[str, Any]:
-    """The growth rule (grow, k_max, stable_for) chosen on every val query (all lengths): among those that answer
-    every query and return DTW's best segment for the aim's share at **every** query length (mean over seeds; the
-    aim holds per length, so 1 s queries cannot carry 5 s ones), the one of least mean k used; else the highest
-    share at the worst length (then the highest overall, fewest unanswered, least mean k). Remaining ties (a bound
-    no val query reached costs nothing more on val) go to the larger k_max: headroom for queries unlike
-    validation's."""
+                   candidates: list[tuple[str, int, int, int]], start_k: int) -> dict[str, Any]:
+    """The search rule (grow, k_max, stable_for, refine) chosen on every val query (all lengths): among those that
+    answer every query and return DTW's best segment for the aim's share at **every** query length (mean over
+    seeds; the aim holds per length, so 1 s queries cannot carry 5 s ones), the one of least mean k used, then
+    fewest candidates refined; else the highest share at the worst length (then the highest overall, fewest
+    unanswered, least mean k, fewest refined). Remaining ties (a bound no val query reached costs nothing more on
+    val) go to the larger k_max: headroom for queries unlike validation's."""
     scores = {}
-    for grow, km, sf in candidates:
-        name = _growth_name(grow, km, sf)
+    for grow, km, sf, refine in candidates:
+        name = _growth_name(grow, km, sf, refine)
         records = {seed: [r for sec in lengths for r in per[("val", seed, sec, name)]] for seed in seeds}
         ks_used = [u for seed in seeds for sec in lengths for u in used[("val", seed, sec, name)]]
         by_length = {f"{sec:g}": float(np.mean([np.mean([r["same_segment"] for r in per[("val", seed, sec, name)]])
                                                 for seed in seeds])) for sec in lengths}
-        scores[name] = {"grow": grow, "k_max": km, "stable_for": sf,
+        scores[name] = {"grow": grow, "k_max": km, "stable_for": sf, "refine": refine,
                         "same_segment": [float(np.mean([r["same_segment"] for r in rs])) for rs in records.values()],
                         "same_segment_by_length": by_length,
                         "no_path": int(sum(r["no_path"] for rs in records.values() for r in rs)),
@@ -129,27 +137,33 @@ def _choose_growth(per: dict[Any, list], used: dict[Any, list], seeds: list[int]
     worst = {n: min(v["same_segment_by_length"].values()) for n, v in scores.items()}
     reaching = [n for n, v in scores.items() if v["no_path"] == 0 and worst[n] >= SAME_SEGMENT_AIM]
     if reaching:
-        name = min(reaching, key=lambda n: (scores[n]["mean_k_used"], -scores[n]["k_max"]))
+        name = min(reaching, key=lambda n: (scores[n]["mean_k_used"], scores[n]["refine"], -scores[n]["k_max"]))
         why = (f"least mean k used among the rules answering every val query with DTW's best segment for "
-               f"≥ {SAME_SEGMENT_AIM:.0%} of them at every query length (ties: the larger k_max)")
+               f"≥ {SAME_SEGMENT_AIM:.0%} of them at every query length (ties: fewer candidates refined, then the "
+               f"larger k_max)")
     else:
         name = max(scores, key=lambda n: (worst[n], mean[n], -scores[n]["no_path"], -scores[n]["mean_k_used"],
-                                          scores[n]["k_max"]))
+                                          -scores[n]["refine"], scores[n]["k_max"]))
         why = (f"no rule reached {SAME_SEGMENT_AIM:.0%} at every length with every val query answered: the highest "
                f"share at the worst length")
     return {"candidates": scores, "start_k": start_k, "rule": why, "aim": SAME_SEGMENT_AIM, "chosen_name": name,
-            "chosen": [scores[name]["grow"], scores[name]["k_max"], scores[name]["stable_for"]],
+            "chosen": [scores[name]["grow"], scores[name]["k_max"], scores[name]["stable_for"],
+                       scores[name]["refine"]],
             "chosen_on": "val: queries cut from the val takes against the train takes (never test)",
-            "default_at_run": [SearchSettings.grow, SearchSettings.k_max, SearchSettings.stable_for],
+            "default_at_run": [SearchSettings.grow, SearchSettings.k_max, SearchSettings.stable_for,
+                               SearchSettings.refine],
             "lengths_s": lengths}
 
 
-def _test_variants(chosen: list[Any]) -> list[tuple[str, int, int]]:
-    """The growth rules run on test: the chosen one and, beside it, its other rule to the same bound, ``stable``
-    with ``stable_for`` 1 to the same bound, and :data:`PREVIOUS_GROWTH` (each once)."""
-    grow, km, sf = _rule(chosen)
+def _test_variants(chosen: list[Any], refine_options: list[int] | None = None) -> list[tuple[str, int, int, int]]:
+    """The search rules run on test: the chosen one and, beside it, the same growth with every other refine
+    option measured (``refine_options``), its other rule to the same bound, ``stable`` with ``stable_for`` 1 to the
+    same bound, and :data:`PREVIOUS_GROWTH` (each once)."""
+    grow, km, sf, refine = _rule(chosen)
     other = "path" if grow == "stable" else "stable"
-    return list(dict.fromkeys([(grow, km, sf), (other, km, 1), ("stable", km, 1), PREVIOUS_GROWTH]))
+    same_growth = [(grow, km, sf, n) for n in sorted(set(refine_options or [refine])) if n != refine]
+    return list(dict.fromkeys([(grow, km, sf, refine), *same_growth, (other, km, 1, 0), ("stable", km, 1, 0),
+                               PREVIOUS_GROWTH]))
 
 
 def _as_best(result: Any, index: Any) -> tuple[int, int, float, int] | None:
@@ -167,7 +181,7 @@ def _test_extras(features: np.ndarray, index: Any, cache: Any, seconds: float, a
     from stylemotion.search import search_features
     from stylemotion.search.lng import GAP_STEPS, lng_match
 
-    grow, km, sf = _rule(chosen)
+    grow, km, sf, refine = _rule(chosen)
     dist, ind = cache(start_k)
     found = lng_match(ind, dist, index.database.take_bounds, steps=GAP_STEPS, top=1)
     out = {f"gaps at {start_k}": (found[0].start, found[0].end, found[0].cost, found[0].take) if found else None}
@@ -179,16 +193,16 @@ def _test_extras(features: np.ndarray, index: Any, cache: Any, seconds: float, a
         return result, time.perf_counter() - t0
 
     _, old = timed()
-    result, new = timed(k_max=km, grow=grow, stable_for=sf)
-    costs[(seconds, _growth_name(grow, km, sf))].append(new / old)
+    result, new = timed(k_max=km, grow=grow, stable_for=sf, refine=refine)
+    costs[(seconds, _growth_name(grow, km, sf, refine))].append(new / old)
     if seconds in args.approx_lengths_s:
         for eps in args.eps:
-            result, t = timed(k_max=km, grow=grow, stable_for=sf, eps=eps)
+            result, t = timed(k_max=km, grow=grow, stable_for=sf, refine=refine, eps=eps)
             out[f"eps {eps:g}"] = _as_best(result, index)
             used[("test", seed, seconds, f"eps {eps:g}")].append(result.k)
             costs[(seconds, f"eps {eps:g}")].append(t / old)
         for radius in args.radii:
-            result, t = timed(k_max=km, grow=grow, stable_for=sf, radius=radius)
+            result, t = timed(k_max=km, grow=grow, stable_for=sf, refine=refine, radius=radius)
             out[f"radius {radius:g}"] = _as_best(result, index)
             used[("test", seed, seconds, f"radius {radius:g}")].append(result.k)
             costs[(seconds, f"radius {radius:g}")].append(t / old)
@@ -223,8 +237,9 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
     classes: dict[tuple[str, float], list[str]] = defaultdict(list)
     costs: dict[Any, list] = defaultdict(list)  # (seconds, key) -> test seconds per query
     swept = []
-    candidates = [(rule, km, sf) for rule in args.grow_rules for km in sorted(set(args.grow_bounds))
-                  for sf in (sorted(set(args.grow_stable_for)) if rule == "stable" else [1])]
+    refine_options = sorted(set(args.refine))
+    candidates = [(rule, km, sf, n) for rule in args.grow_rules for km in sorted(set(args.grow_bounds))
+                  for sf in (sorted(set(args.grow_stable_for)) if rule == "stable" else [1]) for n in refine_options]
     growth_choice: dict[str, Any] = {}
     for p, part in enumerate(("val", "test")):
         index, takes = indexes[part], split[part]
@@ -232,7 +247,7 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
         if part == "test":
             chosen, rule = _choose_k(_val_share(per, seeds, args.lengths_s, ks), ks)
             growth_choice = _choose_growth(per, used, seeds, args.lengths_s, candidates, DEFAULT_K)
-            candidates = _test_variants(growth_choice["chosen"])
+            candidates = _test_variants(growth_choice["chosen"], refine_options)
         for seed in seeds:
             for seconds in args.lengths_s:
                 m = int(round(seconds * bandai.fps))
@@ -240,14 +255,16 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
                 for t, start in random_segments([tk.num_frames for tk in takes], m, args.lng_queries, rng):
                     clip = np.asarray(takes[t].positions[start:start + m])
                     features = index.features_of(clip)
-                    cache = NeighbourCache(index, features, bounds)
+                    cache = NeighbourCache(index, features, bounds, top=max(1, *refine_options))
                     cache(max(ks))
                     variants = {}
-                    for grow, km, sf in candidates:
-                        name = _growth_name(grow, km, sf)
-                        variants[name], k_used = cache.grown(DEFAULT_K, km, grow, sf)
+                    for grow, km, sf, n in candidates:
+                        name = _growth_name(grow, km, sf, n)
+                        variants[name], k_used = cache.grown(DEFAULT_K, km, grow, sf, n)
                         used[(part, seed, seconds, name)].append(k_used)
-                    bounding = list(variants)
+                    # LNG costs bound DTW's from above; refined ones are DTW costs within windows (skips priced
+                    # over the windows), so they stay out of the pruning
+                    bounding = [name for (grow, km, sf, n), name in zip(candidates, variants) if not n]
                     if part == "test":
                         variants.update(_test_extras(features, index, cache, seconds, args, growth_choice["chosen"],
                                                      DEFAULT_K, costs, used, seed))
@@ -312,7 +329,7 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
             "still_speed_m_s": STILL_SPEED_M_S,
             "k_choice": {"candidates": ks, "val_same_segment_1s": {str(k): val_share[k] for k in ks},
                          "rule": rule, "aim": SAME_SEGMENT_AIM, "chosen": chosen, "default_at_run": DEFAULT_K},
-            "growth": growth_choice, "time_ratio": timing,
+            "growth": growth_choice, "refine_options": refine_options, "time_ratio": timing,
             "approx": {"eps": args.eps, "radii": args.radii, "lengths_s": args.approx_lengths_s,
                        "note": "evaluated on test with the chosen growth; not tuned, defaults eps=0, radius=None"},
             "dtw_takes_swept": {"mean": float(np.mean(swept)), "max": int(np.max(swept))},
@@ -397,7 +414,7 @@ def _captures(bandai: Any, seeds: list[int], windows: int, lengths_s: list[float
     from stylemotion.search.dtw import best_subsequence_match
     from stylemotion.search.evaluation import precision_at, spearman_with_misses
 
-    grow, k_max, stable_for = _rule(growth)
+    grow, k_max, stable_for, refine = _rule(growth)
     index = FrameIndex.build(bandai, "E15")
     bounds = index.database.take_bounds
     folder = DATA_ROOT / "other-skeletons"
@@ -421,7 +438,8 @@ def _captures(bandai: Any, seeds: list[int], windows: int, lengths_s: list[float
                     t0 = time.perf_counter()
                     fixed = search_features(features, index, k, 10)
                     t1 = time.perf_counter()
-                    result = search_features(features, index, k, 10, k_max=k_max, grow=grow, stable_for=stable_for)
+                    result = search_features(features, index, k, 10, k_max=k_max, grow=grow, stable_for=stable_for,
+                                             refine=refine)
                     ratios.append((time.perf_counter() - t1) / (t1 - t0))
                     ks_used.append(result.k)
                     found = result.matches
@@ -458,7 +476,8 @@ def _captures(bandai: Any, seeds: list[int], windows: int, lengths_s: list[float
                      "p10_walk_or_turn": spread(per_seed["p10_walk_or_turn"]),
                      "nearest_walk_or_turn": spread(per_seed["nearest_walk_or_turn"])})
     return {"files": list(CAPTURES), "k": k, "k_max": k_max, "grow": grow, "stable_for": stable_for,
-            "defaults": [SearchSettings.grow, SearchSettings.k_max, SearchSettings.stable_for], "top": 10,
+            "refine": refine, "defaults": [SearchSettings.grow, SearchSettings.k_max, SearchSettings.stable_for,
+                                           SearchSettings.refine], "top": 10,
             "features": "E15", "windows_per_file_length_seed": windows,
             "database_takes": index.database.num_takes, "database_frames": index.database.num_frames,
             "file_fps": {n: q.record["file_fps"] for n, q in files.items()},
@@ -476,23 +495,28 @@ def _growth_blocks(r: dict[str, Any], seeds: int, prov: str) -> dict[str, str]:
     for cname, c in growth["candidates"].items():
         by_length = c.get("same_segment_by_length", {})
         crow.append([c["grow"], f"{c['k_max']:,}", str(c.get("stable_for", 1)) if c["grow"] == "stable" else "—",
+                     str(c.get("refine", 0)),
                      _pct(float(np.mean(c["same_segment"]))),
                      ", ".join(f"{sec} s {_pct(v)}" for sec, v in by_length.items()) or "—",
                      ", ".join(_pct(v) for v in c["same_segment"]), f"{c['no_path']} of {c['queries']}",
                      fmt(c["mean_k_used"], 0), f"{c['max_k_used']:,}", "**chosen**" if cname == name else ""])
     default = growth["default_at_run"]
-    note = ("the command's default (grow, k_max, stable_for)" if _rule(default) == _rule(growth["chosen"])
+    note = ("the command's default (grow, k_max, stable_for, refine)" if _rule(default) == _rule(growth["chosen"])
             else f"**differs from the command's default at the run {_rule(default)}**")
-    choice_block = (md_table(["grow", "k_max", "stable for (doublings)", "val: same best segment (mean)",
+    choice_block = (md_table(["grow", "k_max", "stable for (doublings)", "refine (LNG candidates re-ranked by DTW)",
+                              "val: same best segment (mean)",
                               "per length", "per seed", "no path", "mean k used", "max k used", ""], crow)
                     + f"\n\nEvery val query of {', '.join(f'{x:g}' for x in growth['lengths_s'])} s (all seeds) from "
                       f"the val takes against the train takes, k starting at {start} (the command's k) and doubled: "
                       f"`stable` until the best segment has held over `stable_for` doublings in a row (1: the same "
                       f"at k and 2k; 2: at k, 2k and 4k), `path` until a path exists, never past k_max (nor the "
-                      f"database's frames). Chosen on {growth.get('chosen_on', 'val')}. Rule: {growth['rule']} (aim "
+                      f"database's frames); refine N: the LNG's N best candidates re-ranked by exact subsequence "
+                      f"DTW in windows widened by the query's length (0: the LNG's ranking). Chosen on "
+                      f"{growth.get('chosen_on', 'val')}. Rule: {growth['rule']} (aim "
                       f"{_pct(growth['aim'])}); chosen {name}: {note}. {prov}")
     lengths = sorted({p["query_s"] for p in r["lng_pooled"]})
-    variants = [start, *[_growth_name(*v) for v in _test_variants(growth["chosen"])], f"gaps at {start}"]
+    variants = [start, *[_growth_name(*v) for v in _test_variants(growth["chosen"], r.get("refine_options"))],
+                f"gaps at {start}"]
     rows = []
     for seconds in lengths:
         for v in variants:
@@ -699,8 +723,11 @@ def render(record: dict[str, Any]) -> dict[str, str]:
                    f"defaults (E15, k = {cap['k']}"
                    + (f" growing to k_max = {cap['k_max']} by grow = {cap['grow']}, as chosen on validation"
                       + (f" over {cap['stable_for']} doublings" if cap.get("stable_for", 1) > 1 else "")
+                      + (f", the LNG's {cap['refine']} best candidates re-ranked by exact DTW" if cap.get("refine")
+                         else "")
                       + ("" if _rule(cap.get("defaults") or ()) == _rule([cap["grow"], cap["k_max"],
-                                                                         cap.get("stable_for", 1)]) else
+                                                                         cap.get("stable_for", 1),
+                                                                         cap.get("refine", 0)]) else
                          f" (**the command's default at the run was {cap.get('defaults')}**)") if grown else "")
                    + f", top {cap['top']}); precision counts missing matches wrong, mean ± sd over seeds"
                    + ("; same best segment and ρ against exact subsequence DTW over all of Bandai (thesis steps), "

@@ -79,13 +79,16 @@ class NeighbourCache:
     answer kept: every k-rule (a fixed k, :func:`~stylemotion.search.matching.grow_k` with any start and bound)
     is then evaluated on the same neighbours without a second search.
 
-    ``features``: ``(m, d)`` the query's; ``eps``/``radius``: :meth:`FrameIndex.query`'s; ``steps``: the LNG's.
+    ``features``: ``(m, d)`` the query's; ``eps``/``radius``: :meth:`FrameIndex.query`'s; ``steps``: the LNG's;
+    ``top``: candidates the LNG ranks per k (the most a :meth:`grown` refinement re-ranks).
     """
 
     def __init__(self, index: FrameIndex, features: np.ndarray, takes: TakeBounds, *, eps: float = 0.0,
-                 radius: float | None = None, steps: tuple[tuple[int, int], ...] = THESIS_STEPS) -> None:
+                 radius: float | None = None, steps: tuple[tuple[int, int], ...] = THESIS_STEPS,
+                 top: int = 1) -> None:
         self.index, self.features, self.takes = index, features, takes
-        self.eps, self.radius, self.steps = eps, radius, steps
+        self.eps, self.radius, self.steps, self.top = eps, radius, steps, int(top)
+        self._refined: dict[tuple[int, int], list[Match]] = {}
         self._dist = np.zeros((len(features), 0))
         self._ind = np.zeros((len(features), 0), dtype=np.int64)
         self._found: dict[int, list[Match]] = {}
@@ -106,7 +109,8 @@ class NeighbourCache:
         """The LNG's best match on these neighbours (kept per k)."""
         k = int(ind.shape[1])
         if k not in self._found:
-            self._found[k] = lng_match(ind, dist, self.takes, steps=self.steps, top=1, skip_cost=self.radius)
+            self._found[k] = lng_match(ind, dist, self.takes, steps=self.steps, top=self.top,
+                                       skip_cost=self.radius)
         return self._found[k]
 
     def best(self, k: int) -> tuple[int, int, float, int] | None:
@@ -114,15 +118,24 @@ class NeighbourCache:
         found = self.match(*self(k)[::-1])
         return (found[0].start, found[0].end, found[0].cost, found[0].take) if found else None
 
-    def grown(self, k: int, k_max: int, grow: str, stable_for: int = 1
+    def grown(self, k: int, k_max: int, grow: str, stable_for: int = 1, refine: int = 0
               ) -> tuple[tuple[int, int, float, int] | None, int]:
         """The best match of :func:`~stylemotion.search.matching.grow_k` from ``k`` up to ``k_max`` (``grow``,
-        ``stable_for``: its rule) and the k it used."""
+        ``stable_for``: its rule) and the k it used; ``refine`` > 0: the best after re-ranking the LNG's ``refine``
+        best candidates at that k by exact DTW in windows (:func:`~stylemotion.search.refine.refine_matches`; at
+        most :attr:`top` candidates)."""
         from stylemotion.search.matching import grow_k
+        from stylemotion.search.refine import refine_matches
 
         found, _, ind, _ = grow_k(self, self.match, k, min(k_max, self.index.size), grow, stable_for)
+        used = int(ind.shape[1])
+        if refine and found:
+            if (used, refine) not in self._refined:
+                self._refined[(used, refine)] = refine_matches(self.features, self.index.features, self.takes,
+                                                               found[:refine], steps=self.steps)
+            found = self._refined[(used, refine)]
         best = (found[0].start, found[0].end, found[0].cost, found[0].take) if found else None
-        return best, int(ind.shape[1])
+        return best, used
 
 
 @dataclass(frozen=True)

@@ -34,6 +34,7 @@ import numpy as np
 
 from stylemotion.search.index import FrameIndex
 from stylemotion.search.lng import THESIS_STEPS, Match, Normalization, Step, check_skip_cost, lng_match
+from stylemotion.search.refine import refine_matches
 from stylemotion.search.settings import SearchSettings
 
 #: Neighbours per query frame by default: ``stylemotion-search``'s ``k`` (:class:`SearchSettings`, where it is
@@ -217,7 +218,7 @@ def search_features(features: np.ndarray, index: FrameIndex, k: int = DEFAULT_K,
                     exclude_takes: Iterable[str] = (), eps: float = 0.0, radius: float | None = None,
                     steps: tuple[Step, ...] = THESIS_STEPS, normalize: Normalization = "none",
                     k_max: int | None = None, grow: str = "none", stable_for: int = DEFAULT_STABLE_FOR,
-                    skip_cost: float | None = None) -> SearchResult:
+                    skip_cost: float | None = None, refine: int = 0) -> SearchResult:
     """Ranked database segments matching query features ``(m, d)`` (the index's feature set) as a whole.
 
     ``k``: neighbours per query frame (1 ≤ k ≤ database frames outside ``exclude_takes``), the first k a
@@ -225,20 +226,26 @@ def search_features(features: np.ndarray, index: FrameIndex, k: int = DEFAULT_K,
     frames outside ``exclude_takes``); ``top``: at most this many matches; ``exclude_takes``: take names left
     out; ``eps``/``radius``: the k-NN search's approximation and fixed radius (:meth:`FrameIndex.query`);
     ``steps``/``normalize``/``skip_cost``: the LNG's (:func:`lng_match`; ``skip_cost`` None: the radius when one
-    is given, else each frame's k-th distance).
+    is given, else each frame's k-th distance); ``refine``: re-rank the LNG's ``refine`` best candidates by exact
+    subsequence DTW in windows around them (:func:`~stylemotion.search.refine.refine_matches`; 0: the LNG's
+    ranking as it is), which makes the matches' costs exact DTW costs.
 
     Raises:
-        ValueError: bad ``k``/``k_max``/``top``/``grow``/``stable_for``/features, an unknown take name (KeyError).
+        ValueError: bad ``k``/``k_max``/``top``/``grow``/``stable_for``/``refine``/features, an unknown take name
+            (KeyError).
     """
     for value, key in ((k, "k"), (top, "top"), (k if k_max is None else k_max, "k_max")):
         if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
             raise ValueError(f"{key} must be a whole number ≥ 1, got {value!r}")
+    if isinstance(refine, bool) or not isinstance(refine, (int, np.integer)) or refine < 0:
+        raise ValueError(f"refine must be a whole number ≥ 0, got {refine!r}")
     skip_cost = radius if skip_cost is None else check_skip_cost(skip_cost)
     names, ids = _excluded_frames(index, exclude_takes)
     database = index.database
     available = database.num_frames - int(sum(database.take_start[i + 1] - database.take_start[i] for i in ids))
     bound = int(k) if k_max is None else min(int(k_max), max(available, int(k)))
     spent = {"knn": 0.0, "lng": 0.0}
+    candidates = max(int(top), int(refine))
 
     def neighbours(j: int) -> tuple[np.ndarray, np.ndarray]:
         t0 = time.perf_counter()
@@ -248,13 +255,18 @@ def search_features(features: np.ndarray, index: FrameIndex, k: int = DEFAULT_K,
 
     def match(ind: np.ndarray, dist: np.ndarray) -> list[Match]:
         t0 = time.perf_counter()
-        out = lng_match(ind, dist, database.take_bounds, steps=steps, normalize=normalize, top=int(top),
+        out = lng_match(ind, dist, database.take_bounds, steps=steps, normalize=normalize, top=candidates,
                         skip_cost=skip_cost)
         spent["lng"] += time.perf_counter() - t0
         return out
 
     found, distances, indices, tried = grow_k(neighbours, match, int(k), bound, grow, stable_for)
-    matches = [_segment(index, m, rank) for rank, m in enumerate(found, start=1)]
+    if refine:
+        t0 = time.perf_counter()
+        found = refine_matches(features, index.features, database.take_bounds, found[:refine], top=int(top),
+                               steps=steps, normalize=normalize, skip_cost=skip_cost)
+        spent["refine"] = time.perf_counter() - t0
+    matches = [_segment(index, m, rank) for rank, m in enumerate(found[:top], start=1)]
     return SearchResult(matches, indices, distances, tried[-1], names, spent, tried)
 
 

@@ -52,6 +52,8 @@ class SearchSettings(MotionFileKeys):
     exists, ``none`` never; ``search.json`` reports the k used and every k tried. Chosen (with ``k``'s role as
     the first k tried) on 1, 3 and 5 s queries cut from Bandai's validation takes against its train takes by
     ``python scripts/benchmarks.py run search`` (blocks ``growth_choice`` and ``growth`` of benchmarks/search.md).
+    ``refine``: re-rank the LNG's ``refine`` best candidates by exact subsequence DTW in windows around them
+    (:func:`stylemotion.search.refine.refine_matches`; the costs reported are then exact DTW costs); 0: off.
     ``steps``: the LNG's step set: thesis (diagonal, vertical, horizontal: a path may stay on one database
     frame) | online (the OLNG's (1,1), (1,2), (2,1), (2,2)) | gaps (thesis + online skips: a path may skip a query
     frame whose neighbours missed it, paying ``skip_cost``); not tuned: the thesis' set, as §2.4.1.
@@ -79,6 +81,7 @@ class SearchSettings(MotionFileKeys):
     k_max: int = 16384
     grow: str = "stable"
     stable_for: int = 2
+    refine: int = 0
     steps: str = "thesis"
     skip_cost: float | None = None
     top: int = 10

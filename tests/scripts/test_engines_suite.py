@@ -106,7 +106,7 @@ def test_a_quick_run_on_synthetic_data_and_its_render(suite):
     record = {"command": "python scripts/benchmarks.py run engines --quick", "commit": "abc",
               "started": "2026-12-04T00:00", "seeds": [0], "results": r}
     blocks = suite.render(record)
-    assert set(blocks) == {"headline", "table", "choice", "approximate", "scale"}
+    assert set(blocks) == {"summary", "headline", "table", "choice", "approximate", "scale"}
     assert all("Quick smoke run" in b for b in blocks.values())
     assert all(f"{row['auto']} ← auto" in blocks["table"] for row in r["sets"])
     assert "Measured rule" in blocks["choice"] and "Library (`AUTO_ENGINES`" in blocks["choice"]

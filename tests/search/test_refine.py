@@ -1,0 +1,90 @@
+"""Re-ranking LNG candidates by exact DTW in windows (stylemotion.search.refine) against subsequence DTW over the
+whole database, and its use in search_features."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from stylemotion.datasets.registry import load_dataset
+from stylemotion.search import FrameIndex
+from stylemotion.search.dtw import subsequence_dtw_features
+from stylemotion.search.lng import Match, TakeBounds
+from stylemotion.search.matching import search_features
+from stylemotion.search.refine import candidate_windows, refine_matches
+
+SKIP = 1e3  # one skip penalty for both sides (the default is a row's largest distance, which depends on the frames)
+
+
+def _walks(rng: np.random.Generator, lengths: list[int], d: int = 6) -> np.ndarray:
+    return np.concatenate([np.cumsum(rng.normal(0, 0.3, (n, d)), axis=0) for n in lengths])
+
+
+def test_windows_are_clipped_to_takes_and_merged():
+    takes = TakeBounds.from_lengths([100, 50, 80])  # frames 0–99, 100–149, 150–229
+
+    def match(a: int, b: int) -> Match:
+        return Match(a, b, 1.0, np.zeros((1, 2), dtype=np.int64), 0)
+
+    got = candidate_windows([match(10, 20), match(25, 40), match(105, 110), match(200, 229), match(90, 99)],
+                            takes, 10)
+    # 10–20 and 25–40 widen to 0–30 and 15–50 (merged); 90–99 to 80–99 (its own window: 50 < 80 - 1);
+    # 105–110 to 100–120 (not merged with frame 99's window: another take); 200–229 to 190–229
+    assert got == [(0, 50), (80, 99), (100, 120), (190, 229)]
+    assert candidate_windows([match(10, 20)], takes, 0) == [(10, 20)]
+    with pytest.raises(ValueError, match="widen"):
+        candidate_windows([match(10, 20)], takes, -1)
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_refine_finds_the_exact_best_when_a_candidate_lies_near_it(seed):
+    rng = np.random.default_rng(seed)
+    lengths = [int(n) for n in rng.integers(60, 200, size=12)]
+    database = _walks(rng, lengths)
+    takes = TakeBounds.from_lengths(lengths)
+    take = int(rng.integers(len(lengths)))
+    first = sum(lengths[:take])
+    query = database[first + 10:first + 40] + rng.normal(0, 0.05, (30, 6))
+    full = subsequence_dtw_features(query, database, takes, skip_cost=SKIP, top=3).matches
+    best = full[0]
+    near = Match(best.start + 5, best.end - 3, np.inf, best.path, best.take)  # a candidate off by a few frames
+    far = [m for m in full[1:]]
+    got = refine_matches(query, database, takes, [*far, near], top=3, skip_cost=SKIP)
+    assert (got[0].start, got[0].end, got[0].take) == (best.start, best.end, best.take)
+    assert got[0].cost == pytest.approx(best.cost, rel=1e-12)
+    assert [m.cost for m in got] == sorted(m.cost for m in got)
+    np.testing.assert_array_equal(got[0].path, best.path)
+
+
+def test_refine_never_beats_the_whole_database_and_stays_in_its_windows():
+    rng = np.random.default_rng(5)
+    lengths = [150] * 8
+    database = _walks(rng, lengths)
+    takes = TakeBounds.from_lengths(lengths)
+    query = database[620:660] + rng.normal(0, 0.05, (40, 6))  # take 4
+    best = subsequence_dtw_features(query, database, takes, skip_cost=SKIP).best
+    wrong = Match(100, 140, np.inf, np.zeros((1, 2), dtype=np.int64), 0)  # take 0 only
+    got = refine_matches(query, database, takes, [wrong], skip_cost=SKIP)
+    assert got and got[0].take == 0 and 60 <= got[0].start and got[0].end <= 149
+    assert got[0].cost >= best.cost
+    assert refine_matches(query, database, takes, [], skip_cost=SKIP) == []
+
+
+def test_search_with_refine_reports_exact_dtw_costs():
+    takeset = load_dataset("synthetic", takes_per_pair=1)
+    held_out = takeset.takes[3]
+    index = FrameIndex.build(takeset.__class__(takeset.name, [t for t in takeset.takes if t is not held_out],
+                                               takeset.fps), "E15", use_cache=False)
+    features = index.features_of(held_out.positions[5:65].astype(np.float64))
+    plain = search_features(features, index, k=8, top=3, k_max=64, grow="path")
+    refined = search_features(features, index, k=8, top=3, k_max=64, grow="path", refine=8)
+    assert refined.matches and "refine" in refined.timings
+    full = subsequence_dtw_features(features, index.features, index.database.take_bounds, top=1).best
+    assert refined.matches[0].cost <= plain.matches[0].cost + 1e-9
+    assert refined.matches[0].cost >= full.cost - 1e-9  # never below the exact optimum over every frame
+    for m in refined.matches:  # each reported cost is exact DTW of the query on that segment alone
+        seg = index.features[m.global_start:m.global_end]
+        alone = subsequence_dtw_features(features, seg, TakeBounds.from_lengths([len(seg)]), top=1).best
+        assert alone.cost <= m.cost + 1e-9
+    with pytest.raises(ValueError, match="refine"):
+        search_features(features, index, k=8, refine=-1)
