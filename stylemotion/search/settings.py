@@ -54,6 +54,8 @@ class SearchSettings(MotionFileKeys):
     ``python scripts/benchmarks.py run search`` (blocks ``growth_choice`` and ``growth`` of benchmarks/search.md).
     ``refine``: re-rank the LNG's ``refine`` best candidates by exact subsequence DTW in windows around them
     (:func:`stylemotion.search.refine.refine_matches`; the costs reported are then exact DTW costs); 0: off.
+    Chosen with ``grow``, ``k_max`` and ``stable_for`` on Bandai's validation queries by
+    ``python scripts/benchmarks.py run search`` (among 0, 8, 32; block ``growth_choice``).
     ``steps``: the LNG's step set: thesis (diagonal, vertical, horizontal: a path may stay on one database
     frame) | online (the OLNG's (1,1), (1,2), (2,1), (2,2)) | gaps (thesis + online skips: a path may skip a query
     frame whose neighbours missed it, paying ``skip_cost``); not tuned: the thesis' set, as §2.4.1.
@@ -81,7 +83,7 @@ class SearchSettings(MotionFileKeys):
     k_max: int = 16384
     grow: str = "stable"
     stable_for: int = 2
-    refine: int = 0
+    refine: int = 8
     steps: str = "thesis"
     skip_cost: float | None = None
     top: int = 10

@@ -76,7 +76,7 @@ def test_the_console_command_runs_and_refuses_in_one_line(tmp_path, capsys, monk
 
 
 def test_a_c3d_of_skin_markers_at_60_fps(tmp_path, capsys, monkeypatch):
-    import ezc3d
+    from c3d_writer import write_c3d
 
     from stylemotion.reconstruct.marker_set import SKIN_MARKERS, virtual_markers
 
@@ -85,14 +85,8 @@ def test_a_c3d_of_skin_markers_at_60_fps(tmp_path, capsys, monkeypatch):
     at_60 = np.repeat(truth, 2, axis=0)[:-1]  # 60 fps: each 30 fps pose twice (linear in between: the mean)
     at_60[1::2] = 0.5 * (truth[:-1] + truth[1:])
     markers = virtual_markers(at_60, SKIN_MARKERS)
-    c3d = ezc3d.c3d()
-    c3d["parameters"]["POINT"]["RATE"]["value"] = [60.0]
-    c3d["parameters"]["POINT"]["LABELS"]["value"] = list(SKIN_MARKERS.names)
-    points = np.ones((4, 6, len(markers)))
-    points[:3] = np.stack([markers[..., 0], -markers[..., 2], markers[..., 1]], axis=0).swapaxes(1, 2) * 1000.0
-    c3d["data"]["points"] = points
-    c3d.add_parameter("POINT", "UNITS", "mm")
-    c3d.write(str(tmp_path / "walk.c3d"))
+    z_up_mm = np.stack([markers[..., 0], -markers[..., 2], markers[..., 1]], axis=-1) * 1000.0
+    write_c3d(tmp_path / "walk.c3d", list(SKIN_MARKERS.names), z_up_mm, 60.0)
     summary = reconstruct_command(DATA, str(tmp_path / "walk.c3d"), tmp_path / "out", marker_set="skin",
                                   subject="markers", gif=False)
     with np.load(tmp_path / "out" / "motion.npz") as npz:

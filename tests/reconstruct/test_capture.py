@@ -3,28 +3,13 @@ CSV at another rate, resampling and virtual markers on a motion."""
 
 from __future__ import annotations
 
-import ezc3d
 import numpy as np
 import pytest
+from c3d_writer import write_c3d
 
 from stylemotion.reconstruct.capture import read_c3d, read_capture, resample_tracks, tracks_on_motion
 from stylemotion.reconstruct.marker_set import SKIN_MARKERS, joint_marker_set, virtual_markers
 from stylemotion.reconstruct.markers import MarkerGapWarning, MarkerInputError, MarkerTracks, write_marker_csv
-
-
-def write_c3d(path, labels, xyz_mm, rate, residual=None):
-    """A C3D of points ``xyz_mm`` ``(frames, points, 3)`` in millimetres, Z up, at ``rate`` (ezc3d's writer)."""
-    c3d = ezc3d.c3d()
-    c3d["parameters"]["POINT"]["RATE"]["value"] = [float(rate)]
-    c3d["parameters"]["POINT"]["LABELS"]["value"] = list(labels)
-    points = np.ones((4, len(labels), len(xyz_mm)))
-    points[:3] = np.moveaxis(np.asarray(xyz_mm, np.float64), -1, 0).swapaxes(1, 2)
-    c3d["data"]["points"] = points
-    if residual is not None:
-        c3d["data"]["meta_points"]["residuals"] = np.asarray(residual, np.float64).T[None]
-    c3d.add_parameter("POINT", "UNITS", "mm")
-    c3d.write(str(path))
-    return path
 
 
 def y_up_to_z_up_mm(positions_m):
