@@ -82,7 +82,7 @@ class SearchSettings(MotionFileKeys):
     k: int = 1024
     k_max: int = 16384
     grow: str = "stable"
-    stable_for: int = 2
+    stable_for: int = 1
     refine: int = 8
     steps: str = "thesis"
     skip_cost: float | None = None

@@ -40,3 +40,18 @@ def test_every_candidate_names_its_epochs_schedule_and_root_weight() -> None:
         assert keys == {"trainer.max_epochs", "model.lr_schedule", "model.lr", "model.root_weight"} | (
             {"model.lr_gamma"} if name == REF else {"model.warmup_epochs"}), name
         assert f"_e{suite.epochs_of(overrides)}" in name
+
+
+def test_the_test_block_reports_every_seed_and_their_spread() -> None:
+    per_seed = {str(s): {"test_mpjpe_m": v, "test_local_mpjpe_m": w, "test_windows": 344, "window_frames": 60,
+                         "val": {}, "train_seconds": 600.0, "reused": False}
+                for s, v, w in ((0, 0.0090, 0.0027), (1, 0.0100, 0.0029), (2, 0.0110, 0.0028))}
+    record = {"command": "python scripts/benchmarks.py run autoencoder_schedule", "commit": "abc",
+              "started": "2026-12-06T00:00", "seeds": [0],
+              "results": {"seed": 100, "test": {"candidate": "cos_lr2e-3_e40_root2", "seeds": [0, 1, 2],
+                                                "per_seed": per_seed}}}
+    block = suite._test_block(record["results"], record)
+    assert "| 1 | 1.000 | 0.290 | 10.0 |" in block
+    assert "1.000 ± 0.100 (0.900–1.100)" in block and "0.280 ± 0.010 (0.270–0.290)" in block
+    assert "344 windows of 60 frames" in block and "seed 100" in block
+    assert "Not run" in suite._test_block({"test": {}}, record)
