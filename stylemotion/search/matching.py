@@ -226,9 +226,10 @@ def search_features(features: np.ndarray, index: FrameIndex, k: int = DEFAULT_K,
     frames outside ``exclude_takes``); ``top``: at most this many matches; ``exclude_takes``: take names left
     out; ``eps``/``radius``: the k-NN search's approximation and fixed radius (:meth:`FrameIndex.query`);
     ``steps``/``normalize``/``skip_cost``: the LNG's (:func:`lng_match`; ``skip_cost`` None: the radius when one
-    is given, else each frame's k-th distance); ``refine``: re-rank the LNG's ``refine`` best candidates by exact
-    subsequence DTW in windows around them (:func:`~stylemotion.search.refine.refine_matches`; 0: the LNG's
-    ranking as it is), which makes the matches' costs exact DTW costs.
+    is given, else each frame's k-th distance); ``refine``: re-rank the LNG's ``max(refine, top)`` best candidates
+    by exact subsequence DTW in windows around them (:func:`~stylemotion.search.refine.refine_matches`; 0: the
+    LNG's ranking as it is), which makes the matches' costs exact DTW costs (every candidate's window is searched,
+    so as many matches come back as the LNG found, up to ``top``).
 
     Raises:
         ValueError: bad ``k``/``k_max``/``top``/``grow``/``stable_for``/``refine``/features, an unknown take name
@@ -263,7 +264,7 @@ def search_features(features: np.ndarray, index: FrameIndex, k: int = DEFAULT_K,
     found, distances, indices, tried = grow_k(neighbours, match, int(k), bound, grow, stable_for)
     if refine:
         t0 = time.perf_counter()
-        found = refine_matches(features, index.features, database.take_bounds, found[:refine], top=int(top),
+        found = refine_matches(features, index.features, database.take_bounds, found[:candidates], top=int(top),
                                steps=steps, normalize=normalize, skip_cost=skip_cost)
         spent["refine"] = time.perf_counter() - t0
     matches = [_segment(index, m, rank) for rank, m in enumerate(found[:top], start=1)]

@@ -52,7 +52,8 @@ class SearchSettings(MotionFileKeys):
     exists, ``none`` never; ``search.json`` reports the k used and every k tried. Chosen (with ``k``'s role as
     the first k tried) on 1, 3 and 5 s queries cut from Bandai's validation takes against its train takes by
     ``python scripts/benchmarks.py run search`` (blocks ``growth_choice`` and ``growth`` of benchmarks/search.md).
-    ``refine``: re-rank the LNG's ``refine`` best candidates by exact subsequence DTW in windows around them
+    ``refine``: re-rank the LNG's ``refine`` (at least ``top``) best candidates by exact subsequence DTW in windows
+    around them
     (:func:`stylemotion.search.refine.refine_matches`; the costs reported are then exact DTW costs); 0: off.
     Chosen with ``grow``, ``k_max`` and ``stable_for`` on Bandai's validation queries by
     ``python scripts/benchmarks.py run search`` (among 0, 8, 32; block ``growth_choice``).

@@ -86,5 +86,7 @@ def test_search_with_refine_reports_exact_dtw_costs():
         seg = index.features[m.global_start:m.global_end]
         alone = subsequence_dtw_features(features, seg, TakeBounds.from_lengths([len(seg)]), top=1).best
         assert alone.cost <= m.cost + 1e-9
+    few = search_features(features, index, k=8, top=3, k_max=64, grow="path", refine=1)  # refine < top: the
+    assert len(few.matches) == len(plain.matches) == 3  # windows of all top candidates, the list never shrinks
     with pytest.raises(ValueError, match="refine"):
         search_features(features, index, k=8, refine=-1)
