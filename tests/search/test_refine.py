@@ -86,7 +86,10 @@ def test_search_with_refine_reports_exact_dtw_costs():
         seg = index.features[m.global_start:m.global_end]
         alone = subsequence_dtw_features(features, seg, TakeBounds.from_lengths([len(seg)]), top=1).best
         assert alone.cost <= m.cost + 1e-9
-    few = search_features(features, index, k=8, top=3, k_max=64, grow="path", refine=1)  # refine < top: the
-    assert len(few.matches) == len(plain.matches) == 3  # windows of all top candidates, the list never shrinks
+    # refine < top: windows around every one of the LNG's top candidates, so the list never shrinks
+    few = search_features(features, index, k=8, top=3, k_max=64, grow="path", refine=1)
+    assert len(plain.matches) <= len(few.matches) <= 3
+    assert {(m.global_start, m.global_end) for m in few.matches} == {(m.global_start, m.global_end)
+                                                                      for m in refined.matches}
     with pytest.raises(ValueError, match="refine"):
         search_features(features, index, k=8, refine=-1)
