@@ -236,8 +236,7 @@ def best_subsequence_match(query: np.ndarray, database: np.ndarray, takes: TakeB
     tb = TakeBounds.coerce(takes)
     if tb.n != cost.shape[1]:
         raise ValueError(f"takes describe {tb.n} database frames, the features have {cost.shape[1]}")
-    ends = np.flatnonzero(tb.remaining == 0)
-    starts = np.concatenate([[0], ends[:-1] + 1])
+    starts, ends = tb.spans()
     bound = np.minimum.reduceat(cost, starts, axis=1).sum(axis=0)  # (takes,)
     order = np.argsort(bound, kind="stable")
 

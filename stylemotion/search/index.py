@@ -168,10 +168,12 @@ class _ProjectedKDTree:
         return np.column_stack([projected, residual])
 
     def _distances(self, x: np.ndarray, owner: np.ndarray, rows: np.ndarray) -> np.ndarray:
-        return np.sqrt(np.sum((self.data[rows].astype(np.float64) - x[owner].astype(np.float64)) ** 2, axis=1))
+        """Float64 distances from queries ``x[owner]`` (float64) to frames ``rows``."""
+        return np.sqrt(np.sum((self.data[rows].astype(np.float64) - x[owner]) ** 2, axis=1))
 
     def query(self, x: np.ndarray, k: int, eps: float, bound: float) -> tuple[np.ndarray, np.ndarray]:
         m, n = len(x), len(self.data)
+        x = x.astype(np.float64)  # once, for the embedding and both distance passes
         z = self.embed(x)
         _, near = self.tree.query(z, k=k, workers=self.workers)
         near = np.reshape(near, (m, k))

@@ -159,6 +159,11 @@ class TakeBounds:
         """Accept a :class:`TakeBounds` or a ``next_in_take`` array."""
         return takes if isinstance(takes, TakeBounds) else cls.from_next_in_take(takes)
 
+    def spans(self) -> tuple[np.ndarray, np.ndarray]:
+        """``(firsts, lasts)`` ``(takes,)`` each: the first and last frame of every take, ascending."""
+        lasts = np.flatnonzero(self.remaining == 0)
+        return np.concatenate([[0], lasts[:-1] + 1]), lasts
+
     def allows(self, p: np.ndarray, dg: int) -> np.ndarray:
         """``(...)`` bool: a step of ``dg`` database frames from frames ``p`` stays inside the database and
         the take."""

@@ -26,8 +26,7 @@ def candidate_windows(candidates: Sequence[Match], takes: TakeBounds, widen: int
     sorted by first frame."""
     if isinstance(widen, bool) or not isinstance(widen, (int, np.integer)) or widen < 0:
         raise ValueError(f"widen must be a whole number ≥ 0, got {widen!r}")
-    ends = np.flatnonzero(takes.remaining == 0)  # last frame of every take, ascending
-    firsts = np.concatenate([[0], ends[:-1] + 1])
+    firsts, ends = takes.spans()
     spans = []
     for match in candidates:
         t = int(np.searchsorted(ends, match.start))
