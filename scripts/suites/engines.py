@@ -8,9 +8,14 @@
    ("single") — median and p95 over the clips / frames, at 1 thread and at the machine's default thread count.
    The engines are timed back to back: per clip (per frame) every engine in turn, the order rotated, so a
    change of load touches them all alike; compare them as ratios within one run.
-2. **Choice.** The exact engine ``engine="auto"`` should pick per dimension: the rule "kd-tree up to D
-   dimensions, faiss' brute force above" closest to each set's fastest exact engine (geometric mean of the
-   ratios, batched, 1 thread), against the library's :data:`stylemotion.search.index.AUTO_ENGINES`.
+0. **Validation** (the choices). A database of the ``train`` takes only, queried with seeded clips of the ``val``
+   takes: per feature set, cKDTree and ``ckdtree-pca`` under each of :data:`FETCH_CANDIDATES` (its multi-step
+   rounds), back to back, batched, 1 thread. Chosen: the rounds with the least geometric mean of the mean ms per
+   query over the sets, then the ``auto`` rule (:func:`implied_rule` on those means) — against the library's
+   :data:`stylemotion.search.index.FILTER_FETCH` and :data:`stylemotion.search.index.AUTO_ENGINES`.
+2. **Check on test.** The rule "one engine up to D dimensions, another above" closest to each set's fastest exact
+   engine on the test clips (geometric mean of the ratios of medians, batched, 1 thread), beside the library's
+   rule, which the validation phase chose.
 3. **Approximate.** HNSW and IVF at several search breadths (``efSearch``, ``nprobe``): recall@16 against
    the exact neighbours (a returned frame counts when it lies within the exact 16th distance, so ties cannot
    cost recall) and batched time over ``auto``'s, timed back to back.
@@ -51,6 +56,10 @@ EXACT_ENGINES_MEASURED = ("ckdtree", "ckdtree-pca", "pykdtree", "faiss")
 AIM_MS = 0.5
 AIM_RECALL = 0.99
 THREADS = ("1", "all")
+#: ``(first, growth, last)`` rounds of ``ckdtree-pca``'s multi-step search the validation phase compares
+#: (:data:`stylemotion.search.index.FILTER_FETCH`); ``(1, 2, 1)`` is one round and then the ball query, the
+#: engine as it was before the rounds.
+FETCH_CANDIDATES = ((1, 2, 1), (4, 4, 256), (8, 2, 128), (8, 4, 128), (16, 4, 64))
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -71,13 +80,15 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--scale-clips", type=int, default=4, help="query clips per seed of the scale run")
     parser.add_argument("--scale-single", type=int, default=32, help="frames queried alone in the scale run")
     parser.add_argument("--jitter", type=float, default=0.01, help="σ of the scale copies' joint noise, m")
+    parser.add_argument("--validation-clips", type=int, default=32,
+                        help="query clips per seed of the validation phase (val takes against the train takes)")
     parser.add_argument("--quick", action="store_true", help="smoke run: small database, few clips (no measurement)")
 
 
 def _quick(args: argparse.Namespace) -> None:
     """Shrink every count for a smoke run (the render labels its figures as no measurement)."""
     args.features = args.features or ["E15", "E15x5", "pca8"]
-    args.clips, args.clip_frames, args.single_per_clip = 2, 32, 4
+    args.clips, args.clip_frames, args.single_per_clip, args.validation_clips = 2, 32, 4, 2
     args.hnsw_breadths, args.ivf_breadths = [16, 64], [4, 32]
     args.scale_frames = min(args.scale_frames, 50_000)
     args.scale_features, args.scale_clips, args.scale_single = ["E15"], 1, 4
@@ -131,6 +142,28 @@ def implied_rule(dims: Sequence[int], ms: Sequence[dict[str, float]],
         high = low
     return {"limit": None if math.isinf(limit) else int(limit), "low": low, "high": high, "geomean": value,
             "per_set": chosen}
+
+
+def fetch_label(fetch: Sequence[int]) -> str:
+    """``"first/growth/last"`` of one set of multi-step rounds."""
+    return "/".join(str(int(v)) for v in fetch)
+
+
+def choose_fetch(dims: Sequence[int], kd: Sequence[float],
+                 pca: Sequence[dict[str, float]]) -> tuple[str, dict[str, Any]]:
+    """The rounds and ``auto`` rule chosen together: per rounds label, the rule :func:`implied_rule` reads off
+    cKDTree's times ``kd[i]`` and ``ckdtree-pca``'s under those rounds ``pca[i][label]`` (ms per query of set ``i``);
+    the label whose rule has the least geometric mean of the chosen engines' times wins (ties: the earlier label).
+    Returns ``(label, rule)``."""
+    best: tuple[float, int, str, dict[str, Any]] | None = None
+    for i, label in enumerate(pca[0]):
+        times = [{"ckdtree": t, "ckdtree-pca": p[label]} for t, p in zip(kd, pca)]
+        rule = implied_rule(dims, times, candidates=("ckdtree", "ckdtree-pca"))
+        cost = math.fsum(math.log(t[e]) for t, e in zip(times, rule["per_set"])) / len(times)
+        if best is None or (cost, i) < best[:2]:
+            best = (cost, i, label, rule)
+    assert best is not None
+    return best[2], best[3]
 
 
 def library_rule_engines(dims: Sequence[int]) -> list[str]:
@@ -279,6 +312,52 @@ def _exactness(index: Any, queries: np.ndarray, k: int, ref_d: np.ndarray) -> di
             "max_distance_error": float(np.max(np.abs(dist - ref_d), where=finite, initial=0.0))}
 
 
+def measure_validation(train_takes: Sequence[Any], val_takes: Sequence[Any], fps: float, features: Sequence[str],
+                       args: argparse.Namespace, seeds: Sequence[int], use_cache: bool) -> dict[str, Any]:
+    """Phase 0: cKDTree and ``ckdtree-pca`` under every :data:`FETCH_CANDIDATES` on a train-take database with
+    val-take query clips (batched, 1 thread, back to back); the rounds and the ``auto`` rule they choose."""
+    from stylemotion.datasets import TakeSet
+    from stylemotion.search import FrameIndex, MotionDatabase
+
+    database = MotionDatabase.from_takeset(TakeSet("train", list(train_takes), fps))
+    clips = choose_clips(val_takes, args.validation_clips, args.clip_frames, seeds)
+    labels = [fetch_label(f) for f in FETCH_CANDIDATES]
+    sets = []
+    for feature_set in features:
+        print(f"[engines] validation: {feature_set}", flush=True)
+        first = FrameIndex.build(database, feature_set, engine="ckdtree", use_cache=use_cache)
+        kd = FrameIndex(database, feature_set, first.features, first.fitted, engine="ckdtree", workers=1)
+        pca = FrameIndex(database, feature_set, first.features, first.fitted, engine="ckdtree-pca", workers=1)
+        queries = clip_features(first, val_takes, clips, args.clip_frames)
+        del first
+        flat = np.concatenate(queries)
+        ref_d, _ = kd.query(flat, args.k)
+        errors = {}
+        for label, fetch in zip(labels, FETCH_CANDIDATES):
+            pca._engine.fetch = tuple(fetch)  # the engine's rounds (FILTER_FETCH by default)
+            errors[label] = float(np.max(np.abs(pca.query(flat, args.k)[0] - ref_d)))
+        names = ["ckdtree", *labels]
+        times: dict[str, list[float]] = {name: [] for name in names}
+        with thread_limit("1"):
+            kd.query(queries[0], args.k)  # untimed warm-up
+            pca.query(queries[0], args.k)
+            for c, clip in enumerate(queries):
+                for name in rotated(names, c):
+                    index = kd if name == "ckdtree" else pca
+                    if name != "ckdtree":
+                        pca._engine.fetch = FETCH_CANDIDATES[labels.index(name)]
+                    times[name].append(timed_ms(lambda: index.query(clip, args.k)) / len(clip))  # noqa: B023
+        sets.append({"features": feature_set, "dim": kd.dim, "ckdtree": _stats(times["ckdtree"]),
+                     "ckdtree-pca": {label: _stats(times[label]) for label in labels},
+                     "max_distance_error": errors})
+        del kd, pca
+        gc.collect()
+    chosen, rule = choose_fetch([row["dim"] for row in sets], [row["ckdtree"]["mean"] for row in sets],
+                                [{label: row["ckdtree-pca"][label]["mean"] for label in labels} for row in sets])
+    return {"frames": database.num_frames, "takes": database.num_takes, "clips": len(clips),
+            "candidates": labels, "fetch": chosen, "rule": rule, "sets": sets}
+
+
 def measure_set(database: Any, feature_set: str, test_takes: Sequence[Any], clips: Sequence[tuple[int, int]],
                 args: argparse.Namespace, use_cache: bool) -> dict[str, Any]:
     """Every engine on one feature set: build, memory, query times at both thread counts, exactness, breadths."""
@@ -419,7 +498,7 @@ def _peak_rss_mb() -> float:
 def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
     from stylemotion.datasets import TakeSet
     from stylemotion.search import MotionDatabase, feature_names
-    from stylemotion.search.index import AUTO_ENGINES
+    from stylemotion.search.index import AUTO_ENGINES, FILTER_FETCH
 
     if args.quick:
         _quick(args)
@@ -429,6 +508,9 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
     base = TakeSet(f"{takeset.name}-train+val", split["train"] + split["val"], takeset.fps)
     test = split["test"]
     clips = choose_clips(test, args.clips, args.clip_frames, seeds)
+    cached = args.data == "bandai" and not args.quick  # a smoke run's subset is not worth a cache file
+    validation = measure_validation(split["train"], split["val"], takeset.fps, features, args, seeds, cached)
+    gc.collect()
     database = MotionDatabase.from_takeset(base)
     results: dict[str, Any] = {
         "quick": bool(args.quick), "data": args.data, "k": args.k, "frames": database.num_frames,
@@ -437,12 +519,12 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
         "auto_rule": [[None if math.isinf(limit) else limit, engine] for limit, engine in AUTO_ENGINES],
         "splits": {**take_split_record(split, settings["seed"], settings["val_fraction"],
                                        settings["test_fraction"]),
-                   "database": "train + val takes", "queries": "clips of the test takes"},
-        "sets": [], "scale": None,
+                   "database": "train + val takes", "queries": "clips of the test takes",
+                   "choice": "train-take database, val-take query clips (phase 0)"},
+        "library_fetch": fetch_label(FILTER_FETCH), "validation": validation, "sets": [], "scale": None,
     }
     for feature_set in features:
         print(f"[engines] {feature_set}", flush=True)
-        cached = args.data == "bandai" and not args.quick  # a smoke run's subset is not worth a cache file
         results["sets"].append(measure_set(database, feature_set, test, clips, args, use_cache=cached))
     del database
     gc.collect()
@@ -528,9 +610,10 @@ def _choice(r: dict[str, Any]) -> str:
     rule = (f"{implied['low']} for every dimension" if implied["limit"] is None else
             f"{implied['low']} for ≤ {implied['limit']} dimensions, {implied['high']} above")
     same = implied["per_set"] == library
-    verdict = ("the library's rule picks the same engine for every set measured" if same else
-               "**the library's rule differs: set `AUTO_ENGINES` in stylemotion/search/index.py to the measured "
-               "rule and rerun this suite**")
+    verdict = ("the library's rule, chosen on validation (block `engines/validation`), picks the same engine for "
+               "every set here too" if same else
+               "the library's rule, chosen on validation (block `engines/validation`), differs from this test-clip "
+               "rule; it is not re-chosen on the reported clips")
     rules = ", ".join(f"≤ {'∞' if lim is None else lim}: {e}" for lim, e in r["auto_rule"])
     return (_quick_note(r) + md_table(["set (dims)", "fastest exact (batched, 1 thread)", "measured rule's engine",
                                        "library rule's engine"], rows) +
@@ -538,6 +621,52 @@ def _choice(r: dict[str, Any]) -> str:
             f"`auto` may pick: {', '.join(FLOAT64_ENGINES)}; the D and engines whose times are on geometric mean "
             f"closest to each set's fastest exact engine of any kind): **{rule}** (× {fmt(implied['geomean'], 2)} "
             f"the fastest). Library (`AUTO_ENGINES`: {rules}): × {fmt(library_geo, 2)}; {verdict}.")
+
+
+def _validation(r: dict[str, Any]) -> str:
+    from stylemotion.search.index import AUTO_ENGINES
+
+    v = r.get("validation")
+    if not v:
+        return _quick_note(r) + "Not run (a results file from before the validation phase)."
+    chosen, labels, rule = v["fetch"], v["candidates"], v["rule"]
+    rows = []
+    for row in v["sets"]:
+        cells = [f"{row['features']} ({row['dim']})", _mean_p50(row["ckdtree"])]
+        for label in labels:
+            text = _mean_p50(row["ckdtree-pca"][label])
+            cells.append(f"**{text}**" if label == chosen else text)
+        cells.append(f"{max(row['max_distance_error'].values()):.1e}")
+        rows.append(cells)
+    library_rule = [[None if math.isinf(lim) else lim, e] for lim, e in AUTO_ENGINES]
+    rule_text = (f"{rule['low']} for every dimension" if rule["limit"] is None else
+                 f"{rule['low']} for ≤ {rule['limit']} dimensions, {rule['high']} above")
+    measured_rule = ([[None, rule["low"]]] if rule["limit"] is None else
+                     [[rule["limit"], rule["low"]], [None, rule["high"]]])
+    library_engines = library_rule_engines([row["dim"] for row in v["sets"]])
+    same_rule = library_engines == rule["per_set"]
+    same_fetch = r.get("library_fetch") == chosen
+    verdicts = [
+        "The library's `FILTER_FETCH` is the chosen rounds" if same_fetch else
+        f"**The library's `FILTER_FETCH` ({r.get('library_fetch')}) differs from the chosen rounds: set it and rerun**",
+        "the library's `AUTO_ENGINES` picks the chosen rule's engine for every set" if same_rule else
+        f"**the library's `AUTO_ENGINES` ({library_rule}) differs from the chosen rule ({measured_rule}): set it and "
+        "rerun**"]
+    header = ["set (dims)", "cKDTree", *[f"ckdtree-pca {label}" for label in labels], "max distance error"]
+    return (_quick_note(r) + md_table(header, rows) +
+            f"\n\nms per query frame, mean / median over {v['clips']} clips × {r['clip_frames']} frames of the **val** "
+            f"takes against the {v['frames']:,} frames of the **train** takes ({v['takes']:,} takes; the test takes "
+            f"and the reported queries play no part), {r['k']}-NN, batched, 1 thread, back to back (rotated). "
+            "`ckdtree-pca first/growth/last`: its multi-step rounds (fetch first·k nearest in the embedding, growth× "
+            "more per round up to last·k, then the ball query); every candidate's answers equal cKDTree's (last "
+            "column). Chosen together on the means: per candidate rounds, the rule \"one engine up to D dimensions, "
+            "the other above\" closest to each set's faster engine; then the rounds whose rule has the least geometric "
+            f"mean time over the sets: **{chosen}**, with **{rule_text}** (× {fmt(rule['geomean'], 2)} the faster). "
+            + "; ".join(verdicts) + ".")
+
+
+def _mean_p50(stats: dict[str, Any]) -> str:
+    return f"{fmt(stats['mean'], 3)} / {fmt(stats['p50'], 3)}"
 
 
 def _approximate(r: dict[str, Any]) -> str:
@@ -636,5 +765,6 @@ def render(record: dict[str, Any]) -> dict[str, str]:
     line = provenance_line(record)
     return {"summary": f"{_summary(r)} {line}", "headline": f"{_headline(r)}\n\n{line}",
             "table": f"{_table(r)}\n\n{line}",
-            "choice": f"{_choice(r)}\n\n{line}", "approximate": f"{_approximate(r)}\n\n{line}",
+            "choice": f"{_choice(r)}\n\n{line}", "validation": f"{_validation(r)}\n\n{line}",
+            "approximate": f"{_approximate(r)}\n\n{line}",
             "scale": f"{_scale(r)}\n\n{line}"}

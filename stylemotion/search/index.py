@@ -9,7 +9,8 @@ engine that answers k-NN queries on them (Euclidean distance in feature space):
 * ``"ckdtree"`` (exact): :class:`scipy.spatial.cKDTree`;
 * ``"ckdtree-pca"`` (exact): filter and refine — a cKDTree over a low-dimensional embedding whose distances never
   exceed the true ones (the principal-axis coordinates keeping :data:`PROJECTION_VARIANCE` of the variance, plus the
-  norm of the rest), then exact float64 distances of every frame embedded within the k-th candidate's true distance;
+  norm of the rest), then exact float64 distances of the frames nearest in the embedding, fetched in growing rounds
+  until no other frame can be nearer;
 * ``"pykdtree"`` (exact): the ``pykdtree`` package, float32, OpenMP-parallel over queries;
 * ``"faiss"`` (exact): ``faiss.IndexFlatL2`` brute force (optional extra ``search``);
 * ``"faiss-hnsw"`` (approximate, no ε guarantee): ``faiss.IndexHNSWFlat`` graph (:data:`HNSW_M` links per node,
@@ -85,18 +86,24 @@ PROJECTION_VARIANCE = 0.95
 #: Frames (a seeded sample) the principal axes of ``ckdtree-pca`` are fitted on; rows embedded per chunk.
 PROJECTION_SAMPLE = 50_000
 _EMBED_CHUNK = 100_000
+#: ``ckdtree-pca``'s multi-step search (Seidl & Kriegel's optimal filter and refine, in rounds): ``(first, growth,
+#: last)`` — a query fetches ``first · k`` nearest in the embedding, then ``growth`` times more per round while
+#: unsettled, up to ``last · k``; queries still unsettled take every frame embedded within their k-th distance.
+#: Any value gives exact answers; it sets the speed only. Chosen on validation (a train-take database, val-take
+#: query clips) by ``python scripts/benchmarks.py run engines`` (benchmarks/engines.md, block ``engines/validation``).
+FILTER_FETCH: tuple[int, int, int] = (8, 2, 128)
 #: Training points per IVF cell (k-means on a seeded sample of the database; faiss wants ≥ 39).
 IVF_TRAIN_PER_LIST = 40
 #: ``engine="auto"``: ``(largest feature dimension, exact engine)`` rows in ascending order; features of dimension
 #: ``d`` use the engine of the first row whose dimension is ≥ ``d``. Only the float64 engines (:data:`FLOAT64_ENGINES`)
 #: are candidates: pykdtree's and faiss' float32 distances put an LNG path's cost below exact DTW's on Bandai
-#: (tests/search/test_search_bandai_slice.py). The rule is read off ``python scripts/benchmarks.py run engines``
-#: (alone, all of Bandai: 16-NN of held-out test frames against the train + val frames, batched, one thread;
-#: benchmarks/engines.md, block ``engines/choice``, which says whether this rule agrees with the measured one):
-#: cKDTree for the sets of up to 45 dimensions, the projected cKDTree above (the windowed 75–117-dimensional sets,
+#: (tests/search/test_search_bandai_slice.py). Chosen on validation by ``python scripts/benchmarks.py run engines``
+#: (alone, Bandai: 16-NN of val-take clips against the train takes, batched, one thread, mean over clips;
+#: benchmarks/engines.md, block ``engines/validation``, which says whether this rule is the chosen one): cKDTree for
+#: the sets of up to 39 dimensions, the projected cKDTree above (E15x3 and the windowed 75–117-dimensional sets,
 #: whose frames lie near a ~15-dimensional subspace). faiss' brute force was 24–76× slower than a kd-tree at
 #: every dimension measured.
-AUTO_ENGINES: tuple[tuple[float, str], ...] = ((45, "ckdtree"), (math.inf, "ckdtree-pca"))
+AUTO_ENGINES: tuple[tuple[float, str], ...] = ((39, "ckdtree"), (math.inf, "ckdtree-pca"))
 #: The exact engine ``auto`` falls back to when the one its rule names is not installed.
 AUTO_FALLBACK = "ckdtree"
 _INSTALL_HINT = {"pykdtree": "pip install pykdtree", "faiss": "pip install 'stylemotion[search]' (faiss-cpu)"}
@@ -139,9 +146,11 @@ class _ProjectedKDTree:
     Each frame ``x`` is embedded as ``z(x) = [Vᵀ(x − μ), ‖(I − VVᵀ)(x − μ)‖]`` with ``V`` ``(d, p)`` the principal
     axes keeping :data:`PROJECTION_VARIANCE` of a seeded sample's variance; ``‖z(x) − z(y)‖ ≤ ‖x − y‖`` (Pythagoras
     and the reverse triangle inequality), so a frame farther than r in the embedding is farther than r. A query
-    takes its k nearest in the embedding, their true distances give r (≥ the true k-th distance), every frame
-    embedded within r is a candidate, and the candidates are ranked by float64 distances (ties by index). ε is not
-    used: the answer is exact.
+    fetches its ``first · k`` nearest in the embedding and ranks them by float64 distances (ties by index); it is
+    settled when the last one fetched lies farther in the embedding than the k-th true distance found, as then no
+    other frame can be nearer (Seidl & Kriegel's multi-step k-NN, in rounds of ``growth`` times more, up to
+    ``last · k``; :attr:`fetch`). A query still unsettled takes every frame embedded within that k-th distance. ε
+    is not used: the answer is exact.
     """
 
     def __init__(self, data: np.ndarray, workers: int):
@@ -157,6 +166,7 @@ class _ProjectedKDTree:
         self.axes = axes[:p].T  # (d, p), orthonormal columns
         self.data = data
         self.workers = workers
+        self.fetch = FILTER_FETCH  # (first, growth, last): the multi-step rounds of :meth:`query`
         self.tree = cKDTree(np.concatenate([self.embed(data[i:i + _EMBED_CHUNK])
                                             for i in range(0, n, _EMBED_CHUNK)]))
 
@@ -173,29 +183,60 @@ class _ProjectedKDTree:
 
     def query(self, x: np.ndarray, k: int, eps: float, bound: float) -> tuple[np.ndarray, np.ndarray]:
         m, n = len(x), len(self.data)
-        x = x.astype(np.float64)  # once, for the embedding and both distance passes
+        x = x.astype(np.float64)  # once, for the embedding and every distance pass
         z = self.embed(x)
-        _, near = self.tree.query(z, k=k, workers=self.workers)
-        near = np.reshape(near, (m, k))
-        upper = self._distances(x, np.repeat(np.arange(m), k), near.ravel()).reshape(m, k).max(axis=1)
-        radius = np.minimum(upper, bound)
+        distances, indices = np.full((m, k), np.inf), np.full((m, k), n, dtype=np.int64)
+        pending, limit = np.arange(m), np.full(m, bound)
+        first, growth, last = self.fetch
+        fetch = min(n, k * first)
+        while pending.size and fetch <= k * last:
+            pending, limit = self._fetched(x, z, pending, k, fetch, bound, distances, indices)
+            fetch = min(n, max(fetch + 1, fetch * growth))
+        if pending.size:
+            self._ball(x, z, pending, k, limit, bound, distances, indices)
+        return distances, indices
+
+    def _fetched(self, x: np.ndarray, z: np.ndarray, rows: np.ndarray, k: int, fetch: int, bound: float,
+                 distances: np.ndarray, indices: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Answer the queries ``rows`` whose ``fetch`` nearest in the embedding settle them; return the rest with
+        their radius (``(r,)`` each: the k-th smallest true distance among the fetched frames, at most ``bound``).
+
+        A query is settled when its ``fetch``-th embedded distance exceeds its k-th smallest true distance among
+        the fetched frames (or ``bound``): every other frame is at least that far in the embedding, hence in truth.
+        """
+        n = len(self.data)
+        embedded, near = self.tree.query(z[rows], k=fetch, workers=self.workers)
+        embedded, near = np.reshape(embedded, (len(rows), fetch)), np.reshape(near, (len(rows), fetch))
+        exact = self._distances(x, np.repeat(rows, fetch), near.ravel()).reshape(len(rows), fetch)
+        order = np.lexsort((near, exact))[:, :k]  # along each row: by distance, then frame index
+        top_d, top_i = np.take_along_axis(exact, order, axis=1), np.take_along_axis(near, order, axis=1)
+        limit = np.minimum(top_d[:, -1], bound)
+        settled = (fetch == n) | (embedded[:, -1] > limit * (1.0 + 1e-9) + 1e-9)
+        beyond = top_d > bound
+        top_d[beyond], top_i[beyond] = np.inf, n
+        distances[rows[settled]], indices[rows[settled]] = top_d[settled], top_i[settled]
+        return rows[~settled], limit[~settled]
+
+    def _ball(self, x: np.ndarray, z: np.ndarray, rows: np.ndarray, k: int, radius: np.ndarray, bound: float,
+              distances: np.ndarray, indices: np.ndarray) -> None:
+        """Answer the queries ``rows`` from every frame embedded within ``radius`` ``(r,)`` (each ≥ its query's true
+        k-th distance, or ``bound``)."""
+        m = len(rows)
         # a hair wider than r, so that rounding in the embedding cannot drop a frame at exactly r
-        found = self.tree.query_ball_point(z, radius * (1.0 + 1e-9) + 1e-9, workers=self.workers)
+        found = self.tree.query_ball_point(z[rows], radius * (1.0 + 1e-9) + 1e-9, workers=self.workers)
         counts = np.fromiter((len(f) for f in found), dtype=np.int64, count=m)
-        rows = np.fromiter((i for f in found for i in f), dtype=np.int64, count=int(counts.sum()))
+        frames = np.fromiter((i for f in found for i in f), dtype=np.int64, count=int(counts.sum()))
         owner = np.repeat(np.arange(m), counts)
-        dist = self._distances(x, owner, rows)
+        dist = self._distances(x, rows[owner], frames)
         keep = dist <= bound
-        owner, rows, dist = owner[keep], rows[keep], dist[keep]
-        order = np.lexsort((rows, dist, owner))  # by query, then distance, then frame index
-        owner, rows, dist = owner[order], rows[order], dist[order]
+        owner, frames, dist = owner[keep], frames[keep], dist[keep]
+        order = np.lexsort((frames, dist, owner))  # by query, then distance, then frame index
+        owner, frames, dist = owner[order], frames[order], dist[order]
         starts = np.searchsorted(owner, np.arange(m))
         rank = np.arange(len(owner)) - starts[owner]
         first = rank < k
-        distances, indices = np.full((m, k), np.inf), np.full((m, k), n, dtype=np.int64)
-        distances[owner[first], rank[first]] = dist[first]
-        indices[owner[first], rank[first]] = rows[first]
-        return distances, indices
+        distances[rows[owner[first]], rank[first]] = dist[first]
+        indices[rows[owner[first]], rank[first]] = frames[first]
 
 
 def _import_faiss() -> Any:

@@ -61,6 +61,18 @@ def test_the_implied_rule(suite, times, candidates, want):
     assert got["geomean"] == pytest.approx(math.exp(sum(logs) / len(logs)))
 
 
+def test_the_rounds_are_chosen_with_the_rule_they_imply(suite):
+    # rounds "a" make ckdtree-pca fastest on the two wide sets; "b" is faster on the narrow set, where cKDTree is
+    # faster still (so "b"'s gain there does not count), and slower on the wide ones
+    kd = [0.1, 1.0, 1.0]
+    pca = [{"a": 0.5, "b": 0.2}, {"a": 0.3, "b": 0.4}, {"a": 0.3, "b": 0.4}]
+    label, rule = suite.choose_fetch([15, 75, 90], kd, pca)
+    assert label == "a" and rule["limit"] == 15 and rule["per_set"] == ["ckdtree", "ckdtree-pca", "ckdtree-pca"]
+    label, _ = suite.choose_fetch([15, 75, 90], kd, [{"a": 0.5, "b": 0.5}, {"a": 0.3, "b": 0.3}, {"a": 0.3, "b": 0.3}])
+    assert label == "a"  # a tie: the earlier candidate
+    assert suite.fetch_label((8, 2, 128)) == "8/2/128"
+
+
 def test_clips_lie_inside_their_takes_and_follow_the_seed(suite):
     class Take:
         def __init__(self, n):
@@ -100,14 +112,24 @@ def test_a_quick_run_on_synthetic_data_and_its_render(suite):
         assert [b["breadth"] for b in ivf] == sorted(b["breadth"] for b in ivf)
         assert all(a["recall"] <= b["recall"] for a, b in zip(ivf, ivf[1:]))
         assert sum(b["default"] for b in ivf) == 1 and sum(b["default"] for b in row["breadths"]["faiss-hnsw"]) == 1
+    v = r["validation"]  # the choices: val clips against the train takes, every candidate exact
+    assert v["frames"] < r["frames"] and v["clips"] > 0 and v["candidates"] == [suite.fetch_label(f) for f in
+                                                                                 suite.FETCH_CANDIDATES]
+    assert v["fetch"] in v["candidates"] and [row["features"] for row in v["sets"]] == ["E15", "E15x5"]
+    for row in v["sets"]:
+        assert max(row["max_distance_error"].values()) < 1e-9
+        assert row["ckdtree"]["n"] == v["clips"] and all(x["n"] == v["clips"] for x in row["ckdtree-pca"].values())
+    assert r["splits"]["choice"].startswith("train-take database, val-take")
     scale = r["scale"]
     assert scale["frames"] >= 20000 and [s["features"] for s in scale["sets"]] == ["E15"]
     assert all(v["recall"] == 1.0 for e, v in scale["sets"][0]["engines"].items() if e in EXACT_ENGINES)
     record = {"command": "python scripts/benchmarks.py run engines --quick", "commit": "abc",
               "started": "2026-12-04T00:00", "seeds": [0], "results": r}
     blocks = suite.render(record)
-    assert set(blocks) == {"summary", "headline", "table", "choice", "approximate", "scale"}
+    assert set(blocks) == {"summary", "headline", "table", "choice", "validation", "approximate", "scale"}
     assert all("Quick smoke run" in b for b in blocks.values())
     assert all(f"{row['auto']} ← auto" in blocks["table"] for row in r["sets"])
     assert "Measured rule" in blocks["choice"] and "Library (`AUTO_ENGINES`" in blocks["choice"]
+    assert f"**{v['fetch']}**" in blocks["validation"] and "**val**" in blocks["validation"]
     assert "Not run" in suite.render({**record, "results": {**r, "scale": None, "quick": False}})["scale"]
+    assert "Not run" in suite.render({**record, "results": {**r, "validation": None}})["validation"]

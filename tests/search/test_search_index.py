@@ -106,6 +106,30 @@ def test_projected_engine_is_exact_where_the_projection_drops_dimensions(databas
     assert np.all(embedded <= true * (1 + 1e-12) + 1e-12) and np.mean(embedded / np.maximum(true, 1e-9)) > 0.5
 
 
+@pytest.mark.parametrize("fetch", [(1, 2, 1), (8, 2, 128), (1, 2, 1 << 30)],
+                         ids=["ball after one round", "default rounds", "rounds up to every frame"])
+def test_projected_engine_is_exact_in_every_stage_of_its_multi_step_search(database, fetch):
+    """``ckdtree-pca``'s multi-step k-NN settles a query in a fetch round or leaves it to the ball query; each path
+    (forced by its ``fetch``) gives numpy brute force's answers, also within a radius and among duplicated rows."""
+    rng = np.random.default_rng(11)
+    latent = rng.normal(size=(database.num_frames, 4)) * np.array([2.0, 1.0, 0.5, 0.1])
+    features = (latent @ rng.normal(size=(4, 75)) + rng.normal(0, 0.02, (database.num_frames, 75))).astype(np.float32)
+    features[2::7] = features[::7][:len(features[2::7])]
+    index = FrameIndex(database, "E15x5", features, engine="ckdtree-pca")
+    index._engine.fetch = fetch
+    far = rng.normal(0, 3.0, (5, 75))  # far from every frame: the embedding's bound is loose there
+    queries = np.concatenate([features[::61][:15] + rng.normal(0, 0.05, (15, 75)), features[::97][:5], far])
+    queries = queries.astype(np.float32)
+    for k in (1, 16, 40):
+        _check_exact(index, queries, k, "ckdtree-pca")
+    true_d, true_i = brute_force(index.features, queries, 16)
+    radius = float(np.median(true_d[:, 6]))
+    dist, idx = index.query(queries, 16, radius=radius)
+    inside = true_d <= radius
+    np.testing.assert_allclose(dist[inside], true_d[inside], rtol=1e-12)
+    assert np.all(np.isinf(dist[~inside])) and np.all(idx[~inside] == -1)
+
+
 @pytest.mark.parametrize("feature_set", ["E15", "E15x3", "pca8", "EP19"])
 def test_exact_search_on_the_synthetic_dataset(takeset, feature_set):
     """A take the database does not hold, queried frame by frame: the same neighbours as numpy brute force."""
