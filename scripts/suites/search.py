@@ -173,11 +173,17 @@ def _as_best(result: Any, index: Any) -> tuple[int, int, float, int] | None:
     return top.global_start, top.global_end - 1, top.cost, int(index.database.take_id[top.global_start])
 
 
+def _verified_name(chosen: list[Any] | tuple[Any, ...]) -> str:
+    """Key of the chosen search rule with the exact verification of its best segment (``verify=True``)."""
+    return _growth_name(*_rule(chosen)) + " + verify"
+
+
 def _test_extras(features: np.ndarray, index: Any, cache: Any, seconds: float, args: argparse.Namespace,
                  chosen: list[Any], start_k: int, costs: dict[Any, list], used: dict[Any, list],
-                 seed: int) -> dict[str, Any]:
-    """On a test query: the gap-tolerant steps at the start k; seconds of the chosen growth (and of the ε and
-    fixed-radius searches with it) as a ratio to the fixed start k, timed back to back; their answers."""
+                 seed: int, verified_takes: dict[float, list[int]]) -> dict[str, Any]:
+    """On a test query: the gap-tolerant steps at the start k; seconds of the chosen growth (alone, with
+    ``verify``, and with the ε and fixed-radius searches) as a ratio to the fixed start k, timed back to back; their
+    answers; the takes ``verify`` swept (``verified_takes[seconds]``)."""
     from stylemotion.search import search_features
     from stylemotion.search.lng import GAP_STEPS, lng_match
 
@@ -195,6 +201,12 @@ def _test_extras(features: np.ndarray, index: Any, cache: Any, seconds: float, a
     _, old = timed()
     result, new = timed(k_max=km, grow=grow, stable_for=sf, refine=refine)
     costs[(seconds, _growth_name(grow, km, sf, refine))].append(new / old)
+    verified, t = timed(k_max=km, grow=grow, stable_for=sf, refine=refine, verify=True)
+    name = _verified_name(chosen)
+    out[name] = _as_best(verified, index)
+    used[("test", seed, seconds, name)].append(verified.k)
+    costs[(seconds, name)].append(t / old)
+    verified_takes[seconds].append(int(verified.takes_verified))
     if seconds in args.approx_lengths_s:
         for eps in args.eps:
             result, t = timed(k_max=km, grow=grow, stable_for=sf, refine=refine, eps=eps)
@@ -237,6 +249,7 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
     classes: dict[tuple[str, float], list[str]] = defaultdict(list)
     costs: dict[Any, list] = defaultdict(list)  # (seconds, key) -> test seconds per query
     swept = []
+    verified_takes: dict[float, list[int]] = defaultdict(list)  # query length -> takes verify swept per test query
     refine_options = sorted(set(args.refine))
     candidates = [(rule, km, sf, n) for rule in args.grow_rules for km in sorted(set(args.grow_bounds))
                   for sf in (sorted(set(args.grow_stable_for)) if rule == "stable" else [1]) for n in refine_options]
@@ -267,7 +280,7 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
                     bounding = [name for (grow, km, sf, n), name in zip(candidates, variants) if not n]
                     if part == "test":
                         variants.update(_test_extras(features, index, cache, seconds, args, growth_choice["chosen"],
-                                                     DEFAULT_K, costs, used, seed))
+                                                     DEFAULT_K, costs, used, seed, verified_takes))
                         bounding += [v for v in variants if v.startswith(("eps", "radius"))]
                     result = compare_lng_dtw(features, index, bounds, ks, variants, cache, bounding)
                     swept.append(result.takes_swept)
@@ -333,6 +346,8 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
             "approx": {"eps": args.eps, "radii": args.radii, "lengths_s": args.approx_lengths_s,
                        "note": "evaluated on test with the chosen growth; not tuned, defaults eps=0, radius=None"},
             "dtw_takes_swept": {"mean": float(np.mean(swept)), "max": int(np.max(swept))},
+            "verify_takes_swept": {f"{sec:g}": {"mean": float(np.mean(v)), **quantiles(v)}
+                                   for sec, v in verified_takes.items()},
             "lng_per_seed": summaries, "lng_pooled": pooled, "retrieval": retrieval, "captures": captures,
             "ranks": ranks, "turns_by_features": turns}
 
@@ -423,8 +438,8 @@ def _captures(bandai: Any, seeds: list[int], windows: int, lengths_s: list[float
     for seconds in lengths_s:
         per_seed: dict[str, list[float]] = defaultdict(list)
         contents: Counter = Counter()
-        answered = answered_fixed = queries = same = same_fixed = 0
-        lng_costs, fixed_costs, dtw_costs, ks_used, ratios = [], [], [], [], []
+        answered = answered_fixed = queries = same = same_fixed = same_verified = 0
+        lng_costs, fixed_costs, dtw_costs, ks_used, ratios, verify_ratios = [], [], [], [], [], []
         for seed in seeds:
             rng = np.random.default_rng([seed, 3, int(seconds * 1000)])
             p10, walk10, near_walk = [], [], []
@@ -440,7 +455,11 @@ def _captures(bandai: Any, seeds: list[int], windows: int, lengths_s: list[float
                     t1 = time.perf_counter()
                     result = search_features(features, index, k, 10, k_max=k_max, grow=grow, stable_for=stable_for,
                                              refine=refine)
-                    ratios.append((time.perf_counter() - t1) / (t1 - t0))
+                    t2 = time.perf_counter()
+                    verified = search_features(features, index, k, 10, k_max=k_max, grow=grow,
+                                               stable_for=stable_for, refine=refine, verify=True)
+                    ratios.append((t2 - t1) / (t1 - t0))
+                    verify_ratios.append((time.perf_counter() - t2) / (t1 - t0))
                     ks_used.append(result.k)
                     found = result.matches
                     upper = found[0].cost if found else None
@@ -451,6 +470,9 @@ def _captures(bandai: Any, seeds: list[int], windows: int, lengths_s: list[float
                     same += bool(found) and (found[0].global_start, found[0].global_end - 1) == (best.start, best.end)
                     same_fixed += bool(fixed.matches) and (fixed.matches[0].global_start,
                                                            fixed.matches[0].global_end - 1) == (best.start, best.end)
+                    same_verified += bool(verified.matches) and (verified.matches[0].global_start,
+                                                                 verified.matches[0].global_end - 1) == (best.start,
+                                                                                                         best.end)
                     labels = [x.content for x in found]
                     nearest = [index.database.contents[t] for t in index.database.take_id[fixed.indices[:, 0]]]
                     near_walk.append(sum(c in LOCOMOTION for c in nearest) / len(nearest))
@@ -466,7 +488,8 @@ def _captures(bandai: Any, seeds: list[int], windows: int, lengths_s: list[float
         total_matches = sum(contents.values())
         rows.append({"query_s": seconds, "queries": queries, "answered": answered, "matches": total_matches,
                      "answered_fixed_k": answered_fixed, "same_segment": same / queries,
-                     "same_segment_fixed_k": same_fixed / queries,
+                     "same_segment_fixed_k": same_fixed / queries, "same_segment_verified": same_verified / queries,
+                     "time_ratio_verified": {"mean": float(np.mean(verify_ratios)), **quantiles(verify_ratios)},
                      "spearman_rho": spearman_with_misses(lng_costs, dtw_costs),
                      "spearman_rho_fixed_k": spearman_with_misses(fixed_costs, dtw_costs),
                      "k_used": {"mean": float(np.mean(ks_used)), **quantiles(ks_used)},
@@ -477,7 +500,7 @@ def _captures(bandai: Any, seeds: list[int], windows: int, lengths_s: list[float
                      "nearest_walk_or_turn": spread(per_seed["nearest_walk_or_turn"])})
     return {"files": list(CAPTURES), "k": k, "k_max": k_max, "grow": grow, "stable_for": stable_for,
             "refine": refine, "defaults": [SearchSettings.grow, SearchSettings.k_max, SearchSettings.stable_for,
-                                           SearchSettings.refine], "top": 10,
+                                           SearchSettings.refine], "verify_default": SearchSettings.verify, "top": 10,
             "features": "E15", "windows_per_file_length_seed": windows,
             "database_takes": index.database.num_takes, "database_frames": index.database.num_frames,
             "file_fps": {n: q.record["file_fps"] for n, q in files.items()},
@@ -515,8 +538,9 @@ def _growth_blocks(r: dict[str, Any], seeds: int, prov: str) -> dict[str, str]:
                       f"{growth.get('chosen_on', 'val')}. Rule: {growth['rule']} (aim "
                       f"{_pct(growth['aim'])}); chosen {name}: {note}. {prov}")
     lengths = sorted({p["query_s"] for p in r["lng_pooled"]})
-    variants = [start, *[_growth_name(*v) for v in _test_variants(growth["chosen"], r.get("refine_options"))],
-                f"gaps at {start}"]
+    tested = [_growth_name(*v) for v in _test_variants(growth["chosen"], r.get("refine_options"))]
+    variants = [start, tested[0], _verified_name(growth["chosen"]), *tested[1:], f"gaps at {start}"]
+    verify_takes = r.get("verify_takes_swept") or {}
     rows = []
     for seconds in lengths:
         for v in variants:
@@ -527,6 +551,9 @@ def _growth_blocks(r: dict[str, Any], seeds: int, prov: str) -> dict[str, str]:
             ku = p.get("k_used") or {}
             label = (f"k = {v} alone (before)" if isinstance(v, int) else
                      f"{v} (**chosen**)" if v == name else
+                     f"{v} (**the command's default**: swept {fmt(verify_takes[f'{seconds:g}']['mean'], 1)} takes "
+                     f"on mean, {fmt(verify_takes[f'{seconds:g}']['p100'], 0)} at most)"
+                     if v == _verified_name(growth["chosen"]) and f"{seconds:g}" in verify_takes else
                      f"{v} (the default before the stricter stop)" if v == _growth_name(*PREVIOUS_GROWTH) else str(v))
             rows.append([f"{seconds:g} s", label, f"{p['queries'] - p['no_path']} of {p['queries']}",
                          fmt_spread(_seed_spread(r, "test", seconds, v, "same_segment")),
@@ -544,9 +571,13 @@ def _growth_blocks(r: dict[str, Any], seeds: int, prov: str) -> dict[str, str]:
                       f"against exact subsequence DTW with the thesis' steps; a query without a path is a miss "
                       f"everywhere. `gaps at {start}`: the gap-tolerant steps (thesis + the online skips (1,2), "
                       f"(2,1), (2,2), a skipped query frame costing its k-th distance) at k = {start}, compared with "
-                      f"the same thesis-step DTW (their cheaper skipping paths are not DTW's). Time: the whole search "
-                      f"(k-NN + LNG, every k tried) over the search at k = {start} alone, timed back to back per query "
-                      f"on a shared machine (ratios only). {prov}")
+                      f"the same thesis-step DTW (their cheaper skipping paths are not DTW's). `+ verify`: the chosen "
+                      f"search, then exact DTW over every take whose lower bound (each query frame's nearest frame in "
+                      f"it, summed) does not exceed the best cost found (`verify=true`, the command's default): its "
+                      f"best segment is DTW's by construction, and the row checks that against the reference DTW, "
+                      f"computed on its own; the LNG's share is the chosen row's. Time: the whole search "
+                      f"(k-NN + LNG, every k tried, and the verification) over the search at k = {start} alone, timed "
+                      f"back to back per query on a shared machine (ratios only). {prov}")
     approx = r["approx"]
     arows = []
     for seconds in approx["lengths_s"]:
@@ -615,6 +646,16 @@ def render(record: dict[str, Any]) -> dict[str, str]:
                          f"answered {p['queries'] - p['no_path']} of {p['queries']}; k used median "
                          f"{fmt(p['k_used']['p50'], 0)}, max {fmt(p['k_used']['p100'], 0)}; time × "
                          f"{fmt(ratio.get('ratio', {}).get('mean'), 1)} of k = {growth['start_k']} alone"])
+            v = _verified_name(growth["chosen"])
+            p = _pooled(r, "test", seconds, v, missing_ok=True)
+            if p is not None:
+                ratio = r["time_ratio"].get(f"{seconds:g}|{v}", {})
+                rows.append([f"the same, then the best segment verified by exact DTW (`verify=true`, the command's "
+                             f"default), {seconds:g} s test queries",
+                             f"same best segment {fmt_spread(_seed_spread(r, 'test', seconds, v, 'same_segment'))} "
+                             f"(exact by construction, checked); answered {p['queries'] - p['no_path']} of "
+                             f"{p['queries']}; time × {fmt(ratio.get('ratio', {}).get('mean'), 1)} of k = "
+                             f"{growth['start_k']} alone"])
     ret = r["retrieval"]
     rows.append([f"precision@10 by content, {ret['query_s']:g} s test queries (missing matches wrong)",
                  f"{fmt_spread(ret['all']['p10'])}; no match for {fmt(ret['all']['none']['mean'], 1)} of "
@@ -622,6 +663,9 @@ def render(record: dict[str, Any]) -> dict[str, str]:
     for row in r["captures"]["rows"]:
         extra = (f"; same best segment as DTW {_pct(row['same_segment'])}, ρ {fmt(row['spearman_rho'], 3)}"
                  if "same_segment" in row else "")
+        if "same_segment_verified" in row:
+            extra += (f" (LNG alone); with `verify=true` {_pct(row['same_segment_verified'])} at × "
+                      f"{fmt(row['time_ratio_verified']['mean'], 1)} the time of k = {r['captures']['k']} alone")
         rows.append([f"other captures, {row['query_s']:g} s walk queries vs all of Bandai (command defaults)",
                      f"answered {row['answered']} of {row['queries']}{extra}; precision@10 walk or turn "
                      f"{fmt_spread(row['p10_walk_or_turn'])}"])
@@ -706,13 +750,16 @@ def render(record: dict[str, Any]) -> dict[str, str]:
             cells += [f"{row['answered_fixed_k']}",
                       f"{_pct(row['same_segment'])} ({_pct(row['same_segment_fixed_k'])})",
                       f"{fmt(row['spearman_rho'], 3)} ({fmt(row['spearman_rho_fixed_k'], 3)})",
+                      (f"{_pct(row['same_segment_verified'])} (× {fmt(row['time_ratio_verified']['mean'], 1)} / "
+                       f"{fmt(row['time_ratio_verified']['p100'], 1)})" if "same_segment_verified" in row else "—"),
                       f"{fmt(row['k_used']['p50'], 0)} / {fmt(row['k_used']['p100'], 0)}",
                       f"{fmt(row['time_ratio']['mean'], 1)} / {fmt(row['time_ratio']['p100'], 1)}"]
         cells += [fmt(row["matches"] / row["queries"], 1), top, fmt_spread(row["p10_walk"]),
                   fmt_spread(row["p10_walk_or_turn"]), fmt_spread(row["nearest_walk_or_turn"])]
         caprow.append(cells)
     fixed_head = ([f"answered at k = {cap['k']} alone", "same best segment as DTW (k alone)", "Spearman ρ vs DTW "
-                   "(k alone)", "k used: median / max", "time × k alone: mean / max"] if grown else [])
+                   "(k alone)", "same best segment with verify (time × k alone: mean / max)", "k used: median / max",
+                   "time × k alone: mean / max"] if grown else [])
     cap_block = (md_table(["query", "queries", "answered (≥ 1 match)", *fixed_head, "matches per query",
                            "contents of the matches", "precision@10 walk", "precision@10 walk or turn",
                            "query frames whose nearest frame is a walk or turn"], caprow)
@@ -731,8 +778,10 @@ def render(record: dict[str, Any]) -> dict[str, str]:
                          f" (**the command's default at the run was {cap.get('defaults')}**)") if grown else "")
                    + f", top {cap['top']}); precision counts missing matches wrong, mean ± sd over seeds"
                    + ("; same best segment and ρ against exact subsequence DTW over all of Bandai (thesis steps), "
-                      "no path counted as a miss, pooled over seeds; time: the growing search's seconds over the "
-                      "fixed k's, timed back to back on each query" if grown else "") + f". {prov}")
+                      "no path counted as a miss, pooled over seeds; with verify: the same search, then exact DTW over "
+                      "the takes whose lower bound does not exceed its best cost (`verify=true`, the command's "
+                      "default), exact by construction and checked here; time: the growing search's seconds over "
+                      "the fixed k's, timed back to back on each query" if grown else "") + f". {prov}")
     rk = r["ranks"]
     names = rk["features"]
     rank_rows = [[a, *(fmt(rk["rho"][a][b]["mean"]) for b in names)] for a in names]

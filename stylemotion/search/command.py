@@ -168,7 +168,7 @@ def _checked_growth(k: int, k_max: Any, grow: Any, steps: Any, skip_cost: Any,
 
 def search(data: Mapping[str, Any], query: str, out: str | os.PathLike, *, features: str = _D.features,
            k: int = _D.k, k_max: int = _D.k_max, grow: str = _D.grow, stable_for: int = _D.stable_for,
-           refine: int = _D.refine, steps: str = _D.steps,
+           refine: int = _D.refine, verify: bool = _D.verify, steps: str = _D.steps,
            skip_cost: float | None = _D.skip_cost, top: int = _D.top, eps: float = _D.eps,
            radius: float | None = _D.radius,
            engine: str = _D.engine, normalize: str = _D.normalize, exclude_query_take: bool = _D.exclude_query_take,
@@ -195,6 +195,11 @@ def search(data: Mapping[str, Any], query: str, out: str | os.PathLike, *, featu
     k_max, grow, steps, skip_cost, stable_for = _checked_growth(k, k_max, grow, steps, skip_cost, stable_for)
     if isinstance(refine, bool) or not isinstance(refine, int) or refine < 0:
         raise SearchInputError(f"refine={refine} must be a whole number ≥ 0 (LNG candidates re-ranked; 0: off)")
+    if not isinstance(verify, bool):
+        raise SearchInputError(f"verify={verify} must be true or false")
+    if verify and (steps != "thesis" or normalize != "none"):
+        raise SearchInputError(f"verify=true needs steps=thesis and normalize=none (got steps={steps}, normalize="
+                               f"{normalize}); set verify=false for these")
     export_top = positive_int(export_top, "export.top")
     figure_matches = positive_int(figure_matches, "figure.matches")
     try:
@@ -228,14 +233,15 @@ def search(data: Mapping[str, Any], query: str, out: str | os.PathLike, *, featu
     try:
         result = search_motion(q.positions, index, k, top, exclude_takes=exclude, eps=eps, radius=radius,
                                normalize=normalize, k_max=k_max, grow=grow, stable_for=stable_for,
-                               refine=refine, steps=STEP_SETS[steps],
+                               refine=refine, verify=verify, steps=STEP_SETS[steps],
                                skip_cost=skip_cost)
     except ValueError as exc:
         raise SearchInputError(f"query={query}: {exc}") from None
     records = [m.record() for m in result.matches]
     report = {
         "query": {"value": str(query), **q.record}, "features": features, "k": k, "k_max": k_max, "grow": grow,
-        "stable_for": stable_for, "refine": refine, "k_used": result.k, "k_tried": list(result.k_tried), "steps": steps,
+        "stable_for": stable_for, "refine": refine, "verify": verify, "takes_verified": result.takes_verified,
+        "k_used": result.k, "k_tried": list(result.k_tried), "steps": steps,
         "skip_cost": skip_cost, "top": top, "eps": eps,
         "radius": radius, "engine": engine, "normalize": normalize, "excluded_takes": list(result.excluded_takes),
         "database": {"name": database.name, "takes": database.num_takes, "frames": database.num_frames,
@@ -307,7 +313,8 @@ def search_from_config(cfg: DictConfig, command: str = "") -> dict[str, Any]:
     data, settings = settings_from_config(cfg, SearchSettings, "search")
     return search(
         data, settings.query, settings.out, features=settings.features, k=settings.k, k_max=settings.k_max,
-        grow=settings.grow, stable_for=settings.stable_for, refine=settings.refine, steps=settings.steps,
+        grow=settings.grow, stable_for=settings.stable_for, refine=settings.refine, verify=settings.verify,
+        steps=settings.steps,
         skip_cost=settings.skip_cost,
         top=settings.top,
         eps=settings.eps, radius=settings.radius, engine=settings.engine, normalize=settings.normalize,

@@ -17,6 +17,7 @@ matrix for the paths plus a few rows (the full ``(m, n)`` float matrix only on r
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import reduce
 from typing import Literal
@@ -220,31 +221,61 @@ def _backtrack(choice: np.ndarray, i: int, g: int, steps: tuple[Step, ...]) -> n
     return np.array(out[::-1], dtype=np.int64)
 
 
+#: Query × database cells per chunk of :func:`take_lower_bounds` (16 M float64 cells, 128 MB), so that the bounds of
+#: a long query over millions of frames never hold the whole ``(m, n)`` distance matrix.
+BOUND_CHUNK_CELLS = 1 << 24
+
+
+def take_lower_bounds(query: np.ndarray, database: np.ndarray, takes: TakeBounds) -> np.ndarray:
+    """``(takes,)`` ``LB(T) = Σ_i min_{g ∈ T} C[i, g]`` of query ``(m, d)`` against database ``(n, d)`` features:
+    no thesis-step path inside take ``T`` costs less (each step visits every query frame at least once).
+    Computed over chunks of :data:`BOUND_CHUNK_CELLS` cells."""
+    q = np.asarray(query, dtype=np.float64)
+    starts, _ = takes.spans()
+    mins = np.full((len(q), len(starts)), np.inf)
+    step = max(1, BOUND_CHUNK_CELLS // max(len(q), 1))
+    for lo in range(0, takes.n, step):
+        hi = min(takes.n, lo + step)
+        cuts = np.concatenate([[lo], starts[(starts > lo) & (starts < hi)]])  # one segment per take in the chunk
+        ids = np.searchsorted(starts, cuts, side="right") - 1  # the takes' positions
+        segment = np.minimum.reduceat(feature_distances(q, database[lo:hi]), cuts - lo, axis=1)
+        mins[:, ids] = np.minimum(mins[:, ids], segment)
+    return mins.sum(axis=0)
+
+
 def best_subsequence_match(query: np.ndarray, database: np.ndarray, takes: TakeBounds | np.ndarray, *,
-                           upper_bound: float | None = None, first_takes: int = 8) -> tuple[Match | None, int]:
+                           upper_bound: float | None = None, first_takes: int = 8,
+                           excluded_takes: Sequence[int] = ()) -> tuple[Match | None, int]:
     """The best :func:`subsequence_dtw_features` match (thesis steps, no normalization) of query ``(m, d)``
     features in database ``(n, d)`` features, exactly, without sweeping takes that cannot hold it.
 
     Every thesis step visits each query frame at least once, so a path inside take ``T`` costs at least
-    ``LB(T) = Σ_i min_{g ∈ T} C[i, g]``. The sweep runs on the ``first_takes`` takes of lowest bound (or
+    ``LB(T)`` (:func:`take_lower_bounds`). The sweep runs on the ``first_takes`` takes of lowest bound (or
     uses ``upper_bound``, e.g. the LNG's best cost, which can only be higher than DTW's), then on every
     take whose bound does not exceed the best cost so far (a relative margin of 1e-9 covers rounding),
-    kept in database order so ties break as in the full sweep. Returns the match in the database's global
-    frames (``None`` without any path) and the number of takes swept. Tests: equal to the full sweep.
+    kept in database order so ties break as in the full sweep; ``excluded_takes`` (takes' positions in database
+    order, a :class:`~stylemotion.search.MotionDatabase`'s take indices) are never swept.
+    Memory: the bounds' chunks and the swept takes' columns, never the whole ``(m, n)`` matrix. Returns the match
+    in the database's global frames (``None`` without any path) and the number of takes swept. Tests: equal to
+    the full sweep.
     """
-    cost = feature_distances(query, database)
+    q = np.asarray(query, dtype=np.float64)
     tb = TakeBounds.coerce(takes)
-    if tb.n != cost.shape[1]:
-        raise ValueError(f"takes describe {tb.n} database frames, the features have {cost.shape[1]}")
+    if tb.n != len(database):
+        raise ValueError(f"takes describe {tb.n} database frames, the features have {len(database)}")
     starts, ends = tb.spans()
-    bound = np.minimum.reduceat(cost, starts, axis=1).sum(axis=0)  # (takes,)
+    bound = take_lower_bounds(q, database, tb)
+    bound[np.asarray(list(excluded_takes), dtype=np.int64)] = np.inf
     order = np.argsort(bound, kind="stable")
+    order = order[np.isfinite(bound[order])]
 
     def sweep(chosen: np.ndarray) -> Match | None:
+        if chosen.size == 0:
+            return None
         chosen = np.sort(chosen)
         frames = np.concatenate([np.arange(starts[t], ends[t] + 1) for t in chosen])
         lengths = ends[chosen] - starts[chosen] + 1
-        found = subsequence_dtw(cost[:, frames], TakeBounds.from_lengths(lengths)).best
+        found = subsequence_dtw(feature_distances(q, database[frames]), TakeBounds.from_lengths(lengths)).best
         if found is None:
             return None
         path = found.path.copy()
@@ -256,5 +287,5 @@ def best_subsequence_match(query: np.ndarray, database: np.ndarray, takes: TakeB
     if not np.isfinite(limit):
         first = sweep(order[:first_takes])
         limit = np.inf if first is None else first.cost
-    chosen = np.flatnonzero(bound <= limit * (1 + 1e-9) + 1e-12) if np.isfinite(limit) else np.arange(len(starts))
+    chosen = np.flatnonzero(bound <= limit * (1 + 1e-9) + 1e-12) if np.isfinite(limit) else np.sort(order)
     return sweep(chosen), int(len(chosen))

@@ -34,7 +34,7 @@ import numpy as np
 
 from stylemotion.search.index import FrameIndex
 from stylemotion.search.lng import THESIS_STEPS, Match, Normalization, Step, check_skip_cost, lng_match
-from stylemotion.search.refine import refine_matches
+from stylemotion.search.refine import refine_matches, verify_best
 from stylemotion.search.settings import SearchSettings
 
 #: Neighbours per query frame by default: ``stylemotion-search``'s ``k`` (:class:`SearchSettings`, where it is
@@ -97,7 +97,8 @@ class SearchResult:
         k: neighbours per query frame of the graph that gave the matches (the k used; ``indices`` has
             ``k`` columns).  k_tried: every k whose graph was searched, in order (one entry without growth).
         excluded_takes: names of takes left out of the search.
-        timings: seconds of ``features``, ``knn`` and ``lng`` (summed over the k tried).
+        timings: seconds of ``features``, ``knn`` and ``lng`` (summed over the k tried), ``refine`` and ``verify``
+            when run.  takes_verified: takes the exact verification swept (None without ``verify``).
     """
 
     matches: list[SegmentMatch]
@@ -107,6 +108,7 @@ class SearchResult:
     excluded_takes: tuple[str, ...] = ()
     timings: dict[str, float] = field(default_factory=dict)
     k_tried: tuple[int, ...] = ()
+    takes_verified: int | None = None
 
     @property
     def query_frames(self) -> int:
@@ -218,7 +220,7 @@ def search_features(features: np.ndarray, index: FrameIndex, k: int = DEFAULT_K,
                     exclude_takes: Iterable[str] = (), eps: float = 0.0, radius: float | None = None,
                     steps: tuple[Step, ...] = THESIS_STEPS, normalize: Normalization = "none",
                     k_max: int | None = None, grow: str = "none", stable_for: int = DEFAULT_STABLE_FOR,
-                    skip_cost: float | None = None, refine: int = 0) -> SearchResult:
+                    skip_cost: float | None = None, refine: int = 0, verify: bool = False) -> SearchResult:
     """Ranked database segments matching query features ``(m, d)`` (the index's feature set) as a whole.
 
     ``k``: neighbours per query frame (1 ≤ k ≤ database frames outside ``exclude_takes``), the first k a
@@ -229,17 +231,22 @@ def search_features(features: np.ndarray, index: FrameIndex, k: int = DEFAULT_K,
     is given, else each frame's k-th distance); ``refine``: re-rank the LNG's ``max(refine, top)`` best candidates
     by exact subsequence DTW in windows around them (:func:`~stylemotion.search.refine.refine_matches`; 0: the
     LNG's ranking as it is), which makes the matches' costs exact DTW costs (every candidate's window is searched,
-    so as many matches come back as the LNG found, up to ``top``).
+    so as many matches come back as the LNG found, up to ``top``); ``verify``: make the first match exact
+    subsequence DTW's best segment over every take not excluded, sweeping the takes whose lower bound does not
+    exceed the first match's cost (:func:`~stylemotion.search.refine.verify_best`; thesis steps and
+    ``normalize="none"`` only).
 
     Raises:
-        ValueError: bad ``k``/``k_max``/``top``/``grow``/``stable_for``/``refine``/features, an unknown take name
-            (KeyError).
+        ValueError: bad ``k``/``k_max``/``top``/``grow``/``stable_for``/``refine``/features, ``verify`` with other
+            steps or a normalization, an unknown take name (KeyError).
     """
     for value, key in ((k, "k"), (top, "top"), (k if k_max is None else k_max, "k_max")):
         if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
             raise ValueError(f"{key} must be a whole number ≥ 1, got {value!r}")
     if isinstance(refine, bool) or not isinstance(refine, (int, np.integer)) or refine < 0:
         raise ValueError(f"refine must be a whole number ≥ 0, got {refine!r}")
+    if verify and (tuple(steps) != THESIS_STEPS or normalize != "none"):
+        raise ValueError("verify needs the thesis' steps and normalize='none' (the exact search it runs)")
     skip_cost = radius if skip_cost is None else check_skip_cost(skip_cost)
     names, ids = _excluded_frames(index, exclude_takes)
     database = index.database
@@ -267,8 +274,13 @@ def search_features(features: np.ndarray, index: FrameIndex, k: int = DEFAULT_K,
         found = refine_matches(features, index.features, database.take_bounds, found[:candidates], top=int(top),
                                steps=steps, normalize=normalize, skip_cost=skip_cost)
         spent["refine"] = time.perf_counter() - t0
+    swept = None
+    if verify:
+        t0 = time.perf_counter()
+        found, swept = verify_best(features, index.features, database.take_bounds, found, excluded_takes=ids)
+        spent["verify"] = time.perf_counter() - t0
     matches = [_segment(index, m, rank) for rank, m in enumerate(found[:top], start=1)]
-    return SearchResult(matches, indices, distances, tried[-1], names, spent, tried)
+    return SearchResult(matches, indices, distances, tried[-1], names, spent, tried, swept)
 
 
 def search_motion(positions: np.ndarray, index: FrameIndex, k: int = DEFAULT_K, top: int = 10,

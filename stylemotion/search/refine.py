@@ -8,6 +8,10 @@ subsequence DTW (:func:`stylemotion.search.dtw.subsequence_dtw`, every cell eval
 the result is the exact DTW ranking restricted to those windows. It equals the exact search over the whole
 database whenever the exact best segment lies inside a window; the windows cost ``O(N · m · 3m)`` cells, not
 ``O(m · n)``.
+
+:func:`verify_best` goes one step further: with the best candidate's cost as an upper bound it sweeps every take
+whose lower bound does not exceed it (:func:`stylemotion.search.dtw.best_subsequence_match`), so the first match
+is exact DTW's best segment over the whole database, whatever the neighbour lists held.
 """
 
 from __future__ import annotations
@@ -16,7 +20,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from stylemotion.search.dtw import feature_distances, subsequence_dtw
+from stylemotion.search.dtw import best_subsequence_match, feature_distances, subsequence_dtw
 from stylemotion.search.lng import THESIS_STEPS, Match, Normalization, Step, TakeBounds
 
 
@@ -67,3 +71,25 @@ def refine_matches(query: np.ndarray, database: np.ndarray, takes: TakeBounds, c
         start, end = int(frames[match.start]), int(frames[match.end])
         out.append(Match(start, end, match.cost, path, int(takes.take_id[start])))
     return out
+
+
+#: Relative slack on an upper bound taken from a match's cost: the float32 engines' distances may sum to a cost a
+#: hair below the exact one, and a bound too low could prune the best take (a looser bound only sweeps more).
+BOUND_SLACK = 1e-5
+
+
+def verify_best(query: np.ndarray, database: np.ndarray, takes: TakeBounds, matches: Sequence[Match], *,
+                excluded_takes: Sequence[int] = ()) -> tuple[list[Match], int]:
+    """``matches`` (best first) with exact subsequence DTW's best segment (thesis steps, no normalization) first.
+
+    The first match's cost (× ``1 +`` :data:`BOUND_SLACK`) bounds DTW's best from above, so only the takes whose
+    lower bound does not exceed it are swept; without matches every take is. When DTW's best differs from the
+    first match it is put first and the matches overlapping it are dropped. ``excluded_takes``: take positions
+    never searched. Returns the matches and the number of takes swept.
+    """
+    upper = matches[0].cost * (1.0 + BOUND_SLACK) + 1e-12 if matches else None
+    best, swept = best_subsequence_match(query, database, takes, upper_bound=upper, excluded_takes=excluded_takes)
+    if best is None or (matches and (matches[0].start, matches[0].end) == (best.start, best.end)):
+        return list(matches), swept
+    rest = [m for m in matches if m.take != best.take or m.end < best.start or m.start > best.end]
+    return [best, *rest], swept

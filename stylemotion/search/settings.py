@@ -57,6 +57,11 @@ class SearchSettings(MotionFileKeys):
     (:func:`stylemotion.search.refine.refine_matches`; the costs reported are then exact DTW costs); 0: off.
     Chosen with ``grow``, ``k_max`` and ``stable_for`` on Bandai's validation queries by
     ``python scripts/benchmarks.py run search`` (among 0, 8, 32; block ``growth_choice``).
+    ``verify``: make the best match exact subsequence DTW's best segment over the whole database: every take whose
+    lower bound (each query frame's nearest frame in it, summed) does not exceed the LNG's best cost is swept by
+    exact DTW (:func:`stylemotion.search.refine.verify_best`; ``search.json``'s ``takes_verified`` counts them);
+    thesis steps and ``normalize=none`` only. Not tuned: on, because a user asking for the best match should get
+    it; its cost is measured by ``python scripts/benchmarks.py run search`` (block ``growth``).
     ``steps``: the LNG's step set: thesis (diagonal, vertical, horizontal: a path may stay on one database
     frame) | online (the OLNG's (1,1), (1,2), (2,1), (2,2)) | gaps (thesis + online skips: a path may skip a query
     frame whose neighbours missed it, paying ``skip_cost``); not tuned: the thesis' set, as §2.4.1.
@@ -85,6 +90,7 @@ class SearchSettings(MotionFileKeys):
     grow: str = "stable"
     stable_for: int = 1
     refine: int = 8
+    verify: bool = True
     steps: str = "thesis"
     skip_cost: float | None = None
     top: int = 10

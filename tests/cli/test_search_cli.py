@@ -101,6 +101,10 @@ def test_the_query_take_is_excluded_by_default_and_gifs_are_written(tmp_path: Pa
     ({"stable_for": 0}, "stable_for must be a whole number ≥ 1, got 0"),
     ({"steps": "wide"}, "steps=wide is none of ['thesis', 'online', 'gaps']"),
     ({"skip_cost": -1}, "skip_cost=-1 must be a finite number ≥ 0"),
+    ({"verify": "yes"}, "verify=yes must be true or false"),
+    ({"steps": "gaps"}, "verify=true needs steps=thesis and normalize=none (got steps=gaps, normalize=none); set "
+                        "verify=false"),
+    ({"normalize": "length"}, "verify=true needs steps=thesis and normalize=none"),
 ])
 def test_bad_input_is_refused_naming_the_value(overrides: dict, message: str, tmp_path: Path) -> None:
     kwargs = {"data": SYNTHETIC, "query": f"{TAKE}:30-90", "out": tmp_path / "out", **overrides}
@@ -165,8 +169,11 @@ def test_fewer_matches_than_asked_for_says_that_a_larger_k_finds_more(tmp_path: 
 @pytest.mark.parametrize("steps", ["thesis", "gaps"])
 def test_k_grows_from_k_to_k_max_and_search_json_says_which_k_answered(steps: str, tmp_path: Path, caplog) -> None:
     with caplog.at_level(logging.INFO, logger="stylemotion"):
-        report = search(SYNTHETIC, f"{TAKE}:30-90", tmp_path / "out", k=2, k_max=64, grow="stable", steps=steps, top=1)
+        report = search(SYNTHETIC, f"{TAKE}:30-90", tmp_path / "out", k=2, k_max=64, grow="stable", steps=steps, top=1,
+                        verify=steps == "thesis")
     tried = report["k_tried"]
+    assert report["verify"] == (steps == "thesis")
+    assert (report["takes_verified"] is not None) == ("verify" in report["timing_s"]) == (steps == "thesis")
     assert report["matches"] and tried[0] == 2 and report["k_used"] == tried[-1] <= 64
     assert all(b == 2 * a for a, b in zip(tried, tried[1:]))
     assert (report["k"], report["k_max"], report["grow"], report["steps"]) == (2, 64, "stable", steps)

@@ -74,6 +74,7 @@ def test_test_variants_keep_the_older_rule_beside_the_chosen_and_old_records_rea
     assert search._test_variants(["stable", 65536, 2]) == [("stable", 65536, 2, 0), ("path", 65536, 1, 0),
                                                            ("stable", 65536, 1, 0), ("stable", 16384, 1, 0)]
     assert search._test_variants(["stable", 16384]) == [("stable", 16384, 1, 0), ("path", 16384, 1, 0)]
+    assert search._verified_name(["stable", 16384, 1, 8]) == "grow stable to 16384 + refine 8 + verify"
     assert search._growth_name(*search._rule(["stable", 16384])) == "grow stable to 16384"
     # the chosen refine and, beside it, the same growth with every other refine option measured
     assert search._test_variants(["stable", 16384, 2, 8], [0, 8, 32]) == [

@@ -93,3 +93,70 @@ def test_search_with_refine_reports_exact_dtw_costs():
                                                                       for m in refined.matches}
     with pytest.raises(ValueError, match="refine"):
         search_features(features, index, k=8, refine=-1)
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2, 3])
+def test_verify_puts_the_exact_best_first_whatever_the_candidates(seed):
+    """verify_best against the plain-Python DTW (tests/dtw_reference.py) over every take: a wrong or missing
+    candidate list still yields the exact best; matches overlapping it are dropped; excluded takes are never
+    answered; the number of takes swept is bounded by the takes."""
+    from dtw_reference import brute_dtw
+
+    from stylemotion.search.dtw import feature_distances
+    from stylemotion.search.refine import verify_best
+
+    rng = np.random.default_rng(40 + seed)
+    lengths = [int(n) for n in rng.integers(20, 60, size=8)]
+    database = _walks(rng, lengths, d=3)
+    takes = TakeBounds.from_lengths(lengths)
+    take = int(rng.integers(len(lengths)))
+    first = sum(lengths[:take])
+    query = database[first + 3:first + 12] + rng.normal(0, 0.05, (9, 3))
+    cost = feature_distances(query, database)
+    ref_cost, ref_start, ref_end = brute_dtw(cost, lengths)[:3]
+    other = sum(lengths[:(take + 1) % len(lengths)])  # a candidate in another take
+    wrong = Match(other, other + 8, 1e9, np.zeros((1, 2), dtype=np.int64), (take + 1) % len(lengths))
+    for candidates in ([], [wrong]):
+        got, swept = verify_best(query, database, takes, candidates)
+        assert (got[0].start, got[0].end) == (ref_start, ref_end) and got[0].cost == pytest.approx(ref_cost, rel=1e-12)
+        assert 1 <= swept <= len(lengths) and 1 <= len(got) <= len(candidates) + 1
+        assert all(m.take != got[0].take or m.end < got[0].start or m.start > got[0].end for m in got[1:])
+    exact, _ = verify_best(query, database, takes, [])
+    kept, swept = verify_best(query, database, takes, exact)  # already the best: unchanged, few takes swept
+    assert kept == exact and swept <= len(lengths)
+    others, _ = verify_best(query, database, takes, [], excluded_takes=[exact[0].take])
+    assert others[0].take != exact[0].take and others[0].cost >= exact[0].cost - 1e-12
+
+
+def test_take_bounds_in_chunks_equal_the_whole_matrix(monkeypatch):
+    import stylemotion.search.dtw as dtw
+
+    rng = np.random.default_rng(9)
+    lengths = [int(n) for n in rng.integers(1, 40, size=15)]
+    database = _walks(rng, lengths, d=4)
+    takes = TakeBounds.from_lengths(lengths)
+    query = rng.normal(size=(7, 4))
+    whole = np.minimum.reduceat(dtw.feature_distances(query, database), takes.spans()[0], axis=1).sum(axis=0)
+    for cells in (7, 7 * 13, 7 * 1000):  # one frame, chunks cutting takes, one chunk
+        monkeypatch.setattr(dtw, "BOUND_CHUNK_CELLS", cells)
+        np.testing.assert_array_equal(dtw.take_lower_bounds(query, database, takes), whole)
+
+
+def test_search_with_verify_answers_exact_dtw_over_every_take():
+    takeset = load_dataset("synthetic", takes_per_pair=1)
+    held_out = takeset.takes[3]
+    index = FrameIndex.build(takeset.__class__(takeset.name, [t for t in takeset.takes if t is not held_out],
+                                               takeset.fps), "E15", use_cache=False)
+    features = index.features_of(held_out.positions[5:65].astype(np.float64))
+    full = subsequence_dtw_features(features, index.features, index.database.take_bounds, top=1).best
+    for k in (1, 8):  # k = 1: the LNG finds no path or a poor one; verify still answers DTW's best
+        got = search_features(features, index, k=k, top=3, verify=True)
+        assert (got.matches[0].global_start, got.matches[0].global_end - 1) == (full.start, full.end)
+        assert got.matches[0].cost == pytest.approx(full.cost, rel=1e-12)
+        assert "verify" in got.timings and 1 <= got.takes_verified <= index.database.num_takes
+    name = index.database.take_names[full.take]
+    without = search_features(features, index, k=8, top=1, verify=True, exclude_takes=[name])
+    assert without.matches[0].take != name and without.matches[0].cost >= full.cost - 1e-9
+    assert search_features(features, index, k=8, top=1).takes_verified is None
+    with pytest.raises(ValueError, match="verify needs the thesis' steps"):
+        search_features(features, index, k=8, verify=True, normalize="length")
