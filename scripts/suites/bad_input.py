@@ -685,7 +685,8 @@ def build_cases(p: Inputs) -> list[Case]:
     # --- stylemotion-search -------------------------------------------------------------------------------------
     se = "stylemotion-search"
     q = f"query={TAKE}:0-30"
-    for override, names in [("k=0", ["k"]), ("features=bogus", ["bogus"]), ("k=1e12", ["k"])]:
+    for override, names in [("k=0", ["k"]), ("features=bogus", ["bogus"]), ("k=1e12", ["k"]),
+                            ("verify=maybe", ["verify"]), ("steps=gaps", ["verify", "steps=gaps"])]:
         add(se, f"value_{override}", [*DATA, q, override, "out=out"], "refused", "bad Hydra value", names)
     for query, names in [(f"{TAKE}:0-99999", ["99999"]), (f"{i('good.bvh')}:50-10", ["50-10"]),
                          (f"{i('notes.txt')}", ["notes.txt"]),

@@ -229,18 +229,24 @@ BOUND_CHUNK_CELLS = 1 << 24
 def take_lower_bounds(query: np.ndarray, database: np.ndarray, takes: TakeBounds) -> np.ndarray:
     """``(takes,)`` ``LB(T) = Σ_i min_{g ∈ T} C[i, g]`` of query ``(m, d)`` against database ``(n, d)`` features:
     no thesis-step path inside take ``T`` costs less (each step visits every query frame at least once).
-    Computed over chunks of :data:`BOUND_CHUNK_CELLS` cells."""
+    Computed over chunks of :data:`BOUND_CHUNK_CELLS` cells; memory ``O(chunk + m)`` (a take cut by a chunk's
+    end carries its ``(m,)`` minima into the next chunk)."""
     q = np.asarray(query, dtype=np.float64)
-    starts, _ = takes.spans()
-    mins = np.full((len(q), len(starts)), np.inf)
+    starts, ends = takes.spans()
+    bound = np.empty(len(starts))
+    open_mins: np.ndarray | None = None  # minima of the take the previous chunk ended inside
     step = max(1, BOUND_CHUNK_CELLS // max(len(q), 1))
     for lo in range(0, takes.n, step):
         hi = min(takes.n, lo + step)
         cuts = np.concatenate([[lo], starts[(starts > lo) & (starts < hi)]])  # one segment per take in the chunk
         ids = np.searchsorted(starts, cuts, side="right") - 1  # the takes' positions
         segment = np.minimum.reduceat(feature_distances(q, database[lo:hi]), cuts - lo, axis=1)
-        mins[:, ids] = np.minimum(mins[:, ids], segment)
-    return mins.sum(axis=0)
+        if open_mins is not None:  # the first segment continues the open take
+            segment[:, 0] = np.minimum(segment[:, 0], open_mins)
+        done = ends[ids] < hi
+        bound[ids[done]] = segment[:, done].sum(axis=0)
+        open_mins = None if done[-1] else segment[:, -1].copy()
+    return bound
 
 
 def best_subsequence_match(query: np.ndarray, database: np.ndarray, takes: TakeBounds | np.ndarray, *,
