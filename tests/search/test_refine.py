@@ -70,12 +70,18 @@ def test_refine_never_beats_the_whole_database_and_stays_in_its_windows():
     assert refine_matches(query, database, takes, [], skip_cost=SKIP) == []
 
 
-def test_search_with_refine_reports_exact_dtw_costs():
+@pytest.fixture(scope="module")
+def held_out_query() -> tuple[FrameIndex, np.ndarray]:
+    """An E15 index over the synthetic takes but one, and the features of 60 frames of that one."""
     takeset = load_dataset("synthetic", takes_per_pair=1)
     held_out = takeset.takes[3]
     index = FrameIndex.build(takeset.__class__(takeset.name, [t for t in takeset.takes if t is not held_out],
                                                takeset.fps), "E15", use_cache=False)
-    features = index.features_of(held_out.positions[5:65].astype(np.float64))
+    return index, index.features_of(held_out.positions[5:65].astype(np.float64))
+
+
+def test_search_with_refine_reports_exact_dtw_costs(held_out_query):
+    index, features = held_out_query
     plain = search_features(features, index, k=8, top=3, k_max=64, grow="path")
     refined = search_features(features, index, k=8, top=3, k_max=64, grow="path", refine=8)
     assert refined.matches and "refine" in refined.timings
@@ -142,12 +148,8 @@ def test_take_bounds_in_chunks_equal_the_whole_matrix(monkeypatch):
         np.testing.assert_array_equal(dtw.take_lower_bounds(query, database, takes), whole)
 
 
-def test_search_with_verify_answers_exact_dtw_over_every_take():
-    takeset = load_dataset("synthetic", takes_per_pair=1)
-    held_out = takeset.takes[3]
-    index = FrameIndex.build(takeset.__class__(takeset.name, [t for t in takeset.takes if t is not held_out],
-                                               takeset.fps), "E15", use_cache=False)
-    features = index.features_of(held_out.positions[5:65].astype(np.float64))
+def test_search_with_verify_answers_exact_dtw_over_every_take(held_out_query):
+    index, features = held_out_query
     full = subsequence_dtw_features(features, index.features, index.database.take_bounds, top=1).best
     for k in (1, 8):  # k = 1: the LNG finds no path or a poor one; verify still answers DTW's best
         got = search_features(features, index, k=k, top=3, verify=True)
