@@ -226,13 +226,23 @@ def _backtrack(choice: np.ndarray, i: int, g: int, steps: tuple[Step, ...]) -> n
 BOUND_CHUNK_CELLS = 1 << 24
 
 
-def take_lower_bounds(query: np.ndarray, database: np.ndarray, takes: TakeBounds) -> np.ndarray:
+def take_lower_bounds(query: np.ndarray, database: np.ndarray, takes: TakeBounds,
+                      only: np.ndarray | None = None) -> np.ndarray:
     """``(takes,)`` ``LB(T) = Σ_i min_{g ∈ T} C[i, g]`` of query ``(m, d)`` against database ``(n, d)`` features:
     no thesis-step path inside take ``T`` costs less (each step visits every query frame at least once).
     Computed over chunks of :data:`BOUND_CHUNK_CELLS` cells; memory ``O(chunk + m)`` (a take cut by a chunk's
-    end carries its ``(m,)`` minima into the next chunk)."""
+    end carries its ``(m,)`` minima into the next chunk). ``only``: take positions to bound (the others ``inf``),
+    reading only their frames."""
     q = np.asarray(query, dtype=np.float64)
     starts, ends = takes.spans()
+    if only is not None:
+        chosen = np.unique(np.asarray(only, dtype=np.int64))
+        out = np.full(len(starts), np.inf)
+        if chosen.size:
+            frames = np.concatenate([np.arange(starts[t], ends[t] + 1) for t in chosen])
+            out[chosen] = take_lower_bounds(q, database[frames],
+                                            TakeBounds.from_lengths(ends[chosen] - starts[chosen] + 1))
+        return out
     bound = np.empty(len(starts))
     open_mins: np.ndarray | None = None  # minima of the take the previous chunk ended inside
     step = max(1, BOUND_CHUNK_CELLS // max(len(q), 1))
@@ -251,7 +261,8 @@ def take_lower_bounds(query: np.ndarray, database: np.ndarray, takes: TakeBounds
 
 def best_subsequence_match(query: np.ndarray, database: np.ndarray, takes: TakeBounds | np.ndarray, *,
                            upper_bound: float | None = None, first_takes: int = 8,
-                           excluded_takes: Sequence[int] = ()) -> tuple[Match | None, int]:
+                           excluded_takes: Sequence[int] = (),
+                           candidate_takes: np.ndarray | None = None) -> tuple[Match | None, int]:
     """The best :func:`subsequence_dtw_features` match (thesis steps, no normalization) of query ``(m, d)``
     features in database ``(n, d)`` features, exactly, without sweeping takes that cannot hold it.
 
@@ -260,7 +271,9 @@ def best_subsequence_match(query: np.ndarray, database: np.ndarray, takes: TakeB
     uses ``upper_bound``, e.g. the LNG's best cost, which can only be higher than DTW's), then on every
     take whose bound does not exceed the best cost so far (a relative margin of 1e-9 covers rounding),
     kept in database order so ties break as in the full sweep; ``excluded_takes`` (takes' positions in database
-    order, a :class:`~stylemotion.search.MotionDatabase`'s take indices) are never swept.
+    order, a :class:`~stylemotion.search.MotionDatabase`'s take indices) are never swept; ``candidate_takes``
+    (positions; None: every take): the only takes bounded and swept, for a caller that has pruned the others with
+    a bound of its own below ``upper_bound``.
     Memory: the bounds' chunks and the swept takes' columns, never the whole ``(m, n)`` matrix. Returns the match
     in the database's global frames (``None`` without any path) and the number of takes swept. Tests: equal to
     the full sweep.
@@ -270,7 +283,7 @@ def best_subsequence_match(query: np.ndarray, database: np.ndarray, takes: TakeB
     if tb.n != len(database):
         raise ValueError(f"takes describe {tb.n} database frames, the features have {len(database)}")
     starts, ends = tb.spans()
-    bound = take_lower_bounds(q, database, tb)
+    bound = take_lower_bounds(q, database, tb, only=candidate_takes)
     bound[np.asarray(list(excluded_takes), dtype=np.int64)] = np.inf
     order = np.argsort(bound, kind="stable")
     order = order[np.isfinite(bound[order])]

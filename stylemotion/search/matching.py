@@ -32,7 +32,7 @@ from typing import Any
 
 import numpy as np
 
-from stylemotion.search.index import FrameIndex
+from stylemotion.search.index import EXACT_ENGINES, FrameIndex
 from stylemotion.search.lng import THESIS_STEPS, Match, Normalization, Step, check_skip_cost, lng_match
 from stylemotion.search.refine import refine_matches, verify_best
 from stylemotion.search.settings import SearchSettings
@@ -277,7 +277,9 @@ def search_features(features: np.ndarray, index: FrameIndex, k: int = DEFAULT_K,
     swept = None
     if verify:
         t0 = time.perf_counter()
-        found, swept = verify_best(features, index.features, database.take_bounds, found, excluded_takes=ids)
+        exact = eps == 0 and radius is None and index.engine in EXACT_ENGINES and bool(np.isfinite(distances).all())
+        found, swept = verify_best(features, index.features, database.take_bounds, found, excluded_takes=ids,
+                                   neighbours=(indices, distances) if exact else None)
         spent["verify"] = time.perf_counter() - t0
     matches = [_segment(index, m, rank) for rank, m in enumerate(found[:top], start=1)]
     return SearchResult(matches, indices, distances, tried[-1], names, spent, tried, swept)

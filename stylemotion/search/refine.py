@@ -78,17 +78,39 @@ def refine_matches(query: np.ndarray, database: np.ndarray, takes: TakeBounds, c
 BOUND_SLACK = 1e-5
 
 
+def neighbour_floor(indices: np.ndarray, distances: np.ndarray, takes: TakeBounds) -> np.ndarray:
+    """``(takes,)`` a lower bound of ``LB(T) = Σ_i min_{g ∈ T} C[i, g]`` from the query frames' exact k nearest
+    frames alone (``indices``, ``distances`` ``(m, k)``, ascending per row, all finite): where frame i has
+    neighbours in T the nearest of them is T's nearest frame (a nearer one would be among the k); where it has none,
+    every frame of T is at least its k-th distance away. No database frame is read."""
+    starts, _ = takes.spans()
+    m, count = len(starts), len(distances)
+    kth = distances[:, -1]
+    keys = (np.arange(count)[:, None] * m + (np.searchsorted(starts, indices, side="right") - 1)).ravel()
+    pairs, first = np.unique(keys, return_index=True)  # rows ascending: the first of a (row, take) is its nearest
+    gain = distances.ravel()[first] - kth[pairs // m]  # ≤ 0: how much nearer than the k-th the take comes
+    return float(np.sum(kth)) + np.bincount(pairs % m, weights=gain, minlength=m)
+
+
 def verify_best(query: np.ndarray, database: np.ndarray, takes: TakeBounds, matches: Sequence[Match], *,
-                excluded_takes: Sequence[int] = ()) -> tuple[list[Match], int]:
+                excluded_takes: Sequence[int] = (),
+                neighbours: tuple[np.ndarray, np.ndarray] | None = None) -> tuple[list[Match], int]:
     """``matches`` (best first) with exact subsequence DTW's best segment (thesis steps, no normalization) first.
 
     The first match's cost (× ``1 +`` :data:`BOUND_SLACK`) bounds DTW's best from above, so only the takes whose
-    lower bound does not exceed it are swept; without matches every take is. When DTW's best differs from the
-    first match it is put first and the matches overlapping it are dropped. ``excluded_takes``: take positions
-    never searched. Returns the matches and the number of takes swept.
+    lower bound does not exceed it are swept; without matches every take is. ``neighbours``: the query frames'
+    **exact** k nearest frames outside the excluded takes (``(indices, distances)`` ``(m, k)``, ascending, finite)
+    — their :func:`neighbour_floor` (× ``1 −`` :data:`BOUND_SLACK`) prunes takes before any of their frames is
+    read. When DTW's best differs from the first match it is put first and the matches overlapping it are dropped.
+    ``excluded_takes``: take positions never searched. Returns the matches and the number of takes swept.
     """
     upper = matches[0].cost * (1.0 + BOUND_SLACK) + 1e-12 if matches else None
-    best, swept = best_subsequence_match(query, database, takes, upper_bound=upper, excluded_takes=excluded_takes)
+    candidates = None
+    if upper is not None and neighbours is not None:
+        floor = neighbour_floor(*neighbours, takes) * (1.0 - BOUND_SLACK)
+        candidates = np.flatnonzero(floor <= upper)
+    best, swept = best_subsequence_match(query, database, takes, upper_bound=upper, excluded_takes=excluded_takes,
+                                         candidate_takes=candidates)
     if best is None or (matches and (matches[0].start, matches[0].end) == (best.start, best.end)):
         return list(matches), swept
     rest = [m for m in matches if m.take != best.take or m.end < best.start or m.start > best.end]

@@ -162,3 +162,40 @@ def test_search_with_verify_answers_exact_dtw_over_every_take(held_out_query):
     assert search_features(features, index, k=8, top=1).takes_verified is None
     with pytest.raises(ValueError, match="verify needs the thesis' steps"):
         search_features(features, index, k=8, verify=True, normalize="length")
+
+
+@pytest.mark.parametrize("k", [1, 5, 40])
+def test_the_neighbour_floor_never_exceeds_the_take_bounds_and_prunes_the_same_best(k):
+    """neighbour_floor from brute-force k nearest frames: ≤ the exact take bounds everywhere, equal where every query
+    frame has a neighbour in the take; verify with it answers what verify without it does; ``only`` bounds just the
+    takes it names."""
+    from stylemotion.search.dtw import feature_distances, take_lower_bounds
+    from stylemotion.search.refine import neighbour_floor, verify_best
+
+    rng = np.random.default_rng(k)
+    lengths = [int(n) for n in rng.integers(15, 50, size=10)]
+    database = _walks(rng, lengths, d=3)
+    takes = TakeBounds.from_lengths(lengths)
+    query = database[40:52] + rng.normal(0, 0.05, (12, 3))
+    cost = feature_distances(query, database)
+    nearest = np.argsort(cost, axis=1, kind="stable")[:, :k]
+    dist = np.take_along_axis(cost, nearest, axis=1)
+    floor = neighbour_floor(nearest, dist, takes)
+    exact = take_lower_bounds(query, database, takes)
+    assert np.all(floor <= exact + 1e-12)
+    starts, ends = takes.spans()
+    covered = [all(np.any((row >= a) & (row <= b)) for row in nearest) for a, b in zip(starts, ends)]
+    np.testing.assert_allclose(floor[covered], exact[covered], rtol=1e-12)
+    assert any(covered) and not all(covered)
+    plain, _ = verify_best(query, database, takes, [])
+    start = sum(lengths[:3])  # a poor candidate in take 3: a loose bound, so the floor must do the pruning
+    poor = Match(start, start + 11, float(cost[np.arange(12), np.arange(start, start + 12)].sum()),
+                 np.zeros((1, 2), dtype=np.int64), 3)
+    floored, swept = verify_best(query, database, takes, [poor], neighbours=(nearest, dist))
+    unfloored, swept_all = verify_best(query, database, takes, [poor])
+    assert (floored[0].start, floored[0].end) == (unfloored[0].start, unfloored[0].end) == (plain[0].start,
+                                                                                            plain[0].end)
+    assert swept <= swept_all
+    only = take_lower_bounds(query, database, takes, only=np.array([4, 1]))
+    np.testing.assert_array_equal(only[[1, 4]], exact[[1, 4]])
+    assert np.isinf(np.delete(only, [1, 4])).all()
