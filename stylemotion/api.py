@@ -169,7 +169,8 @@ def walk(run: str | os.PathLike | Mapping[str, Any], out: str | os.PathLike, *, 
 def search_motion(query: str | os.PathLike, out: str | os.PathLike, *, data: str | Mapping[str, Any] = "synthetic",
                   force: bool = False, **keys: Any) -> dict[str, Any]:
     """The database segments most like a query motion, as ``stylemotion-search`` finds them (Krüger §2.4.1: k-NN of
-    every query frame, then the best paths through the lazy neighbourhood graph); writes ``out``: ``matches.json``,
+    every query frame, then the best paths through the lazy neighbourhood graph, the best made exact DTW's with
+    ``verify=True``, the default); writes ``out``: ``matches.json``,
     ``search.json``, ``distance_matrix.png`` (the thesis' Fig. 2.8).
 
     Args:

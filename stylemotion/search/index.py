@@ -92,6 +92,9 @@ _EMBED_CHUNK = 100_000
 #: Any value gives exact answers; it sets the speed only. Chosen on validation (a train-take database, val-take
 #: query clips) by ``python scripts/benchmarks.py run engines`` (benchmarks/engines.md, block ``engines/validation``).
 FILTER_FETCH: tuple[int, int, int] = (8, 2, 128)
+#: Most candidate coordinates (queries × fetched frames × dimensions) one pass of ``ckdtree-pca`` holds in float64
+#: (16 M: 128 MB); a large batch of queries (a motion graph's every frame) is answered in slices of that size.
+_FETCH_CELLS = 1 << 24
 #: Training points per IVF cell (k-means on a seeded sample of the database; faiss wants ≥ 39).
 IVF_TRAIN_PER_LIST = 40
 #: ``engine="auto"``: ``(largest feature dimension, exact engine)`` rows in ascending order; features of dimension
@@ -149,8 +152,9 @@ class _ProjectedKDTree:
     fetches its ``first · k`` nearest in the embedding and ranks them by float64 distances (ties by index); it is
     settled when the last one fetched lies farther in the embedding than the k-th true distance found, as then no
     other frame can be nearer (Seidl & Kriegel's multi-step k-NN, in rounds of ``growth`` times more, up to
-    ``last · k``; :attr:`fetch`). A query still unsettled takes every frame embedded within that k-th distance. ε
-    is not used: the answer is exact.
+    ``last · k``; :attr:`fetch`). A query still unsettled takes every frame embedded within that k-th distance. A
+    radius search (a finite ``bound``) runs one round of k and then the ball within ``min(r, bound)``. ε is not
+    used: the answer is exact.
     """
 
     def __init__(self, data: np.ndarray, workers: int):
@@ -187,13 +191,18 @@ class _ProjectedKDTree:
         z = self.embed(x)
         distances, indices = np.full((m, k), np.inf), np.full((m, k), n, dtype=np.int64)
         pending, limit = np.arange(m), np.full(m, bound)
-        first, growth, last = self.fetch
+        # a radius caps the ball query already: one round of k, then the ball (the rounds pay off without a radius)
+        first, growth, last = self.fetch if math.isinf(bound) else (1, 2, 1)
         fetch = min(n, k * first)
         while pending.size and fetch <= k * last:
-            pending, limit = self._fetched(x, z, pending, k, fetch, bound, distances, indices)
+            step = max(1, _FETCH_CELLS // (fetch * x.shape[1]))  # queries per slice: bounded memory
+            parts = [self._fetched(x, z, pending[i:i + step], k, fetch, bound, distances, indices)
+                     for i in range(0, len(pending), step)]
+            pending, limit = np.concatenate([p[0] for p in parts]), np.concatenate([p[1] for p in parts])
             fetch = min(n, max(fetch + 1, fetch * growth))
-        if pending.size:
-            self._ball(x, z, pending, k, limit, bound, distances, indices)
+        step = max(1, _FETCH_CELLS // (k * last * x.shape[1]))  # the ball holds about as many frames as the last round
+        for i in range(0, len(pending), step):
+            self._ball(x, z, pending[i:i + step], k, limit[i:i + step], bound, distances, indices)
         return distances, indices
 
     def _fetched(self, x: np.ndarray, z: np.ndarray, rows: np.ndarray, k: int, fetch: int, bound: float,

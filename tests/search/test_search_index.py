@@ -130,6 +130,20 @@ def test_projected_engine_is_exact_in_every_stage_of_its_multi_step_search(datab
     assert np.all(np.isinf(dist[~inside])) and np.all(idx[~inside] == -1)
 
 
+def test_projected_engine_answers_large_batches_in_slices_of_bounded_memory(database, monkeypatch):
+    """A batch of queries larger than one pass may hold (a motion graph queries every frame) is answered in slices,
+    with brute force's answers: the cap that kept suite fat_graph's 300k-frame batches from 24 GB."""
+    import stylemotion.search.index as index_module
+
+    rng = np.random.default_rng(3)
+    features = (rng.normal(size=(database.num_frames, 3)) @ rng.normal(size=(3, 75))).astype(np.float32)
+    features += rng.normal(0, 0.01, features.shape).astype(np.float32)
+    index = FrameIndex(database, "E15x5", features, engine="ckdtree-pca")
+    monkeypatch.setattr(index_module, "_FETCH_CELLS", 75 * 8 * 16 * 3)  # three queries per slice at the first fetch
+    queries = features[::97][:40] + rng.normal(0, 0.02, (40, 75)).astype(np.float32)
+    _check_exact(index, queries, 16, "ckdtree-pca")
+
+
 @pytest.mark.parametrize("feature_set", ["E15", "E15x3", "pca8", "EP19"])
 def test_exact_search_on_the_synthetic_dataset(takeset, feature_set):
     """A take the database does not hold, queried frame by frame: the same neighbours as numpy brute force."""
