@@ -239,9 +239,8 @@ def take_lower_bounds(query: np.ndarray, database: np.ndarray, takes: TakeBounds
         chosen = np.unique(np.asarray(only, dtype=np.int64))
         out = np.full(len(starts), np.inf)
         if chosen.size:
-            frames = np.concatenate([np.arange(starts[t], ends[t] + 1) for t in chosen])
-            out[chosen] = take_lower_bounds(q, database[frames],
-                                            TakeBounds.from_lengths(ends[chosen] - starts[chosen] + 1))
+            frames, layout = takes.subset(chosen)
+            out[chosen] = take_lower_bounds(q, database[frames], layout)
         return out
     bound = np.empty(len(starts))
     open_mins: np.ndarray | None = None  # minima of the take the previous chunk ended inside
@@ -282,7 +281,6 @@ def best_subsequence_match(query: np.ndarray, database: np.ndarray, takes: TakeB
     tb = TakeBounds.coerce(takes)
     if tb.n != len(database):
         raise ValueError(f"takes describe {tb.n} database frames, the features have {len(database)}")
-    starts, ends = tb.spans()
     bound = take_lower_bounds(q, database, tb, only=candidate_takes)
     bound[np.asarray(list(excluded_takes), dtype=np.int64)] = np.inf
     order = np.argsort(bound, kind="stable")
@@ -291,10 +289,8 @@ def best_subsequence_match(query: np.ndarray, database: np.ndarray, takes: TakeB
     def sweep(chosen: np.ndarray) -> Match | None:
         if chosen.size == 0:
             return None
-        chosen = np.sort(chosen)
-        frames = np.concatenate([np.arange(starts[t], ends[t] + 1) for t in chosen])
-        lengths = ends[chosen] - starts[chosen] + 1
-        found = subsequence_dtw(feature_distances(q, database[frames]), TakeBounds.from_lengths(lengths)).best
+        frames, layout = tb.subset(np.sort(chosen))
+        found = subsequence_dtw(feature_distances(q, database[frames]), layout).best
         if found is None:
             return None
         path = found.path.copy()

@@ -164,6 +164,13 @@ class TakeBounds:
         lasts = np.flatnonzero(self.remaining == 0)
         return np.concatenate([[0], lasts[:-1] + 1]), lasts
 
+    def subset(self, positions: np.ndarray) -> tuple[np.ndarray, TakeBounds]:
+        """The global frames ``(f,)`` of the takes at ``positions`` (ascending, non-empty), stored one after
+        another, and their own layout (take ids: their order in ``positions``)."""
+        firsts, lasts = self.spans()
+        lengths = lasts[positions] - firsts[positions] + 1
+        return np.concatenate([np.arange(firsts[t], lasts[t] + 1) for t in positions]), TakeBounds.from_lengths(lengths)
+
     def allows(self, p: np.ndarray, dg: int) -> np.ndarray:
         """``(...)`` bool: a step of ``dg`` database frames from frames ``p`` stays inside the database and
         the take."""
