@@ -18,8 +18,10 @@ Per seed: Bandai is split by take (``TakeSet.split(seed, 0.1, 0.1)``, grouped by
   joints, which the k-NN alone cannot beat.
 * **Bandai leave-style-out**: :func:`stylemotion.datasets.retarget.actor_groups` finds one actor group in Bandai
   (suite ``actors``), so a leave-actor-group-out split does not exist; the nearest stand-in: per seed one style
-  (drawn with the seed) is left out of the database (train takes of the other styles), ``k`` is chosen on that
-  style's val takes and reported on its test takes.
+  (drawn with the seed) is left out of the database (train takes of the other styles); the marker-only feature set,
+  ``k`` and the local model's prior weight are chosen together on that style's val takes (a grid, ``--features``,
+  ``--k``, ``--prior-weights``) and reported on its test takes. The other captures use the seed's choice (beside
+  them the library's defaults), so nothing is chosen on them.
 """
 
 from __future__ import annotations
@@ -42,7 +44,10 @@ CONDITIONS = {
     "skin": "skin markers, database's bones",
     "skin_scaled": "skin markers, database scaled to the subject from the markers",
     "skin_lengths": "skin markers, the subject's bone lengths given",
-    "skin_subject": "skin markers, the subject's skeleton given (bone lengths and rigid bones: calibration)",
+    "skin_subject": "skin markers, the subject's skeleton given (bone lengths, rigid bones, feet: calibration)",
+    "skin_subject_no_feet": "the same without the feet's convention (the database's foot bones)",
+    "skin_subject_defaults": "the same with the library's defaults (E15, k 512, prior weight 1) instead of the val "
+                             "choice",
     "skin_subject_unheld": "the same, bones not held (the local model's poses as they come)",
     "skin_subject_nn": "nearest neighbour (k = 1), the subject's skeleton given",
     "floor_subject": "floor: the database pose nearest to the truth in all joints, on the subject's skeleton",
@@ -53,6 +58,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--contents", nargs="+", default=["walk", "run", "wave-both-hands", "raise-up-both-hands"],
                         help="Bandai queries' contents (leave-style-out)")
     parser.add_argument("--k", type=int, nargs="+", default=[128, 512], help="candidates of k (chosen on val)")
+    parser.add_argument("--features", nargs="+", default=["E15", "E15x3", "E15x5"],
+                        help="candidate marker-only feature sets (chosen on val with k and the prior weight)")
+    parser.add_argument("--prior-weights", type=float, nargs="+", default=[1.0, 3.0, 10.0],
+                        help="candidates of the local model's prior weight (chosen on val)")
     parser.add_argument("--placement-mm", type=float, default=10.0, help="marker placement error, ± mm per axis")
     parser.add_argument("--jitter-mm", type=float, default=1.0, help="per-frame marker jitter, ± mm per axis")
 
@@ -69,7 +78,7 @@ def _floor(rec, markers: np.ndarray, truth: np.ndarray) -> np.ndarray:
     return to_world(rec.local[nearest].reshape(len(truth), -1, 3), rotation, origin)
 
 
-def _other_captures(args, database, k: int, rng: np.random.Generator) -> dict[str, Any]:
+def _other_captures(args, database, chosen: dict[str, Any], rng: np.random.Generator) -> dict[str, Any]:
     from stylemotion.bones import median_bone_lengths
     from stylemotion.reconstruct import DEFAULT_MARKERS, SparseReconstructor, read_markers
     from stylemotion.reconstruct.benchmark import (
@@ -80,11 +89,14 @@ def _other_captures(args, database, k: int, rng: np.random.Generator) -> dict[st
     )
     from stylemotion.reconstruct.marker_set import SKIN_MARKERS, virtual_markers
     from stylemotion.reconstruct.sparse import subject_scale
-    from stylemotion.reconstruct.subject import subject_from_motion
+    from stylemotion.reconstruct.subject import Subject, subject_from_motion
     from stylemotion.skeleton import CANONICAL_JOINTS, JOINT_INDEX
 
-    joint_rec = SparseReconstructor(database, DEFAULT_MARKERS, k=k, hold_bones=False)
-    skin_rec = SparseReconstructor(database, SKIN_MARKERS, k=k)
+    def skin_reconstructor(bones=None, **settings) -> SparseReconstructor:
+        return SparseReconstructor(database, SKIN_MARKERS, bones=bones, **{**chosen, **settings})
+
+    joint_rec = SparseReconstructor(database, DEFAULT_MARKERS, hold_bones=False)  # the library's defaults
+    skin_rec = skin_reconstructor()
     database_bones = median_bone_lengths(np.asarray(database.positions[:: max(1, database.num_frames // 50_000)],
                                                     np.float64))
     tables: dict[str, list[np.ndarray]] = {c: [] for c in CONDITIONS}
@@ -96,14 +108,17 @@ def _other_captures(args, database, k: int, rng: np.random.Generator) -> dict[st
                                           args.placement_mm, args.jitter_mm)
         skin = skin_marker_noise(virtual_markers(truth, SKIN_MARKERS), rng, args.placement_mm, args.jitter_mm)
         scale = subject_scale(skin, SKIN_MARKERS, database)
-        scaled = SparseReconstructor(database, SKIN_MARKERS, k=k, bones=database_bones * scale)
-        lengths = SparseReconstructor(database, SKIN_MARKERS, k=k, bones=median_bone_lengths(truth))
-        subject = SparseReconstructor(database, SKIN_MARKERS, k=k, bones=subject_from_motion(truth))
+        calibration = subject_from_motion(truth)
+        subject = skin_reconstructor(calibration)
         outputs = {"joints": joint_rec.reconstruct(joint_markers).positions,
                    "skin": skin_rec.reconstruct(skin).positions,
-                   "skin_scaled": scaled.reconstruct(skin).positions,
-                   "skin_lengths": lengths.reconstruct(skin).positions,
+                   "skin_scaled": skin_reconstructor(database_bones * scale).reconstruct(skin).positions,
+                   "skin_lengths": skin_reconstructor(median_bone_lengths(truth)).reconstruct(skin).positions,
                    "skin_subject": subject.reconstruct(skin).positions,
+                   "skin_subject_no_feet": skin_reconstructor(Subject(calibration.lengths, calibration.rigid))
+                   .reconstruct(skin).positions,
+                   "skin_subject_defaults": SparseReconstructor(database, SKIN_MARKERS, bones=calibration)
+                   .reconstruct(skin).positions,
                    "skin_subject_nn": subject.nearest_neighbour(skin),
                    "floor_subject": _floor(subject, skin, truth)}
         subject.hold_bones = False
@@ -142,14 +157,18 @@ def _leave_style_out(args, bandai, parts, rng) -> dict[str, Any]:
                for part in ("val", "test")}
     markers = {part: [skin_marker_noise(virtual_markers(q.positions, SKIN_MARKERS), rng, args.placement_mm,
                                         args.jitter_mm) for q in qs] for part, qs in queries.items()}
-    rec = SparseReconstructor(database, SKIN_MARKERS, k=max(args.k))
-    val = {}
-    for k in args.k:
-        rec.k = k
-        val[str(k)] = error_figures([joint_error_table(rec.reconstruct(m).positions, q.positions)
-                                     for q, m in zip(queries["val"], markers["val"])])["mean_cm"]
-    k = int(choose_setting(val))
-    rec.k = k
+    candidates = []
+    for features in args.features:
+        rec = SparseReconstructor(database, SKIN_MARKERS, features=features, k=max(args.k))
+        for k in args.k:
+            for prior_weight in args.prior_weights:
+                rec.k, rec.prior_weight = k, prior_weight
+                score = error_figures([joint_error_table(rec.reconstruct(m).positions, q.positions)
+                                       for q, m in zip(queries["val"], markers["val"])])["mean_cm"]
+                candidates.append({"features": features, "k": k, "prior_weight": prior_weight, "val_mean_cm": score})
+    best = candidates[choose_setting({i: c["val_mean_cm"] for i, c in enumerate(candidates)})]
+    chosen = {key: best[key] for key in ("features", "k", "prior_weight")}
+    rec = SparseReconstructor(database, SKIN_MARKERS, **chosen)
     ours, nn, unheld, spread_held, spread_unheld = [], [], [], [], []
     for q, m in zip(queries["test"], markers["test"]):
         rec.hold_bones = True
@@ -163,8 +182,8 @@ def _leave_style_out(args, bandai, parts, rng) -> dict[str, Any]:
         spread_unheld.append(bone_length_spread_cm(free)["mean_sd_cm"])
     return {"style": style, "val_takes": [q.name for q in queries["val"]],
             "test_takes": [q.name for q in queries["test"]], "database_frames": database.num_frames,
-            "val_mean_cm_by_k": val, "k": k, "figures": {"ours": error_figures(ours), "nn": error_figures(nn),
-                                                         "unheld": error_figures(unheld)},
+            "candidates": candidates, "chosen": chosen,
+            "figures": {"ours": error_figures(ours), "nn": error_figures(nn), "unheld": error_figures(unheld)},
             "bone_sd_cm": {"held": float(np.mean(spread_held)), "unheld": float(np.mean(spread_unheld))}}
 
 
@@ -183,10 +202,11 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
         splits.append(take_split_record(parts, seed, VAL_FRACTION, TEST_FRACTION))
         rng = np.random.default_rng(seed)
         bandai_part = _leave_style_out(args, bandai, parts, rng)
-        other = _other_captures(args, database_of("bandai-train", parts["train"], bandai.fps), bandai_part["k"], rng)
+        other = _other_captures(args, database_of("bandai-train", parts["train"], bandai.fps), bandai_part["chosen"],
+                               rng)
         per_seed.append({"seed": seed, "bandai": bandai_part, "other": other,
                          "seconds": round(time.perf_counter() - started, 1)})
-        print(f"seed {seed}: style {bandai_part['style']} k {bandai_part['k']}: "
+        print(f"seed {seed}: style {bandai_part['style']} chose {bandai_part['chosen']}: "
               f"{bandai_part['figures']['ours']['mean_cm']:.2f} cm; other captures "
               f"{other['figures']['skin_subject']['mean_cm']:.2f} cm", flush=True)
     return {"splits": {"kind": "by take, one split per seed; Bandai: one style left out of the database per seed",
@@ -194,11 +214,14 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
                        "actor_groups_in_bandai": groups,
                        "other_captures": "the three walks of other-skeletons, never in any split; virtual skin "
                                          "markers; database = the seed's train takes (all styles)"},
-            "settings": {"contents": args.contents, "k_candidates": args.k, "placement_mm": args.placement_mm,
-                         "jitter_mm": args.jitter_mm, "features": "E15", "marker_set": "skin"},
-            "choice": {"k": Counter(r["bandai"]["k"] for r in per_seed).most_common(1)[0][0],
-                       "rule": "each seed chooses k on the left-out style's val takes (lowest mean per-joint error); "
-                               "the other captures use the seed's choice"},
+            "settings": {"contents": args.contents, "k_candidates": args.k, "feature_candidates": args.features,
+                         "prior_weight_candidates": args.prior_weights, "placement_mm": args.placement_mm,
+                         "jitter_mm": args.jitter_mm, "marker_set": "skin"},
+            "choice": {"most_frequent": dict(Counter(tuple(sorted(r["bandai"]["chosen"].items())) for r in per_seed)
+                                             .most_common(1)[0][0]),
+                       "rule": "each seed chooses features, k and the prior weight together on the left-out style's "
+                               "val takes (lowest mean per-joint error, the first in grid order on a tie); the other "
+                               "captures use the seed's choice"},
             "per_seed": per_seed}
 
 
@@ -219,6 +242,22 @@ def _cm(r: dict, path: list[str], digits: int = 2) -> str:
     return fmt_spread(spread(_values(r, path)), digits)
 
 
+def _chosen_text(chosen: dict[str, Any]) -> str:
+    return f"{chosen['features']}, k {chosen['k']}, prior weight {fmt(chosen['prior_weight'], 0)}"
+
+
+def _validation_table(r: dict) -> str:
+    first = r["per_seed"][0]["bandai"]["candidates"]
+    rows = []
+    for i, candidate in enumerate(first):
+        scores = [seed["bandai"]["candidates"][i]["val_mean_cm"] for seed in r["per_seed"]]
+        times = sum(seed["bandai"]["chosen"] == {k: candidate[k] for k in ("features", "k", "prior_weight")}
+                    for seed in r["per_seed"])
+        rows.append([candidate["features"], str(candidate["k"]), fmt(candidate["prior_weight"], 0),
+                     fmt_spread(spread(scores), 2), f"{times} of {len(r['per_seed'])}"])
+    return md_table(["features", "k", "prior weight", "val mean cm", "chosen by"], rows)
+
+
 def render(record: dict[str, Any]) -> dict[str, str]:
     r = record["results"]
     prov = provenance_line(record)
@@ -227,7 +266,7 @@ def render(record: dict[str, Any]) -> dict[str, str]:
         base = ["other", "figures", c]
         rows.append(["other captures (3 walks, other actors)", CONDITIONS[c], _cm(r, base + ["mean_cm"]),
                      _cm(r, base + ["p95_cm"]), _cm(r, base + ["max_cm"])])
-    for key, text in (("ours", "skin markers, bones held (k chosen on val)"),
+    for key, text in (("ours", "skin markers, bones held (features, k and prior weight chosen on val)"),
                       ("unheld", "skin markers, bones not held"), ("nn", "nearest neighbour (k = 1)")):
         base = ["bandai", "figures", key]
         rows.append(["Bandai, one style left out of the database", text, _cm(r, base + ["mean_cm"]),
@@ -241,8 +280,11 @@ def render(record: dict[str, Any]) -> dict[str, str]:
         f"{fmt(r['settings']['jitter_mm'], 0)} mm per frame. Other captures: {', '.join(OTHER_CAPTURES)}; truth = "
         f"their own skeleton's joints; database = the seed's Bandai train takes. Bandai: actor_groups finds "
         f"{r['splits']['actor_groups_in_bandai']} actor group, so one style per seed ({styles}) is left out instead "
-        f"(1 test take of each of {', '.join(r['settings']['contents'])}); k per seed on its val takes "
-        f"({', '.join(str(v) for v in _values(r, ['bandai', 'k']))}) of {r['settings']['k_candidates']}. {prov}")
+        f"(1 test take of each of {', '.join(r['settings']['contents'])}). Per seed the feature set, k and the local "
+        f"model's prior weight are chosen together on the left-out style's val takes (below), and the other captures "
+        f"use the seed's choice: {'; '.join(_chosen_text(c) for c in _values(r, ['bandai', 'chosen']))}. {prov}"
+        "\n\nThe choice: mean per-joint error (cm) on the val takes of the left-out style, mean ± sd over seeds.\n\n"
+        + _validation_table(r))
     from stylemotion.skeleton import CANONICAL_JOINTS
 
     joint_rows = []
@@ -270,8 +312,10 @@ def render(record: dict[str, Any]) -> dict[str, str]:
     aim = "met" if mean is not None and mean <= 3.0 else "not met"
     summary = (f"Krüger §2.5.2 with six skin markers (virtual, on 3 walks of actors not in the database; "
                f"[benchmarks/reconstruct.md](benchmarks/reconstruct.md)): mean per-joint error "
-               f"**{figures['skin_subject']} cm** with the subject's skeleton given (p95 {_cm(r, ours + ['p95_cm'])}, "
-               f"max {_cm(r, ours + ['max_cm'])} cm), {figures['skin']} cm on the database's skeleton, against "
+               f"**{figures['skin_subject']} cm** with the subject's skeleton given and the settings chosen on val "
+               f"(p95 {_cm(r, ours + ['p95_cm'])}, max {_cm(r, ours + ['max_cm'])} cm; "
+               f"{figures['skin_subject_defaults']} cm with the library's defaults), {figures['skin']} cm on the "
+               f"database's skeleton, against "
                f"{figures['joints']} cm for the method before (markers at the joint centres); the aim of ≤ 3 cm is "
                f"{aim}. Bandai with one style left out of the database: "
                f"{_cm(r, ['bandai', 'figures', 'ours', 'mean_cm'])} cm. Bones held: length sd over frames "

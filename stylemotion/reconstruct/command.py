@@ -65,6 +65,7 @@ from stylemotion.reconstruct.sparse import (
     joint_errors_cm,
     subject_scale,
 )
+from stylemotion.reconstruct.subject import Subject
 from stylemotion.skeleton import CANONICAL_JOINTS
 
 log = logging.getLogger(__name__)
@@ -127,9 +128,12 @@ def load_tracks(text: str, takeset: TakeSet, joints: Sequence[str] | None,
 
 
 def subject_bones(subject: str, positions: np.ndarray, marker_set: MarkerSet, database,
-                  conversion: Mapping[str, Any] | None, fps: float) -> tuple[np.ndarray | None, dict[str, Any]]:
-    """``subject=``: the bone lengths ``(20,)`` m the database is put on (None: its own) and what to record."""
+                  conversion: Mapping[str, Any] | None, fps: float
+                  ) -> tuple[np.ndarray | Subject | None, dict[str, Any]]:
+    """``subject=``: the bone lengths ``(20,)`` m or the :class:`Subject` (lengths, rigid bones and feet measured on
+    a BVH of the subject) the database is put on (None: its own), and what to record."""
     from stylemotion.bones import median_bone_lengths
+    from stylemotion.reconstruct.subject import subject_from_motion
 
     if subject in ("", "database"):
         return None, {"value": "database"}
@@ -141,7 +145,9 @@ def subject_bones(subject: str, positions: np.ndarray, marker_set: MarkerSet, da
     if not subject.lower().split(":")[0].endswith(".bvh"):
         raise ConfigError(f"subject={subject}: give database, markers or a BVH of the subject's skeleton")
     full = read_markers(subject, CANONICAL_JOINTS, fps, dict(conversion or {})).full
-    return median_bone_lengths(full), {"value": subject, "source": "the BVH's median bone lengths"}
+    return subject_from_motion(full), {"value": subject, "source": "the BVH's skeleton: median bone lengths, the "
+                                                                   "directions of the bones rigid in the pelvis and "
+                                                                   "chest, the feet's convention"}
 
 
 def reconstruct_command(data: Mapping[str, Any], markers: str, out: str | os.PathLike, *,

@@ -6,7 +6,12 @@ side), is a convention of the capture system, fixed for a skeleton. A :class:`Su
 
 * ``lengths``: the 20 bone lengths (metres, :data:`stylemotion.bones.BONE_NAMES` order);
 * ``rigid``: for the bones that hang rigidly off the pelvis or the chest (:data:`RIGID_BONES`), their direction
-  in that body part's frame (:func:`body_frames`), or None to keep the database's.
+  in that body part's frame (:func:`body_frames`), or None to keep the database's;
+* ``hinged``: for the feet (:data:`HINGED_BONES`), the median direction of the foot bone (ankle → toe joint) in the
+  shank's frame. The foot turns at the ankle, so it is not rigid, but where a skeleton puts its ankle and toe joints
+  is a convention: Bandai's ankle sits 12 cm above the floor and its foot bone points 40° down in stance, other
+  skeletons' 2–7 cm and 12–19°. The database's feet are turned by the constant rotation that takes the database's
+  median direction to the subject's, so their flexing is kept and their convention becomes the subject's.
 
 :func:`subject_from_motion` measures both on a motion of the subject (a calibration: the medians over its frames);
 :func:`database_on_subject` puts every database take on them (each other bone keeps its direction per frame,
@@ -26,6 +31,8 @@ from stylemotion.skeleton import CANONICAL_PARENTS, JOINT_INDEX
 #: Bones whose direction is fixed in the frame of the body part they hang off: bone (child joint) → part.
 RIGID_BONES = {"UpperLeg_L": "pelvis", "UpperLeg_R": "pelvis", "Neck": "chest", "Shoulder_L": "chest",
                "Shoulder_R": "chest", "UpperArm_L": "chest", "UpperArm_R": "chest"}
+#: Bones whose direction differs between skeletons by a constant turn in their parent segment's frame: bone → part.
+HINGED_BONES = {"Toes_L": "shank_L", "Toes_R": "shank_R"}
 _EPS = 1e-9
 
 
@@ -35,11 +42,14 @@ class Subject:
 
     lengths: np.ndarray
     rigid: dict[str, np.ndarray] | None = None
+    hinged: dict[str, np.ndarray] | None = None
 
     def describe(self) -> dict:
-        return {"bones_m": [round(float(b), 5) for b in self.lengths],
-                "rigid": None if self.rigid is None else {k: [round(float(x), 4) for x in v]
-                                                          for k, v in self.rigid.items()}}
+        def rounded(directions: dict[str, np.ndarray] | None) -> dict | None:
+            return None if directions is None else {k: [round(float(x), 4) for x in v] for k, v in directions.items()}
+
+        return {"bones_m": [round(float(b), 5) for b in self.lengths], "rigid": rounded(self.rigid),
+                "hinged": rounded(self.hinged)}
 
 
 def _frame(x_ref: np.ndarray, y_ref: np.ndarray) -> np.ndarray:
@@ -51,20 +61,23 @@ def _frame(x_ref: np.ndarray, y_ref: np.ndarray) -> np.ndarray:
 
 
 def body_frames(positions: np.ndarray) -> dict[str, np.ndarray]:
-    """The pelvis frame (x: right hip joint → left, y: Hips → Spine) and the chest frame (x: right upper arm →
-    left, y: Spine → Chest) of a motion ``(frames, 21, 3)`` → part → ``(frames, 3, 3)``."""
+    """The pelvis frame (x: right hip joint → left, y: Hips → Spine), the chest frame (x: right upper arm →
+    left, y: Spine → Chest) and each shank's frame (x: right hip joint → left, y: knee → ankle) of a motion
+    ``(frames, 21, 3)`` → part → ``(frames, 3, 3)``."""
     p = np.asarray(positions, np.float64)
     j = JOINT_INDEX
-    return {"pelvis": _frame(p[:, j["UpperLeg_L"]] - p[:, j["UpperLeg_R"]], p[:, j["Spine"]] - p[:, j["Hips"]]),
-            "chest": _frame(p[:, j["UpperArm_L"]] - p[:, j["UpperArm_R"]], p[:, j["Chest"]] - p[:, j["Spine"]])}
+    left = p[:, j["UpperLeg_L"]] - p[:, j["UpperLeg_R"]]
+    return {"pelvis": _frame(left, p[:, j["Spine"]] - p[:, j["Hips"]]),
+            "chest": _frame(p[:, j["UpperArm_L"]] - p[:, j["UpperArm_R"]], p[:, j["Chest"]] - p[:, j["Spine"]]),
+            **{f"shank_{s}": _frame(left, p[:, j[f"Foot_{s}"]] - p[:, j[f"LowerLeg_{s}"]]) for s in "LR"}}
 
 
-def _rigid_directions(positions: np.ndarray) -> dict[str, np.ndarray]:
-    """Each rigid bone's unit direction in its part's frame, the median over frames (zero for a zero-length bone)."""
+def _median_directions(positions: np.ndarray, bones: dict[str, str]) -> dict[str, np.ndarray]:
+    """Each bone's unit direction in its part's frame, the median over frames (zero for a zero-length bone)."""
     p = np.asarray(positions, np.float64)
     frames = body_frames(p)
     out = {}
-    for bone, part in RIGID_BONES.items():
+    for bone, part in bones.items():
         child = JOINT_INDEX[bone]
         vector = p[:, child] - p[:, CANONICAL_PARENTS[child]]
         local = np.einsum("fij,fi->fj", frames[part], vector)  # Rᵀ v
@@ -75,23 +88,44 @@ def _rigid_directions(positions: np.ndarray) -> dict[str, np.ndarray]:
 
 
 def subject_from_motion(positions: np.ndarray) -> Subject:
-    """The skeleton of a motion of the subject ``(frames, 21, 3)`` metres: median bone lengths and rigid directions."""
+    """The skeleton of a motion of the subject ``(frames, 21, 3)`` metres: median bone lengths, rigid and hinged
+    directions (module docstring)."""
     p = np.asarray(positions, np.float64)
-    return Subject(median_bone_lengths(p), _rigid_directions(p))
+    return Subject(median_bone_lengths(p), _median_directions(p, RIGID_BONES), _median_directions(p, HINGED_BONES))
+
+
+def _turn(source: np.ndarray, target: np.ndarray) -> np.ndarray:
+    """The smallest rotation ``(3, 3)`` taking unit vector ``source`` to ``target`` (identity when either is zero
+    or they are opposite)."""
+    axis = np.cross(source, target)
+    sin, cos = float(np.linalg.norm(axis)), float(np.dot(source, target))
+    if sin < 1e-9:
+        return np.eye(3)
+    k = axis / sin
+    cross = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
+    return np.eye(3) + sin * cross + (1.0 - cos) * cross @ cross
 
 
 def database_on_subject(database: MotionDatabase, subject: Subject) -> MotionDatabase:
-    """``database`` with every take on the subject's bone lengths and, where given, its rigid bone directions."""
+    """``database`` with every take on the subject's bone lengths and, where given, its rigid bone directions and
+    its feet's convention (each database foot bone turned in its shank's frame, module docstring)."""
     positions = np.asarray(database.positions, np.float64)
     directions = None
-    if subject.rigid is not None:
+    if subject.rigid is not None or subject.hinged is not None:
         from stylemotion.bones import BONE_JOINTS
 
         vectors = positions[:, list(BONE_JOINTS)] - positions[:, [CANONICAL_PARENTS[j] for j in BONE_JOINTS]]
         directions = vectors / np.maximum(np.linalg.norm(vectors, axis=-1, keepdims=True), _EPS)
         frames = body_frames(positions)
-        for bone, local in subject.rigid.items():
+        for bone, local in (subject.rigid or {}).items():
             directions[:, BONE_NAMES.index(bone)] = frames[RIGID_BONES[bone]] @ np.asarray(local, np.float64)
+        if subject.hinged:
+            own = _median_directions(positions[:: max(1, len(positions) // 50_000)], HINGED_BONES)
+            for bone, local in subject.hinged.items():
+                frame, b = frames[HINGED_BONES[bone]], BONE_NAMES.index(bone)
+                turn = _turn(own[bone], np.asarray(local, np.float64))  # in the part's frame
+                local_now = np.einsum("fji,fj->fi", frame, directions[:, b])  # Rᵀ d per frame
+                directions[:, b] = np.einsum("fij,jk,fk->fi", frame, turn, local_now)
     moved = retarget_takes(positions, database.take_start, subject.lengths, directions)
     return replace(database, name=f"{database.name}-on-subject", positions=moved.astype(database.positions.dtype))
 

@@ -106,3 +106,22 @@ def test_a_c3d_of_skin_markers_at_60_fps(tmp_path, capsys, monkeypatch):
     done = run_command("reconstruct", *run, capsys=capsys, monkeypatch=monkeypatch, cwd=tmp_path)
     assert done.returncode == 2 and "markers_up_axis=x" in done.stderr and "Traceback" not in done.stderr
     assert not (tmp_path / "b").exists()
+
+
+def test_subject_from_a_bvh_gives_its_whole_skeleton(tmp_path):
+    from stylemotion.io.export import write_motion_bvh
+    from stylemotion.reconstruct.subject import subject_from_motion
+
+    take = load_dataset("synthetic", takes_per_pair=1).takes[1]
+    other = np.asarray(take.positions, np.float64) * 1.1  # a taller subject recorded elsewhere
+    write_motion_bvh(other, tmp_path / "subject.bvh", fps=30.0)
+    summary = reconstruct_command(DATA, TAKE, tmp_path / "out", marker_set="skin",
+                                  subject=str(tmp_path / "subject.bvh"), gif=False)
+    recorded = summary["settings"]["subject"]
+    expected = subject_from_motion(other)
+    np.testing.assert_allclose(recorded["bones_m"], expected.lengths, atol=2e-3)
+    for part in ("rigid", "hinged"):  # not the lengths alone: the directions the skeleton fixes come along
+        assert set(recorded[part]) == set(getattr(expected, part))
+        for bone, direction in recorded[part].items():
+            np.testing.assert_allclose(direction, getattr(expected, part)[bone], atol=0.02)
+    assert summary["markers"]["subject"]["value"] == str(tmp_path / "subject.bvh")

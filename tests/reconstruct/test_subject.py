@@ -9,7 +9,9 @@ from stylemotion.bones import BONE_JOINTS, median_bone_lengths
 from stylemotion.datasets.base import TakeSet
 from stylemotion.datasets.registry import load_dataset
 from stylemotion.reconstruct.subject import (
+    HINGED_BONES,
     RIGID_BONES,
+    Subject,
     body_frames,
     database_on_subject,
     hold_bone_lengths,
@@ -24,8 +26,8 @@ def takes():
     return load_dataset("synthetic", takes_per_pair=1).takes[:4]
 
 
-def _rigid_local(positions, bone):
-    frames = body_frames(positions)[RIGID_BONES[bone]]
+def _rigid_local(positions, bone, parts=RIGID_BONES):
+    frames = body_frames(positions)[parts[bone]]
     child = JOINT_INDEX[bone]
     vector = positions[:, child] - positions[:, CANONICAL_PARENTS[child]]
     local = np.einsum("fij,fi->fj", frames, vector)
@@ -48,6 +50,45 @@ def test_a_database_on_a_subject_has_its_bones_and_rigid_directions(takes):
         expected = np.broadcast_to(subject.rigid[bone], (len(positions), 3))
         np.testing.assert_allclose(_rigid_local(positions, bone), expected, atol=2e-3)
     assert moved.take_start.tolist() == database.take_start.tolist()
+
+
+def _pitched_feet(positions, degrees):
+    """``positions`` with each foot bone turned by ``degrees`` about its shank frame's x axis (toes up for > 0)."""
+    out = np.asarray(positions, np.float64).copy()
+    frames = body_frames(out)
+    angle = np.radians(degrees)
+    turn = np.array([[1.0, 0.0, 0.0], [0.0, np.cos(angle), -np.sin(angle)], [0.0, np.sin(angle), np.cos(angle)]])
+    for bone, part in HINGED_BONES.items():
+        child, parent = JOINT_INDEX[bone], CANONICAL_PARENTS[JOINT_INDEX[bone]]
+        local = np.einsum("fji,fj->fi", frames[part], out[:, child] - out[:, parent])
+        out[:, child] = out[:, parent] + np.einsum("fij,jk,fk->fi", frames[part], turn, local)
+    return out
+
+
+def test_a_database_on_a_subject_takes_its_foot_convention_and_keeps_the_ankles_flexing(takes):
+    database = MotionDatabase.from_takeset(TakeSet("s", list(takes[1:]), 30.0))
+    base = np.asarray(database.positions, np.float64)
+    subject = subject_from_motion(_pitched_feet(takes[0].positions, 25.0))  # another skeleton's foot convention
+    own = subject_from_motion(takes[0].positions)
+    for bone in HINGED_BONES:  # the measured convention differs by the turn given
+        cos = float(np.dot(subject.hinged[bone], own.hinged[bone]))
+        assert np.degrees(np.arccos(np.clip(cos, -1, 1))) == pytest.approx(25.0, abs=0.5)
+    moved = np.asarray(database_on_subject(database, subject).positions, np.float64)
+    plain = np.asarray(database_on_subject(database, Subject(subject.lengths, subject.rigid)).positions, np.float64)
+    for bone in HINGED_BONES:
+        got = np.median(_rigid_local(moved, bone, HINGED_BONES), axis=0)
+        np.testing.assert_allclose(got / np.linalg.norm(got), subject.hinged[bone], atol=0.02)
+        # every frame turned by one constant rotation in the shank's frame (the ankle's flexing kept): the best
+        # single rotation (Kabsch) maps each unturned foot onto the turned one, by about 25°
+        a, b = _rigid_local(moved, bone, HINGED_BONES), _rigid_local(plain, bone, HINGED_BONES)
+        u, _, vt = np.linalg.svd(a.T @ b)
+        turn = u @ np.diag([1.0, 1.0, np.linalg.det(u @ vt)]) @ vt
+        np.testing.assert_allclose(b @ turn.T, a, atol=1e-4)  # the database stores float32
+        assert 20.0 < np.degrees(np.arccos((np.trace(turn) - 1) / 2)) < 30.0
+    others = [j for j in range(moved.shape[1]) if j not in (JOINT_INDEX["Toes_L"], JOINT_INDEX["Toes_R"])]
+    relative = moved[:, others] - moved[:, :1]  # the rest of the body as it was (a take's ground may shift)
+    np.testing.assert_allclose(relative, plain[:, others] - plain[:, :1], atol=1e-6)
+    assert base.shape == moved.shape
 
 
 def test_held_bones_reach_the_given_ends_and_stay_constant(takes):
