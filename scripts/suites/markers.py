@@ -60,7 +60,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--k", type=int, nargs="+", default=[128, 512], help="candidates of k (chosen on val)")
     parser.add_argument("--features", nargs="+", default=["E15", "E15x3", "E15x5"],
                         help="candidate marker-only feature sets (chosen on val with k and the prior weight)")
-    parser.add_argument("--prior-weights", type=float, nargs="+", default=[1.0, 3.0, 10.0],
+    parser.add_argument("--prior-weights", type=float, nargs="+", default=[1.0, 3.0, 10.0, 30.0, 100.0],
                         help="candidates of the local model's prior weight (chosen on val)")
     parser.add_argument("--placement-mm", type=float, default=10.0, help="marker placement error, ± mm per axis")
     parser.add_argument("--jitter-mm", type=float, default=1.0, help="per-frame marker jitter, ± mm per axis")

@@ -50,11 +50,12 @@ class ReconstructSettings(MotionFileKeys):
     same name). ``markers_fps``: a CSV's rate when it has no ``# fps:`` line (default the dataset's).
     ``markers_up_axis``: a C3D's up axis (``z`` or ``y``). ``subject``: whose bones the database is put on and the
     output holds: ``database`` (its own), ``markers`` (scaled to the subject from the markers) or a BVH of the
-    subject's skeleton (its median bone lengths: a calibration). ``features``: k-NN feature set
-    (E15 E30 E39 E15x3 E15x5 pca8 pca16 pca25). ``k``: neighbours of the local linear model per frame; chosen
-    on Bandai val takes (suite reconstruct, docs/reconstruct.md). ``noise_mm``: uniform noise of ± ``noise_mm``
-    millimetres added to the markers (thesis: 1); ``seed``: of that noise. ``exclude_markers_take``: markers= a
-    take of the dataset: leave it out of the database. ``model``: :class:`SparseModelSettings`.
+    subject's skeleton (bone lengths, rigid bones and feet measured on it: a calibration). ``features``: k-NN
+    feature set (E15 E30 E39 E15x3 E15x5 pca8 pca16 pca25). ``k``: neighbours of the local linear model per
+    frame; chosen on Bandai val takes (suite reconstruct, docs/reconstruct.md). ``noise_mm``: uniform noise of
+    ± ``noise_mm`` millimetres added to the markers (thesis: 1); ``seed``: of that noise.
+    ``exclude_markers_take``: markers= a take of the dataset: leave it out of the database.
+    ``model``: :class:`SparseModelSettings`.
     ``joint_map``, ``unit_scale``, ``up_axis``: a BVH's (:class:`~stylemotion.config.MotionFileKeys`). ``out``:
     a new folder (an existing one is refused unless ``force``). ``gif``: also ``out/motion.gif`` (the stick
     figure along its ground track).
