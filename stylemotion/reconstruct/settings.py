@@ -16,6 +16,12 @@ from omegaconf import MISSING
 
 from stylemotion.config import MotionFileKeys
 
+#: The local model's prior weight for markers at the joint centres (chosen on held-out takes of the synthetic data).
+JOINT_CENTRE_PRIOR_WEIGHT = 1.0
+#: The same for skin-marker sets: suite ``markers``' choice on the val takes of a style left out of the database
+#: (benchmarks/reconstruct.md, ``benchmarks/results/markers.json``).
+SKIN_PRIOR_WEIGHT = 30.0
+
 
 @dataclass(frozen=True)
 class SparseModelSettings:
@@ -26,12 +32,14 @@ class SparseModelSettings:
     Mahalanobis prior of the local PCA; ``iterations``: k-NN searches per frame for E30/E39/pca* (searched
     around the synthesized pose); ``weighted``: neighbours weighted by ``1/(feature distance + marker_sd)^2``;
     ``hold_bones``: every output frame's bones set to the subject's lengths (constant over time).
+    ``prior_weight`` None: :data:`JOINT_CENTRE_PRIOR_WEIGHT` for markers at the joint centres,
+    :data:`SKIN_PRIOR_WEIGHT` for skin-marker sets.
     """
 
     variance: float = 0.99
     marker_sd: float = 0.002
     smooth_sd: float = 0.1
-    prior_weight: float = 1.0
+    prior_weight: float | None = None
     iterations: int = 1
     weighted: bool = True
     hold_bones: bool = True

@@ -51,6 +51,7 @@ import numpy as np
 
 from stylemotion.reconstruct.marker_set import MarkerSet, joint_marker_set, virtual_markers
 from stylemotion.reconstruct.markers import MarkerInputError, MarkerTracks, check_marker_names
+from stylemotion.reconstruct.settings import JOINT_CENTRE_PRIOR_WEIGHT, SKIN_PRIOR_WEIGHT
 from stylemotion.reconstruct.settings import ReconstructSettings as _C
 from stylemotion.reconstruct.settings import SparseModelSettings as _M
 from stylemotion.reconstruct.subject import Subject, database_on_subject, hold_bone_lengths
@@ -166,14 +167,15 @@ class SparseReconstructor:
         features: one of :data:`RECONSTRUCT_FEATURE_SETS`.  k: neighbours per frame.
         variance: fraction of the neighbours' spread the local PCA keeps.  marker_sd: metres a marker may miss
             by.  smooth_sd: metres a joint may move between frames (in the marker frame).  prior_weight: weight
-            of the Mahalanobis prior.  iterations: k-NN searches per frame for pose-guided sets.
-            weighted: distance-weighted local model (module docstring, step 3).
+            of the Mahalanobis prior (None: by marker kind, as ``SparseModelSettings`` says).  iterations: k-NN
+            searches per frame for pose-guided sets.  weighted: distance-weighted local model (module docstring,
+            step 3).
         engine, workers: the k-NN engine (:class:`FrameIndex`).
     """
 
     def __init__(self, database: MotionDatabase, joints: Sequence[str] | MarkerSet, features: str = _C.features,
                  k: int = _C.k, variance: float = _M.variance, marker_sd: float = _M.marker_sd,
-                 smooth_sd: float = _M.smooth_sd, prior_weight: float = _M.prior_weight,
+                 smooth_sd: float = _M.smooth_sd, prior_weight: float | None = _M.prior_weight,
                  iterations: int = _M.iterations, weighted: bool = _M.weighted, engine: str = "ckdtree",
                  workers: int = 1, bones: np.ndarray | Subject | None = None, hold_bones: bool = _M.hold_bones):
         if isinstance(joints, MarkerSet):
@@ -184,6 +186,8 @@ class SparseReconstructor:
             self.marker_set = joint_marker_set(self.joints)
         self.roles = self.marker_set.segments  # what the marker frame calls each marker
         self.skin = not self.marker_set.is_joint_centres
+        if prior_weight is None:
+            prior_weight = SKIN_PRIOR_WEIGHT if self.skin else JOINT_CENTRE_PRIOR_WEIGHT
         if features not in RECONSTRUCT_FEATURE_SETS:
             raise ValueError(f"features={features} cannot be used for reconstruction; valid: "
                              f"{list(RECONSTRUCT_FEATURE_SETS)}")

@@ -172,3 +172,13 @@ def test_the_subject_scale_of_a_scaled_database_take_and_the_database_on_its_bon
     out = rec.reconstruct(virtual_markers(grown, SKIN_MARKERS)).positions
     np.testing.assert_allclose(median_bone_lengths(out), bones, atol=1e-6)
     assert joint_errors_cm(out, grown)["mean_cm"] < 3.0
+
+
+def test_the_prior_weight_follows_the_marker_kind_unless_given(split):
+    from stylemotion.reconstruct.settings import JOINT_CENTRE_PRIOR_WEIGHT, SKIN_PRIOR_WEIGHT
+
+    assert SKIN_PRIOR_WEIGHT != JOINT_CENTRE_PRIOR_WEIGHT  # else the test below could not tell them apart
+    assert SparseReconstructor(split[0], DEFAULT_MARKERS).prior_weight == JOINT_CENTRE_PRIOR_WEIGHT
+    skin = SparseReconstructor(split[0], SKIN_MARKERS)
+    assert skin.prior_weight == SKIN_PRIOR_WEIGHT and skin.settings()["prior_weight"] == SKIN_PRIOR_WEIGHT
+    assert SparseReconstructor(split[0], SKIN_MARKERS, prior_weight=2.5).prior_weight == 2.5
