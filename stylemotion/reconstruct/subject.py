@@ -13,7 +13,7 @@ side), is a convention of the capture system, fixed for a skeleton. A :class:`Su
   skeletons' 2–7 cm and 12–19°. The database's feet are turned by the constant rotation that takes the database's
   median direction to the subject's, so their flexing is kept and their convention becomes the subject's.
 
-:func:`subject_from_motion` measures both on a motion of the subject (a calibration: the medians over its frames);
+:func:`subject_from_motion` measures all three on a motion of the subject (a calibration: the medians over its frames);
 :func:`database_on_subject` puts every database take on them (each other bone keeps its direction per frame,
 :func:`stylemotion.bones.retarget_takes`).
 """
@@ -95,15 +95,13 @@ def subject_from_motion(positions: np.ndarray) -> Subject:
 
 
 def _turn(source: np.ndarray, target: np.ndarray) -> np.ndarray:
-    """The smallest rotation ``(3, 3)`` taking unit vector ``source`` to ``target`` (identity when either is zero
-    or they are opposite)."""
-    axis = np.cross(source, target)
-    sin, cos = float(np.linalg.norm(axis)), float(np.dot(source, target))
-    if sin < 1e-9:
+    """The smallest rotation ``(3, 3)`` taking unit vector ``source`` to ``target`` (scipy's ``align_vectors`` of
+    one pair: the shortest arc); the identity when either is zero (a zero-length bone)."""
+    from scipy.spatial.transform import Rotation
+
+    if np.linalg.norm(source) < 1e-9 or np.linalg.norm(target) < 1e-9:
         return np.eye(3)
-    k = axis / sin
-    cross = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
-    return np.eye(3) + sin * cross + (1.0 - cos) * cross @ cross
+    return Rotation.align_vectors(np.asarray(target)[None], np.asarray(source)[None])[0].as_matrix()
 
 
 def database_on_subject(database: MotionDatabase, subject: Subject) -> MotionDatabase:
