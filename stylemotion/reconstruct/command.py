@@ -3,7 +3,7 @@
     stylemotion-reconstruct markers=tracks.csv data=bandai out=runs/reconstruct/mine
     stylemotion-reconstruct markers=synthetic_walk_normal_000 features=E15x3 k=128 'joints=[Hand_L,Hand_R,Hips]'
 
-    stylemotion-reconstruct markers=capture.c3d marker_set=skin data=bandai subject=markers
+    stylemotion-reconstruct markers=capture.c3d marker_set=skin data=bandai subject=calibration.bvh
 
 ``markers`` is a BVH (``file.bvh[:start-end]``, any skeleton a joint map names; its canonical joints become the
 markers), an NPZ as ``stylemotion-convert`` writes it, a CSV of marker tracks at any rate (resampled to the
