@@ -107,3 +107,16 @@ def test_held_bones_reach_the_given_ends_and_stay_constant(takes):
     hip, knee, ankle = (JOINT_INDEX[j] for j in ("UpperLeg_L", "LowerLeg_L", "Foot_L"))
     pulled[:, knee] += 0.3 * (0.5 * (truth[:, hip] + truth[:, ankle]) - truth[:, knee])
     np.testing.assert_allclose(hold_bone_lengths(pulled, lengths)[:, knee], truth[:, knee], atol=1e-3)
+
+
+def test_a_subject_without_toes_or_with_a_shoulder_at_the_chest_joint_gives_a_finite_database(takes):
+    other = np.asarray(takes[0].positions, np.float64).copy()
+    other[:, JOINT_INDEX["Toes_L"]] = other[:, JOINT_INDEX["Foot_L"]]  # a skeleton with no toes
+    other[:, JOINT_INDEX["Shoulder_L"]] = other[:, JOINT_INDEX["Chest"]]  # clavicle starting at the chest joint
+    subject = subject_from_motion(other)
+    assert not np.any(subject.hinged["Toes_L"]) and not np.any(subject.rigid["Shoulder_L"])
+    database = MotionDatabase.from_takeset(TakeSet("s", list(takes[1:]), 30.0))
+    positions = np.asarray(database_on_subject(database, subject).positions, np.float64)
+    assert np.isfinite(positions).all()
+    toes = np.linalg.norm(positions[:, JOINT_INDEX["Toes_L"]] - positions[:, JOINT_INDEX["Foot_L"]], axis=-1)
+    assert toes.max() < 1e-6
