@@ -65,7 +65,7 @@ from stylemotion.reconstruct.sparse import (
     joint_errors_cm,
     subject_scale,
 )
-from stylemotion.reconstruct.subject import Subject
+from stylemotion.reconstruct.subject import Subject, subject_from_motion
 from stylemotion.skeleton import CANONICAL_JOINTS
 
 log = logging.getLogger(__name__)
@@ -133,7 +133,6 @@ def subject_bones(subject: str, positions: np.ndarray, marker_set: MarkerSet, da
     """``subject=``: the bone lengths ``(20,)`` m or the :class:`Subject` (lengths, rigid bones and feet measured on
     a BVH of the subject) the database is put on (None: its own), and what to record."""
     from stylemotion.bones import median_bone_lengths
-    from stylemotion.reconstruct.subject import subject_from_motion
 
     if subject in ("", "database"):
         return None, {"value": "database"}
