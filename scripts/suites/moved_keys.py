@@ -11,11 +11,15 @@ takes are the motion database, val takes choose, test takes report. From each ch
   offset about the first key's vertical by each of ``--move-angles`` (the thesis' "Move second key frame":
   0.5–1.5 × in 0.2 steps, 30° steps), :func:`~stylemotion.reconstruct.keyframes.move_key`.
 
-``turn_radius_m`` and ``max_iterations`` are chosen on the val takes' turned cases among ``--radii`` × ``--iterations``
-(by default 1, 1.5, 2.5 m × 12, 24; radius 0 — D_node of eq. 4.12 with the facing term — and 12 iterations are the
-search before this suite, measured on the test cases as "before"): fewest failures, then the lowest mean |duration
-error| of the joined pairs. Test cases are joined with (0, 12) (**before**) and with
-the seed's choice (**after**): joined / attempted (a pair whose
+``turn_radius_m``, ``max_iterations`` and ``facing_first_iterations`` are chosen together on the val takes among
+``--radii`` × ``--iterations`` × ``--facing-first`` (by default 1, 1.5, 2.5 m × 12, 24 × 0, 6, 12; radius 0 — D_node
+of eq. 4.12 with the facing term — and 12 iterations are the search before this suite, measured on the test cases as
+"before"; ``facing_first_iterations`` > 0 runs that search first and the turn-aware one only when its trees do not
+meet). The val cases are the val walk's turned second keys and, since the choice also decides keys that need no
+turn, **straight** key pairs: every pair ``--straight-spacings`` s apart of ``--straight-val-takes`` val take(s) per
+``--straight-contents`` (walks, turning walks, runs). Rule: fewest failed val cases, then the lowest sum of the two
+kinds' mean |duration error| of the joined pairs (turned, straight). Test cases are joined with (0, 12, 0)
+(**before**) and with the seed's choice (**after**): joined / attempted (a pair whose
 trees do not meet is a failure, counted), the duration error of the joined path (its frames against the keys' time
 difference; a key turned against the direction of travel needs a detour, so this grows with the angle, as in the
 thesis' Fig. 4.20), the path's end against the key, and foot skating of the joined path before cleaning
@@ -54,6 +58,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="candidates of DynamicMotionGraph.turn_radius_m (0: off, the search before)")
     parser.add_argument("--iterations", type=int, nargs="+", default=[12, 24],
                         help="candidates of DynamicMotionGraph.max_iterations (12: the default before)")
+    parser.add_argument("--facing-first", type=int, nargs="+", default=[0, 6, 12],
+                        help="candidates of DynamicMotionGraph.facing_first_iterations (0: the turn-aware search "
+                             "alone)")
+    parser.add_argument("--straight-contents", nargs="+", default=["walk", "walk-turn-left", "walk-turn-right", "run"],
+                        help="contents of the val takes whose own (straight) key pairs join the val cases")
+    parser.add_argument("--straight-val-takes", type=int, default=1, help="straight val takes per content and seed")
+    parser.add_argument("--straight-spacings", type=float, nargs="+", default=[1.0, 2.0, 4.0],
+                        help="seconds between the straight val keys")
 
 
 # -- run ----------------------------------------------------------------------------------------------------
@@ -81,10 +93,59 @@ def _outcomes(graph, cases: list[dict[str, Any]], quality: bool) -> list[dict[st
              **pair_outcome(graph, c["first"], c["second"], quality=quality)} for c in cases]
 
 
+def _straight_cases(takes, fps: float, args: argparse.Namespace) -> list[dict[str, Any]]:
+    """Every key pair ``--straight-spacings`` apart of ``takes``, the keys as recorded."""
+    from stylemotion.reconstruct.benchmark import key_pairs
+
+    return [{"take": t.name, "kind": "straight", "angle_deg": 0.0, "scale": 1.0, "first": a, "second": b}
+            for t in takes for spacing in args.straight_spacings for a, b in key_pairs(t.positions, fps, spacing)]
+
+
 def _val_score(outcomes: list[dict[str, Any]]) -> list[float]:
-    """(failed pairs, mean |duration error| s of the joined ones): lower is better, compared in that order."""
-    joined = [abs(o["duration_error_s"]) for o in outcomes if o["joined"]]
-    return [float(len(outcomes) - len(joined)), float(np.mean(joined)) if joined else float("inf")]
+    """(failed cases, Σ over the kinds (turned, straight) of the mean |duration error| s of the joined ones): lower
+    is better, compared in that order; a kind none of whose cases joined adds infinity."""
+    total = 0.0
+    for kind in sorted({o["kind"] for o in outcomes}):
+        joined = [abs(o["duration_error_s"]) for o in outcomes if o["kind"] == kind and o["joined"]]
+        total += float(np.mean(joined)) if joined else float("inf")
+    return [float(sum(not o["joined"] for o in outcomes)), total]
+
+
+def _budget_outcomes(graph, cases: list[dict[str, Any]], radius: float, budgets: list[int]
+                     ) -> dict[int, list[dict[str, Any]]]:
+    """The outcomes of one search (``turn_radius_m = radius``, no facing-first) at every iteration budget: one
+    search per case at the largest budget; a smaller budget's outcome is the same search cut short — joined when
+    it met before its last iteration (identical path), rerun when it met at that iteration (it stops without the
+    extra iteration), failed otherwise."""
+    top = max(budgets)
+    graph.turn_radius_m, graph.max_iterations, graph.facing_first_iterations = float(radius), top, 0
+    full = _outcomes(graph, cases, quality=False)
+    by_budget = {}
+    for budget in sorted(budgets):
+        outcomes = []
+        for case, o in zip(cases, full):
+            met = o.get("met_at_iteration") if o["joined"] else None
+            if met is not None and met == budget and budget < top:
+                graph.max_iterations = budget
+                o = _outcomes(graph, [case], quality=False)[0]
+                graph.max_iterations = top
+            elif met is None or met > budget:
+                o = {**{k: o[k] for k in ("take", "kind", "angle_deg", "scale", "spacing_s", "seconds")},
+                     "joined": False}
+            outcomes.append(o)
+        by_budget[budget] = outcomes
+    return by_budget
+
+
+def _val_figures(outcomes: list[dict[str, Any]]) -> dict[str, Any]:
+    out: dict[str, Any] = {"joined": sum(o["joined"] for o in outcomes), "attempted": len(outcomes)}
+    for kind in ("turned", "straight"):
+        of_kind = [o for o in outcomes if o["kind"] == kind]
+        joined = [abs(o["duration_error_s"]) for o in of_kind if o["joined"]]
+        out[kind] = {"joined": len(joined), "attempted": len(of_kind),
+                     "duration_error_s": float(np.mean(joined)) if joined else None,
+                     "seconds": float(np.mean([o["seconds"] for o in of_kind])) if of_kind else None}
+    return out
 
 
 def _take_skating(take, fps: float, spacing: float) -> float:
@@ -111,51 +172,58 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
         graph = DynamicMotionGraph(database_of("bandai-train", parts["train"], fps), clean=False)
         val_takes = choose_queries(parts["val"], args.contents, args.val_takes, rng)
         test_takes = choose_queries(parts["test"], args.contents, args.takes, rng)
-        val_cases = [c for t in val_takes for c in _cases(t, fps, args, moved=False)]
+        straight_takes = choose_queries(parts["val"], args.straight_contents, args.straight_val_takes, rng)
+        val_cases = ([c for t in val_takes for c in _cases(t, fps, args, moved=False)]
+                     + _straight_cases(straight_takes, fps, args))
+        # eq. 4.12's search alone at each facing-first budget, then each turn-aware search at each iteration budget;
+        # a candidate's outcome is the library's: the facing search's when it joined, else the turn-aware one's
+        # (which starts afresh), its seconds the sum of both
+        first_budgets = [f for f in args.facing_first if f > 0]
+        facing = _budget_outcomes(graph, val_cases, 0.0, first_budgets) if first_budgets else {}
         scores, val_figures = {}, {}
         for radius in args.radii:
-            # one search per case at the largest budget; a smaller budget's outcome is the same search cut short:
-            # joined when it met before its last iteration (identical path), rerun when it met at that iteration
-            # (it stops without the extra iteration), failed otherwise
-            graph.turn_radius_m, graph.max_iterations = float(radius), max(args.iterations)
-            full = _outcomes(graph, val_cases, quality=False)
+            turning = _budget_outcomes(graph, val_cases, radius, args.iterations)
             for budget in sorted(args.iterations):
-                outcomes = []
-                for case, o in zip(val_cases, full):
-                    met = o.get("met_at_iteration") if o["joined"] else None
-                    if met is not None and met == budget and budget < max(args.iterations):
-                        graph.max_iterations = budget
-                        o = _outcomes(graph, [case], quality=False)[0]
-                        graph.max_iterations = max(args.iterations)
-                    elif met is None or met > budget:
-                        o = {**{k: o[k] for k in ("take", "kind", "angle_deg", "scale", "spacing_s")},
-                             "joined": False}
-                    outcomes.append(o)
-                key = f"{radius:g}/{budget}"
-                scores[key] = _val_score(outcomes)
-                val_figures[key] = {"joined": sum(o["joined"] for o in outcomes), "attempted": len(outcomes)}
-                print(f"seed {seed} val turn_radius_m {radius:g}, max_iterations {budget}: {scores[key]}", flush=True)
+                for first_budget in sorted(args.facing_first):
+                    outcomes = []
+                    for i, o in enumerate(turning[budget]):
+                        f = facing[first_budget][i] if first_budget > 0 else None
+                        if f is not None and f["joined"]:
+                            o = f
+                        elif f is not None:
+                            o = {**o, "seconds": round(o["seconds"] + f["seconds"], 3)}
+                        outcomes.append(o)
+                    key = f"{radius:g}/{budget}/{first_budget}"
+                    scores[key] = _val_score(outcomes)
+                    val_figures[key] = _val_figures(outcomes)
+                    print(f"seed {seed} val turn_radius_m {radius:g}, max_iterations {budget}, facing_first "
+                          f"{first_budget}: {scores[key]}", flush=True)
         best = min(scores, key=lambda c: tuple(scores[c]))
-        chosen, iterations = float(best.split("/")[0]), int(best.split("/")[1])
+        chosen, iterations, first_iterations = float(best.split("/")[0]), int(best.split("/")[1]), \
+            int(best.split("/")[2])
         test_cases = [c for t in test_takes for c in _cases(t, fps, args, moved=True)]
         test: dict[str, list] = {}
-        before = (0.0, min(args.iterations))
-        for label, (radius, budget) in (("before", before), ("after", (chosen, iterations))):
-            if label == "after" and (radius, budget) == before:
+        before = (0.0, min(args.iterations), 0)
+        for label, (radius, budget, first_budget) in (("before", before),
+                                                      ("after", (chosen, iterations, first_iterations))):
+            if label == "after" and (radius, budget, first_budget) == before:
                 test["after"] = test["before"]
                 continue
-            graph.turn_radius_m, graph.max_iterations = radius, budget
+            graph.turn_radius_m, graph.max_iterations, graph.facing_first_iterations = radius, budget, first_budget
             test[label] = _outcomes(graph, test_cases, quality=True)
             joined = sum(o["joined"] for o in test[label])
-            print(f"seed {seed} test {label} (turn_radius_m {radius:g}, max_iterations {budget}): {joined} / "
-                  f"{len(test[label])}", flush=True)
+            print(f"seed {seed} test {label} (turn_radius_m {radius:g}, max_iterations {budget}, facing_first "
+                  f"{first_budget}): {joined} / {len(test[label])}", flush=True)
         per_seed.append({"seed": seed, "val_takes": [t.name for t in val_takes],
+                         "straight_val_takes": [t.name for t in straight_takes],
+                         "facing_first_iterations": first_iterations,
                          "test_takes": [t.name for t in test_takes], "val_score_by_radius": scores,
                          "val_figures": val_figures, "turn_radius_m": chosen, "max_iterations": iterations,
                          "test": test,
                          "take_skating": {t.name: _take_skating(t, fps, args.spacing) for t in test_takes},
                          "settings": graph.settings(), "seconds": round(time.perf_counter() - started, 1)})
-    counts = Counter(f"{r['turn_radius_m']:g}/{r['max_iterations']}" for r in per_seed)
+    counts = Counter(f"{r['turn_radius_m']:g}/{r['max_iterations']}/{r['facing_first_iterations']}"
+                     for r in per_seed)
     top = max(counts.values())
     default = min((c for c in counts if counts[c] == top),
                   key=lambda c: tuple(np.mean([r["val_score_by_radius"][c] for r in per_seed], axis=0)))
@@ -164,11 +232,15 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
             "settings": {"contents": args.contents, "takes": args.takes, "val_takes": args.val_takes,
                          "spacing_s": args.spacing, "angles_deg": args.angles, "scales": args.scales,
                          "move_angles_deg": args.move_angles, "radius_candidates": args.radii,
-                         "iteration_candidates": args.iterations, "clean": False},
+                         "iteration_candidates": args.iterations, "facing_first_candidates": args.facing_first,
+                         "straight_contents": args.straight_contents, "straight_val_takes": args.straight_val_takes,
+                         "straight_spacings_s": args.straight_spacings, "clean": False},
             "choice": {"turn_radius_m": float(default.split("/")[0]), "max_iterations": int(default.split("/")[1]),
-                       "rule": "each seed chooses (turn_radius_m, max_iterations) on its val takes' turned keys: "
-                               "fewest failed pairs, then the lowest mean |duration error| of the joined ones; the "
-                               "default is the most frequent choice"},
+                       "facing_first_iterations": int(default.split("/")[2]),
+                       "rule": "each seed chooses (turn_radius_m, max_iterations, facing_first_iterations) on its val "
+                               "takes' turned keys and straight key pairs: fewest failed cases, then the lowest sum "
+                               "over the two kinds of the mean |duration error| of the joined ones; the default is "
+                               "the most frequent choice (ties: the lowest mean val score)"},
             "per_seed": per_seed}
 
 
@@ -205,12 +277,14 @@ def render(record: dict[str, Any]) -> dict[str, str]:
     s = r["settings"]
     prov = provenance_line(record)
     n = len(r["per_seed"])
-    chosen = ", ".join(f"{fmt(x['turn_radius_m'], 2)} m / {x['max_iterations']}" for x in r["per_seed"])
+    chosen = ", ".join(f"{fmt(x['turn_radius_m'], 2)} m / {x['max_iterations']} / {x['facing_first_iterations']}"
+                       for x in r["per_seed"])
     take_skating = float(np.mean([v for x in r["per_seed"] for v in x["take_skating"].values()])) * 100.0
     note = (f"Test: {s['takes']} {', '.join(s['contents'])} test take(s) per seed × {n} seeds, the first key pair "
             f"{s['spacing_s']:g} s apart; database = the seed's train takes; no cleaning. before: turn_radius_m = 0 "
             f"(D_node of eq. 4.12 with the facing term), max_iterations = {min(s['iteration_candidates'])}; after: "
-            f"the seed's val choice of turn_radius_m / max_iterations ({chosen}). Duration error: "
+            f"the seed's val choice of turn_radius_m / max_iterations / facing_first_iterations ({chosen}). "
+            f"Duration error: "
             f"the joined path's frames against the keys' {s['spacing_s']:g} s (a turned key needs a detour, as in the "
             f"thesis' Fig. 4.20); end gap: the path's last Hips to the key's, on the ground; foot skating "
             f"(share of contact frames that skate, stylemotion.synthesis.quality.skating) of the joined path before "
@@ -229,30 +303,46 @@ def render(record: dict[str, Any]) -> dict[str, str]:
                               [o for o in _select(r, "after", angle_deg=a, scale=scale) if o["kind"] == "moved"]))
     moved.append(_row("all moves", [o for o in _select(r, "before") if o["kind"] == "moved"],
                       [o for o in _select(r, "after") if o["kind"] == "moved"]))
-    radii, budgets = s["radius_candidates"], s["iteration_candidates"]
+    radii, budgets, firsts = s["radius_candidates"], s["iteration_candidates"], s["facing_first_candidates"]
     crows = []
+
+    def kind_cell(f: dict, kind: str) -> str:
+        k = f[kind]
+        return f"{k['joined']}/{k['attempted']}, {fmt(k['duration_error_s'], 2)} s, {fmt(k['seconds'], 1)} s/pair"
+
     for radius in radii:
         for budget in budgets:
-            key = f"{radius:g}/{budget}"
-            row = [fmt(radius, 2), str(budget)]
-            for x in r["per_seed"]:
-                _, dur = x["val_score_by_radius"][key]
-                f = x["val_figures"][key]
-                row.append(f"{f['joined']} / {f['attempted']} joined, {fmt(dur, 2)} s")
-            crows.append(row)
-    crows.append(["chosen", ""] + [f"{fmt(x['turn_radius_m'], 2)} / {x['max_iterations']}" for x in r["per_seed"]])
+            for first in firsts:
+                key = f"{radius:g}/{budget}/{first}"
+                row = [fmt(radius, 2), str(budget), str(first)]
+                for x in r["per_seed"]:
+                    f = x["val_figures"][key]
+                    row.append(f"turned {kind_cell(f, 'turned')}; straight {kind_cell(f, 'straight')}")
+                crows.append(row)
+    crows.append(["chosen", "", ""] + [f"{fmt(x['turn_radius_m'], 2)} / {x['max_iterations']} / "
+                                       f"{x['facing_first_iterations']}" for x in r["per_seed"]])
     c = r["choice"]
     edges = [name for name, value, grid in (("turn_radius_m", c["turn_radius_m"], radii),
-                                             ("max_iterations", c["max_iterations"], budgets))
+                                             ("max_iterations", c["max_iterations"], budgets),
+                                             ("facing_first_iterations", c["facing_first_iterations"], firsts))
              if len(grid) > 1 and value in (max(grid), min(grid))]
     edge = (f" {' and '.join(edges)}: the choice lies at the edge of the candidates; values beyond them were not "
             f"tried." if edges else "")
-    choice = (md_table(["turn_radius_m", "max_iterations", *[f"seed {x['seed']}" for x in r["per_seed"]]], crows)
+    straight = sum(x["val_figures"][f"{radii[0]:g}/{budgets[0]}/{firsts[0]}"]["straight"]["attempted"]
+                   for x in r["per_seed"])
+    choice = (md_table(["turn_radius_m", "max_iterations", "facing_first_iterations",
+                        *[f"seed {x['seed']}" for x in r["per_seed"]]], crows)
               + f"\n\nVal: {s['val_takes']} {', '.join(s['contents'])} val take(s) per seed, the turned second keys "
-                f"({len(s['angles_deg'])} angles); each cell: joined / attempted and the mean abs. duration error of "
-                f"the joined pairs. A smaller max_iterations is the same search cut short (a pair that met at its last "
-                f"iteration rerun with it). Rule: {c['rule']}. Default: turn_radius_m = {fmt(c['turn_radius_m'], 2)} "
-                f"m, max_iterations = {c['max_iterations']}.{edge} {prov}")
+                f"({len(s['angles_deg'])} angles), and the straight key pairs "
+                f"{', '.join(fmt(v, 0) for v in s['straight_spacings_s'])} s apart of {s['straight_val_takes']} val "
+                f"take(s) per {', '.join(s['straight_contents'])} "
+                f"({straight} pairs over the seeds); each cell: joined / attempted, the mean abs. duration error of "
+                f"the joined pairs and the mean seconds per pair (a failed facing-first search's time included; at a "
+                f"cut-short budget the time of the longer search). A smaller budget is the same search cut short (a "
+                f"pair that met at its last iteration rerun with it); a facing-first candidate takes eq. 4.12's path "
+                f"where that search joined and the turn-aware search's otherwise, as the library does. Rule: "
+                f"{c['rule']}. Default: turn_radius_m = {fmt(c['turn_radius_m'], 2)} m, max_iterations = "
+                f"{c['max_iterations']}, facing_first_iterations = {c['facing_first_iterations']}.{edge} {prov}")
     tb, ta = len([o for o in all_b if o["joined"]]), len([o for o in all_a if o["joined"]])
     mb = len([o for o in _select(r, "before") if o["kind"] == "moved" and o["joined"]])
     ma = len([o for o in _select(r, "after") if o["kind"] == "moved" and o["joined"]])
@@ -261,7 +351,8 @@ def render(record: dict[str, Any]) -> dict[str, str]:
                f"[benchmarks/reconstruct.md](benchmarks/reconstruct.md)): joined {tb} / {len(all_b)} turned and "
                f"{mb} / {nm} moved keys before, **{ta} / {len(all_a)}** and **{ma} / {nm}** with the turning-aware "
                f"search (turn_radius_m = {fmt(r['choice']['turn_radius_m'], 2)} m, max_iterations = "
-               f"{r['choice']['max_iterations']}, chosen on val takes); mean abs. "
+               f"{r['choice']['max_iterations']}, facing_first_iterations = "
+               f"{r['choice']['facing_first_iterations']}, chosen on val takes); mean abs. "
                f"duration error of the joined turned pairs {fmt(_mean(all_a, 'duration_error_s', absolute=True), 2)} "
                f"s (the detour), foot skating {fmt(_mean(all_a, 'skating', 100.0), 1)} % (the takes' "
                f"{fmt(take_skating, 1)} %).")

@@ -174,24 +174,29 @@ def _keyframes_section(args, bandai, parts, rng) -> dict[str, Any]:
     weight = choose_setting(val_scores)
     graph.duration_weight = float(weight)
     outcomes = [(c, pair_outcome(graph, a, b)) for c, (a, b) in pairs["test"]["pairs"]]
-    # the turn-aware search (turn_radius_m, chosen by suite moved_keys on turned keys) against eq. 4.12's facing
-    # term on these straight keys, val and test pairs alike: reported, not chosen here (the default's figures are
-    # the ones above; only the facing term's are new)
-    default_radius = graph.turn_radius_m
-    turn_radius = {f"{default_radius:g}": {"val": val_figures[str(weight)],
-                                           "test": pairs_figures([o for _, o in outcomes])}}
-    if default_radius != 0.0:
-        graph.turn_radius_m = 0.0
-        turn_radius["0"] = {part: pairs_figures([pair_outcome(graph, a, b) for _, (a, b) in pairs[part]["pairs"]])
-                            for part in ("val", "test")}
-        graph.turn_radius_m = default_radius
-    turn_radius = dict(sorted(turn_radius.items(), key=lambda item: float(item[0])))
+    # the searches suite moved_keys chose between, on these straight keys, val and test pairs alike: reported, not
+    # chosen here (the default's figures are the ones above; the others are joined anew)
+    default = (graph.turn_radius_m, graph.facing_first_iterations)
+    compared: dict[str, Any] = {}
+    for label, setting in (("eq. 4.12 with the facing term", (0.0, 0)), ("turn-aware alone", (default[0], 0)),
+                           ("eq. 4.12 first, turn-aware when it fails", default)):
+        if any((v["turn_radius_m"], v["facing_first_iterations"]) == setting for v in compared.values()):
+            continue
+        if setting == default:
+            figures = {"val": val_figures[str(weight)], "test": pairs_figures([o for _, o in outcomes])}
+        else:
+            graph.turn_radius_m, graph.facing_first_iterations = setting
+            figures = {part: pairs_figures([pair_outcome(graph, a, b) for _, (a, b) in pairs[part]["pairs"]])
+                       for part in ("val", "test")}
+        compared[label] = {**figures, "turn_radius_m": setting[0], "facing_first_iterations": setting[1],
+                           "default": setting == default}
+    graph.turn_radius_m, graph.facing_first_iterations = default
     by_spacing = {f"{s:g}": pairs_figures([o for _, o in outcomes if abs(o["spacing_s"] - s) < 1e-6])
                   for s in args.spacings}
     by_content = {c: pairs_figures([o for cc, o in outcomes if cc == c]) for c in args.key_contents}
     return {"val_takes": pairs["val"]["takes"], "test_takes": pairs["test"]["takes"],
             "val_score_s_by_weight": {str(w): s for w, s in val_scores.items()}, "val_figures": val_figures,
-            "turn_radius": turn_radius,
+            "searches": compared,
             "duration_weight": float(weight), "test": {"all": pairs_figures([o for _, o in outcomes]),
                                                         "by_spacing": by_spacing, "by_content": by_content},
             "settings": graph.settings()}
@@ -352,27 +357,29 @@ def _edge(r: dict) -> str:
     return out
 
 
-def _turn_radius_table(r: dict) -> str:
-    """The turn-aware search against eq. 4.12's facing term on the straight key pairs (val and test, over seeds)."""
-    seeds = [x for x in r["per_seed"] if "turn_radius" in x["keyframes"]]
+def _searches_table(r: dict) -> str:
+    """The searches suite moved_keys chose between on the straight key pairs (val and test, over seeds)."""
+    seeds = [x for x in r["per_seed"] if "searches" in x["keyframes"]]
     if not seeds:
         return ""
     rows = []
-    for radius in seeds[0]["keyframes"]["turn_radius"]:
-        row = [f"{radius} m" + (" (eq. 4.12 with the facing term)" if float(radius) == 0 else " (default)")]
+    for label, entry in seeds[0]["keyframes"]["searches"].items():
+        row = [label + (" (default)" if entry["default"] else ""), fmt(entry["turn_radius_m"], 1),
+               str(entry["facing_first_iterations"])]
         for part in ("val", "test"):
-            figures = [x["keyframes"]["turn_radius"][radius][part] for x in seeds]
+            figures = [x["keyframes"]["searches"][label][part] for x in seeds]
             means = [f["duration_error_s"]["mean"] for f in figures if "duration_error_s" in f]
             maxima = [f["duration_error_s"]["max"] for f in figures if "duration_error_s" in f]
             joined = sum(f["joined"] for f in figures)
             attempted = sum(f["attempted"] for f in figures)
             row += [f"{joined} / {attempted}", fmt_spread(spread(means), 3), fmt(max(maxima), 2) if maxima else "—"]
         rows.append(row)
-    return ("The turn-aware search (`turn_radius_m`, chosen by suite `moved_keys` on **turned** keys) against eq. "
-            "4.12's facing term on these straight key pairs, at each seed's chosen duration_weight (reported, not "
-            "chosen here):\n\n"
-            + md_table(["turn_radius_m", "val: joined", "val: mean abs. duration error s", "val: max s",
-                        "test: joined", "test: mean abs. duration error s", "test: max s"], rows))
+    return ("The searches suite `moved_keys` chooses between (`turn_radius_m`, `facing_first_iterations`, chosen there "
+            "on val turned **and** straight keys) on these straight key pairs, at each seed's chosen duration_weight "
+            "(reported, not chosen here):\n\n"
+            + md_table(["search", "turn_radius_m", "facing_first_iterations", "val: joined",
+                        "val: mean abs. duration error s", "val: max s", "test: joined",
+                        "test: mean abs. duration error s", "test: max s"], rows))
 
 
 def render(record: dict[str, Any]) -> dict[str, str]:
@@ -466,7 +473,7 @@ def render(record: dict[str, Any]) -> dict[str, str]:
               + md_table(["k", *seeds_cols], krows)
               + "\n\nValidation score of each duration_weight (s: mean |duration error|, a failed pair counting its "
                 "whole spacing; joined / attempted val pairs):\n\n" + md_table(["duration_weight", *seeds_cols], wrows)
-              + "".join("\n\n" + t for t in [_turn_radius_table(r)] if t)
+              + "".join("\n\n" + t for t in [_searches_table(r)] if t)
               + f"\n\nRule: {r['choice']['rule']}."
               + f" Defaults (most frequent choice over seeds): k = {r['choice']['k']}, duration_weight = "
                 f"{fmt(r['choice']['duration_weight'], 0)}.{_edge(r)} {prov}")

@@ -18,6 +18,8 @@ Between every two consecutive keys ``k_i → k_{i+1}`` (docs/reconstruct.md, "Dy
    tighter than ``turn_radius_m`` from the outgoing node's placement to the incoming one's
    (:func:`~stylemotion.reconstruct.turning.dubins_length`): a key turned against the direction of travel is then
    far from the trees that face it, and they grow along a loop rather than stalling face to face.
+   With ``facing_first_iterations > 0`` the search of eq. 4.12 (with the facing term) runs first and the turn-aware
+   one only when its trees do not meet in that many iterations.
 3. **Connections.** The Hips of every incoming frame go into a spatial hash of ``voxel_m`` voxels; every
    outgoing frame looks in its 27 neighbouring voxels. A pair connects when the Hips are within ``voxel_m``,
    the facings within ``max_turn_deg``, the body-frame hands/feet/head within ``max_pose_m`` (mean) and the
@@ -173,6 +175,7 @@ class _Tree:
     """One search tree: nodes (a placed database frame) and the edges (segments) that made them."""
 
     forward: bool
+    turn_radius_m: float = 0.0  # D_node's turning radius for this search (0: eq. 4.12 with the facing term)
     node_frame: list[int] = field(default_factory=list)  # database frame (-1: the key itself)
     node_ground: list[np.ndarray] = field(default_factory=list)
     node_yaw: list[float] = field(default_factory=list)
@@ -252,6 +255,8 @@ class DynamicMotionGraph:
         connection tests.  blend_frames: frames blended at a connection.  duration_weight: price of a frame of
         timing error in median frames of motion (0: the thesis' cost alone).  turn_radius_m: turning radius
         (metres) of D_node's walk length (0: eq. 4.12 with the facing term; module docstring, step 2).
+        facing_first_iterations: with ``turn_radius_m > 0``, iterations of eq. 4.12's search tried first; the
+        turn-aware search runs only when its trees do not meet (0: the turn-aware search alone).
         retime: resample each pair to its keys' times.  clean: texture the intermediate result with the keys
         pinned.  index: an E15 :class:`FrameIndex` of ``database`` (built, cached, when None).  texturer: the cleaning
         :class:`MotionTexturer` (built in texture mode when None and ``clean``).
@@ -263,10 +268,12 @@ class DynamicMotionGraph:
                  max_pose_m: float = _G.max_pose_m, max_velocity_m_s: float = _G.max_velocity_m_s,
                  blend_frames: int = _G.blend_frames, duration_weight: float = _G.duration_weight,
                  facing_weight_m: float = _G.facing_weight_m, turn_radius_m: float = _G.turn_radius_m,
-                 key_weight: float = 10.0, extra_iterations: int = 1,
+                 facing_first_iterations: int = _G.facing_first_iterations, key_weight: float = 10.0,
+                 extra_iterations: int = 1,
                  retime: bool = _G.retime, clean: bool = _G.clean,
                  index: FrameIndex | None = None, texturer: MotionTexturer | None = None):
         for key, value, low in (("k", k, 1), ("b", b, 1), ("max_iterations", max_iterations, 1),
+                                ("facing_first_iterations", facing_first_iterations, 0),
                                 ("min_segment_frames", min_segment_frames, 1), ("blend_frames", blend_frames, 0)):
             if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < low:
                 raise KeyframeError(f"{key}={value} must be a whole number ≥ {low}")
@@ -291,7 +298,7 @@ class DynamicMotionGraph:
         self.max_pose_m, self.max_velocity_m_s = float(max_pose_m), float(max_velocity_m_s)
         self.blend_frames, self.duration_weight = int(blend_frames), float(duration_weight)
         self.facing_weight_m, self.key_weight = float(facing_weight_m), float(key_weight)
-        self.turn_radius_m = float(turn_radius_m)
+        self.turn_radius_m, self.facing_first_iterations = float(turn_radius_m), int(facing_first_iterations)
         self.extra_iterations = int(extra_iterations)
         self.retime, self.clean = bool(retime), bool(clean)
         self._prepare_database()
@@ -372,8 +379,8 @@ class DynamicMotionGraph:
 
     # -- growing the trees ----------------------------------------------------------------------------------
 
-    def _root(self, key: Keyframe, forward: bool) -> _Tree:
-        tree = _Tree(forward)
+    def _root(self, key: Keyframe, forward: bool, turn_radius_m: float) -> _Tree:
+        tree = _Tree(forward, turn_radius_m)
         ground, yaw = placements(key.pose[None], self.fps)
         tree.add_node(-1, ground[0], float(yaw[0]), np.asarray(key.pose)[EFFECTORS], -1, 0, 0.0)
         return tree
@@ -422,15 +429,17 @@ class DynamicMotionGraph:
     def _pair_distance(self, a: _Tree, rows: np.ndarray, b: _Tree, cols: np.ndarray) -> np.ndarray:
         """D_node terms ``(len(rows), len(cols))`` between nodes ``rows`` of ``a`` and ``cols`` of ``b``.
 
-        ``turn_radius_m = 0``: eq. 4.13 (hands, feet and head, world, summed, metres) plus ``facing_weight_m`` ×
-        the facing difference (radians). ``turn_radius_m > 0``: the same joints in the body frame (the pose
-        alone) plus their number × the length of the shortest forward walk of that turning radius from the O
-        node's placement to the I node's (:func:`~stylemotion.reconstruct.turning.dubins_length`): a node turned
-        against the way to the other tree is far, so the trees grow along a loop rather than meeting face to face.
+        The trees' ``turn_radius_m`` = 0: eq. 4.13 (hands, feet and head, world, summed, metres) plus
+        ``facing_weight_m`` × the facing difference (radians). ``turn_radius_m > 0``: the same joints in the body
+        frame (the pose alone) plus their number × the length of the shortest forward walk of that turning radius
+        from the O node's placement to the I node's (:func:`~stylemotion.reconstruct.turning.dubins_length`): a node
+        turned against the way to the other tree is far, so the trees grow along a loop rather than meeting face to
+        face.
         """
         ea, eb = np.stack(a.node_effectors)[rows], np.stack(b.node_effectors)[cols]
         ya, yb = np.asarray(a.node_yaw)[rows], np.asarray(b.node_yaw)[cols]
-        if self.turn_radius_m <= 0:
+        radius = a.turn_radius_m
+        if radius <= 0:
             d = np.linalg.norm(ea[:, None] - eb[None], axis=-1).sum(axis=-1)
             return d + self.facing_weight_m * np.abs(wrap_angle(ya[:, None] - yb[None]))
         ga, gb = np.stack(a.node_ground)[rows], np.stack(b.node_ground)[cols]
@@ -439,9 +448,9 @@ class DynamicMotionGraph:
         pose = np.linalg.norm(la[:, None] - lb[None], axis=-1).sum(axis=-1)
         xa, xb = ga[:, [0, 2]], gb[:, [0, 2]]
         if a.forward:
-            walk = dubins_length(xa[:, None], ya[:, None], xb[None], yb[None], self.turn_radius_m)
+            walk = dubins_length(xa[:, None], ya[:, None], xb[None], yb[None], radius)
         else:
-            walk = dubins_length(xb[None], yb[None], xa[:, None], ya[:, None], self.turn_radius_m)
+            walk = dubins_length(xb[None], yb[None], xa[:, None], ya[:, None], radius)
         return pose + len(EFFECTORS) * walk
 
     def _node_distance(self, a: _Tree, b: _Tree) -> np.ndarray:
@@ -582,15 +591,34 @@ class DynamicMotionGraph:
         return rotate_yaw(local, yaw[:, None]) + ground[:, None]
 
     def connect(self, first: Keyframe, second: Keyframe) -> PairResult:
-        """The motion from ``first`` to ``second`` (module docstring, steps 2–5; NoConnectionError if none)."""
+        """The motion from ``first`` to ``second`` (module docstring, steps 2–5; NoConnectionError if none).
+
+        With ``turn_radius_m > 0`` and ``facing_first_iterations > 0``, eq. 4.12's search (with the facing term)
+        runs first for that many iterations; only when its trees do not meet does the turn-aware search start afresh
+        (``max_iterations``). ``figures["search"]`` says which search joined the pair ("facing" or "turn-aware")."""
         started = time.perf_counter()
-        out_tree, in_tree = self._root(first, True), self._root(second, False)
+        if self.turn_radius_m > 0 and self.facing_first_iterations > 0:
+            try:
+                pair = self._search(first, second, 0.0, self.facing_first_iterations, started)
+                pair.figures["search"] = "facing"
+                return pair
+            except NoConnectionError as error:
+                log.info(f"  eq. 4.12's search did not join ({error}); the turn-aware search starts")
+        pair = self._search(first, second, self.turn_radius_m, self.max_iterations, started)
+        pair.figures["search"] = "turn-aware" if self.turn_radius_m > 0 else "facing"
+        return pair
+
+    def _search(self, first: Keyframe, second: Keyframe, turn_radius_m: float, max_iterations: int,
+                started: float) -> PairResult:
+        """One bidirectional search with D_node of ``turn_radius_m`` for at most ``max_iterations``; ``started``:
+        the pair's start (``perf_counter``), so ``figures["seconds"]`` counts an earlier search that failed."""
+        out_tree, in_tree = self._root(first, True, turn_radius_m), self._root(second, False, turn_radius_m)
         out_edges: list[int] = []
         in_edges: list[int] = []
         target_frames = int(round((second.time_s - first.time_s) * self.fps)) + 1
         connections: list[tuple[int, int, int, int]] = []
         iteration, met = 0, None
-        for iteration in range(1, self.max_iterations + 1):
+        for iteration in range(1, max_iterations + 1):
             new_out = self._expand(out_tree, self._select(out_tree, in_tree), first)
             new_in = self._expand(in_tree, self._select(in_tree, out_tree), second)
             out_edges += new_out
@@ -607,7 +635,7 @@ class DynamicMotionGraph:
         if not connections:
             gap = float(self._node_distance(out_tree, in_tree).min())
             raise NoConnectionError(
-                f"keys at {first.time_s:g} s → {second.time_s:g} s: the trees did not meet in {self.max_iterations} "
+                f"keys at {first.time_s:g} s → {second.time_s:g} s: the trees did not meet in {max_iterations} "
                 f"iterations ({len(out_tree.node_frame)} + {len(in_tree.node_frame)} nodes; the closest nodes are "
                 f"{gap:.2f} m apart, hands, feet and head summed): add a key between them, raise max_iterations or "
                 f"use a database that holds such motion")
@@ -631,7 +659,7 @@ class DynamicMotionGraph:
                 "max_turn_deg": round(float(np.rad2deg(self.max_turn)), 3), "max_pose_m": self.max_pose_m,
                 "max_velocity_m_s": self.max_velocity_m_s, "blend_frames": self.blend_frames,
                 "duration_weight": self.duration_weight, "facing_weight_m": self.facing_weight_m,
-                "turn_radius_m": self.turn_radius_m,
+                "turn_radius_m": self.turn_radius_m, "facing_first_iterations": self.facing_first_iterations,
                 "key_weight": self.key_weight, "extra_iterations": self.extra_iterations,
                 "retime": self.retime, "clean": self.clean,
                 "database": {"name": self.database.name, "takes": self.database.num_takes,

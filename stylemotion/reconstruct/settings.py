@@ -146,8 +146,10 @@ class DynamicGraphSettings:
     metres per radian (0: thesis); ``turn_radius_m``: D_node measures the way from an outgoing node to an incoming
     one as the shortest forward walk turning no tighter than this radius, metres (0: eq. 4.12, the thesis, with the
     facing term); chosen with ``max_iterations`` on Bandai val takes' turned keys (suite moved_keys,
-    docs/reconstruct.md); ``retime``: resample each key pair to the keys' times; ``clean``: motion
-    texturing of the result with the keys pinned (§4.3.4).
+    docs/reconstruct.md); ``facing_first_iterations``: with ``turn_radius_m > 0``, iterations of eq. 4.12's search
+    (with the facing term) tried first, the turn-aware search only when its trees do not meet (0: the turn-aware
+    search alone); chosen on Bandai val takes' turned and straight keys (suite moved_keys); ``retime``: resample
+    each key pair to the keys' times; ``clean``: motion texturing of the result with the keys pinned (§4.3.4).
     """
 
     k: int = 16
@@ -163,6 +165,7 @@ class DynamicGraphSettings:
     duration_weight: float = 30.0
     facing_weight_m: float = 1.0
     turn_radius_m: float = 1.0
+    facing_first_iterations: int = 0
     retime: bool = True
     clean: bool = True
 

@@ -169,6 +169,27 @@ def test_key_turned_against_travel_joins_with_the_turning_search(short_turns):
     assert pair.figures["duration_s"] > 2.0  # a 180° turn at ≤ 60°/s cannot fit the keys' 1 s
 
 
+def test_facing_search_first_falls_back_to_the_turning_search(short_turns):
+    database, first, second = short_turns
+    back = Keyframe(second.time_s, turn_key(second.pose, np.pi))
+    facing = DynamicMotionGraph(database, turn_radius_m=0.0, max_iterations=12, clean=False)
+    turning = DynamicMotionGraph(database, turn_radius_m=1.0, max_iterations=24, clean=False)
+    both = DynamicMotionGraph(database, turn_radius_m=1.0, max_iterations=24, facing_first_iterations=12,
+                              clean=False)
+    # a straight pair: eq. 4.12's search meets, and its path is the one taken
+    straight = both.connect(first, second)
+    assert straight.figures["search"] == "facing"
+    np.testing.assert_array_equal(straight.positions, facing.connect(first, second).positions)
+    # the key turned back: eq. 4.12's search fails (test above), the turn-aware search from scratch joins it
+    turned = both.connect(first, back)
+    assert turned.figures["search"] == "turn-aware"
+    alone = turning.connect(first, back)
+    np.testing.assert_array_equal(turned.positions, alone.positions)
+    assert turned.figures["seconds"] > 0 and both.settings()["facing_first_iterations"] == 12
+    with pytest.raises(KeyframeError, match="facing_first_iterations=-1"):
+        DynamicMotionGraph(database, facing_first_iterations=-1, clean=False)
+
+
 def test_moved_key_path_ends_where_the_key_was_moved(short_turns):
     database, first, second = short_turns
     graph = DynamicMotionGraph(database, turn_radius_m=1.0, max_iterations=24, clean=False)
