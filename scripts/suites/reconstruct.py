@@ -45,6 +45,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="candidates of k")
     parser.add_argument("--k-tolerance", type=float, default=0.01,
                         help="k: the smallest candidate whose val error is within this fraction of the lowest")
+    parser.add_argument("--prior-weights", type=float, nargs="+", default=[1.0, 3.0, 10.0, 30.0],
+                        help="candidates of the local model's prior weight at the joint centres (chosen on val with k)")
     parser.add_argument("--noise-mm", type=float, default=1.0, help="uniform marker noise, ± mm (thesis: 1)")
     parser.add_argument("--key-contents", nargs="+", default=["walk", "walk-turn-left", "walk-turn-right", "run"])
     parser.add_argument("--key-takes", type=int, default=2, help="keyframe test takes per content")
@@ -90,30 +92,37 @@ def _markers_section(args, bandai, parts, rng) -> dict[str, Any]:
         recs[("without", content)] = SparseReconstructor(database_of(f"bandai-train-without-{content}", takes, fps),
                                                          DEFAULT_MARKERS, "E15", max(args.k), hold_bones=False)
 
-    def errors(db: str, part: str, k: int, baseline: bool = False) -> list[tuple[str, np.ndarray]]:
+    def errors(db: str, part: str, k: int, prior_weight: float, baseline: bool = False
+               ) -> list[tuple[str, np.ndarray]]:
         out = []
         for query, m in zip(queries[part], markers[part]):
             rec = recs[(db, None if db == "same" else query.content)]
-            rec.k = k  # k is read per query; the index does not depend on it
+            rec.k, rec.prior_weight = k, prior_weight  # read per query; the index depends on neither
             pose = rec.nearest_neighbour(m) if baseline else rec.reconstruct(m).positions
             out.append((query.content, joint_error_table(pose, query.positions)))
         return out
 
-    val_scores = {}
-    for k in args.k:
-        tables = [e for db in ("same", "without") for _, e in errors(db, "val", k)]
-        val_scores[k] = error_figures(tables)["mean_cm"]
+    # (k, prior weight) together: the prior weight whose best k has the lowest val error, then at that weight the
+    # smallest k within the tolerance of its lowest
+    by_weight: dict[float, dict[int, float]] = {}
+    for prior_weight in args.prior_weights:
+        by_weight[prior_weight] = {}
+        for k in args.k:
+            tables = [e for db in ("same", "without") for _, e in errors(db, "val", k, prior_weight)]
+            by_weight[prior_weight][k] = error_figures(tables)["mean_cm"]
+    prior_weight = min(by_weight, key=lambda w: min(by_weight[w].values()))
+    val_scores = by_weight[prior_weight]
     k = choose_smallest_within(val_scores, args.k_tolerance)
     test: dict[str, Any] = {}
     for db in ("same", "without"):
         for name, baseline in (("ours", False), ("nn", True)):
-            found = errors(db, "test", k, baseline)
+            found = errors(db, "test", k, prior_weight, baseline)
             test[f"{db}/{name}"] = error_figures([e for _, e in found])
             test[f"{db}/{name}"]["by_content"] = {c: error_figures([e for cc, e in found if cc == c])["mean_cm"]
                                                   for c in args.contents}
     # other captures: the reader of a user's file, against every train take
     same = recs[("same", None)]
-    same.k = k
+    same.k, same.prior_weight = k, prior_weight
     # the database's skeleton (median bones of the train takes; every Bandai take shares one): the other captures'
     # own joints differ from any pose on it by their bone lengths ("floor"); "retargeted" puts each capture on it
     # first (stylemotion.bones.retarget_positions), so that only the motion differs
@@ -142,7 +151,10 @@ def _markers_section(args, bandai, parts, rng) -> dict[str, Any]:
             "test_frames": int(sum(q.num_frames for q in queries["test"])),
             "database_frames": {"same": same.database.num_frames,
                                 **{f"without {c}": recs[("without", c)].database.num_frames for c in args.contents}},
-            "val_mean_cm_by_k": {str(c): s for c, s in val_scores.items()}, "k": int(k), "test": test}
+            "val_mean_cm_by_k": {str(c): s for c, s in val_scores.items()}, "k": int(k),
+            "val_mean_cm_by_prior_weight_and_k": {f"{w:g}": {str(c): v for c, v in scores.items()}
+                                                  for w, scores in by_weight.items()},
+            "prior_weight": float(prior_weight), "test": test}
 
 
 def _keyframes_section(args, bandai, parts, rng) -> dict[str, Any]:
@@ -274,8 +286,12 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
             record[name] = section(args, bandai, parts, rng)
             record["seconds"][name] = round(time.perf_counter() - started, 1)
         per_seed.append(record)
-        print(f"seed {seed}: k {record['markers']['k']}, duration_weight {record['keyframes']['duration_weight']}",
+        print(f"seed {seed}: k {record['markers']['k']}, prior weight {record['markers']['prior_weight']:g}, "
+              f"duration_weight {record['keyframes']['duration_weight']}",
               flush=True)
+    prior_weight = _mode([f"{r['markers']['prior_weight']:g}" for r in per_seed],
+                         [{w: min(v.values()) for w, v in r["markers"]["val_mean_cm_by_prior_weight_and_k"].items()}
+                          for r in per_seed])
     k = _mode([r["markers"]["k"] for r in per_seed], [r["markers"]["val_mean_cm_by_k"] for r in per_seed])
     weight = _mode([r["keyframes"]["duration_weight"] for r in per_seed],
                    [r["keyframes"]["val_score_s_by_weight"] for r in per_seed])
@@ -284,15 +300,16 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
                        "other_captures": "the three walks of other-skeletons (other actors, studios, skeletons), "
                                          "never in any split; database = the seed's train takes"},
             "settings": {"contents": args.contents, "takes_per_content": args.takes, "k_candidates": args.k,
-                         "k_tolerance": args.k_tolerance,
+                         "k_tolerance": args.k_tolerance, "prior_weight_candidates": args.prior_weights,
                          "noise_mm": args.noise_mm, "key_contents": args.key_contents, "key_takes": args.key_takes,
                          "key_val_takes": args.key_val_takes,
                          "spacings_s": args.spacings, "val_spacings_s": args.val_spacings,
                          "duration_weight_candidates": args.duration_weights,
                          "texture_takes": args.texture_takes, "texture_frames": args.texture_frames,
                          "texture_every": args.texture_every, "features": "E15", "markers": "DEFAULT_MARKERS"},
-            "choice": {"k": int(k), "duration_weight": float(weight),
-                       "rule": f"each seed chooses on its val takes (k: the smallest candidate within "
+            "choice": {"k": int(k), "prior_weight": float(prior_weight), "duration_weight": float(weight),
+                       "rule": f"each seed chooses on its val takes (the prior weight whose best k has the lowest "
+                               f"mean error, then at that weight k: the smallest candidate within "
                                f"{args.k_tolerance:g} of the lowest mean error; duration_weight: the lowest score); "
                                f"the default is the most frequent choice"},
             "per_seed": per_seed}
@@ -339,6 +356,8 @@ def _edge(r: dict) -> str:
     """A sentence when a default is the largest or smallest candidate (the grid did not bracket the optimum)."""
     s, c = r["settings"], r["choice"]
     edges = [name for name, value, grid in (("k", c["k"], s["k_candidates"]),
+                                             ("prior_weight", c.get("prior_weight"),
+                                              s.get("prior_weight_candidates", [])),
                                              ("duration_weight", c["duration_weight"], s["duration_weight_candidates"]))
              if len(grid) > 1 and value in (max(grid), min(grid))]
     out = ""
@@ -469,13 +488,23 @@ def render(record: dict[str, Any]) -> dict[str, str]:
         wrows.append(row)
     wrows.append(["chosen"] + [fmt(x["keyframes"]["duration_weight"], 0) for x in r["per_seed"]])
     seeds_cols = [f"seed {x['seed']}" for x in r["per_seed"]]
-    choice = ("Validation mean per-joint error (cm) of each k (E15, both Bandai databases pooled):\n\n"
+    def best_at(x: dict, w: str) -> str:
+        scores = x["markers"]["val_mean_cm_by_prior_weight_and_k"][w]
+        return f"{fmt(min(scores.values()), 3)} (k {min(scores, key=scores.get)})"
+
+    prows = [[fmt(float(w), 0)] + [best_at(x, w) for x in r["per_seed"]]
+             for w in r["per_seed"][0]["markers"].get("val_mean_cm_by_prior_weight_and_k", {})]
+    prows.append(["chosen"] + [fmt(x["markers"].get("prior_weight"), 0) for x in r["per_seed"]])
+    choice = ("Validation mean per-joint error (cm) of each prior weight of the local model at its best k (E15, both "
+              "Bandai databases pooled):\n\n" + md_table(["prior weight", *seeds_cols], prows)
+              + "\n\nValidation mean per-joint error (cm) of each k at the seed's chosen prior weight:\n\n"
               + md_table(["k", *seeds_cols], krows)
               + "\n\nValidation score of each duration_weight (s: mean |duration error|, a failed pair counting its "
                 "whole spacing; joined / attempted val pairs):\n\n" + md_table(["duration_weight", *seeds_cols], wrows)
               + "".join("\n\n" + t for t in [_searches_table(r)] if t)
               + f"\n\nRule: {r['choice']['rule']}."
-              + f" Defaults (most frequent choice over seeds): k = {r['choice']['k']}, duration_weight = "
+              + f" Defaults (most frequent choice over seeds): k = {r['choice']['k']}, prior weight = "
+                f"{fmt(r['choice'].get('prior_weight'), 0)}, duration_weight = "
                 f"{fmt(r['choice']['duration_weight'], 0)}.{_edge(r)} {prov}")
 
     # keyframes

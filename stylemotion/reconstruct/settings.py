@@ -165,7 +165,7 @@ class DynamicGraphSettings:
     duration_weight: float = 30.0
     facing_weight_m: float = 1.0
     turn_radius_m: float = 1.0
-    facing_first_iterations: int = 0
+    facing_first_iterations: int = 12
     retime: bool = True
     clean: bool = True
 
