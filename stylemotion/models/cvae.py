@@ -13,8 +13,9 @@ length, any primitive (see :mod:`stylemotion.datamodules.features`).
 Which ``z`` (``style_latents``): the thesis writes ``decoder(z)`` next to the reconstruction's
 ``z_il = μ(y_i) + σ(y_i) ε_l``. Styling only those (``posterior``) leaves the samples a user draws,
 ``z ~ N(0, I)``, unstyled wherever the encoder's posteriors do not cover the prior; ``prior``
-styles as many fresh prior draws instead; ``both`` (default) styles both, so reconstructions and
-samples agree.
+(default) styles as many fresh prior draws instead, the draws a user samples; ``both`` styles both, so
+reconstructions and samples agree. ``prior`` was chosen on Bandai validation clips by suite ``style_term``
+(benchmarks/evaluation.md): its samples lie nearer the example's Gram, with less spread.
 
 α (``style_weight``) is 5 by default, chosen on Bandai validation clips (suite ``style_alpha``,
 benchmarks/evaluation.md): the thesis' 200 is far too strong in our units (the Gram is divided by the
@@ -77,7 +78,7 @@ class StyleCVAE(PrimitiveVAE):
         **kwargs: :class:`PrimitiveVAE` arguments.
     """
 
-    def __init__(self, style_weight: float = 5.0, style_latents: str = "both", style_term: str = "distance",
+    def __init__(self, style_weight: float = 5.0, style_latents: str = "prior", style_term: str = "distance",
                  style_margin: float = 1.0, style_centred: bool = False, gram_normalization: str = "mean",
                  style_channels: str = "all", style_subset: int = 0, **kwargs: Any):
         super().__init__(**kwargs)
