@@ -16,7 +16,8 @@ from omegaconf import MISSING
 
 from stylemotion.config import MotionFileKeys
 
-#: The local model's prior weight for markers at the joint centres (chosen on held-out takes of the synthetic data).
+#: The local model's prior weight for markers at the joint centres: suite ``reconstruct``'s choice, with k, on Bandai
+#: val takes among 1, 3, 10, 30 (set on synthetic data before; benchmarks/reconstruct.md, block ``reconstruct/choice``).
 JOINT_CENTRE_PRIOR_WEIGHT = 1.0
 #: The same for skin-marker sets: suite ``markers``' choice on the val takes of a style left out of the database
 #: (benchmarks/reconstruct.md, ``benchmarks/results/markers.json``).
