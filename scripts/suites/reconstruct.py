@@ -431,8 +431,10 @@ def render(record: dict[str, Any]) -> dict[str, str]:
                      f"{_cm(r, ['texture', 'nn_upper_cm'])} cm"])
     headline = (md_table(["task (test takes)", "like for like", "ours: mean ± sd over seeds",
                           "p95 / max", "nearest-neighbour baseline"], rows)
-                + f"\n\nk = {r['choice']['k']} and duration_weight = {fmt(r['choice']['duration_weight'], 0)} chosen "
-                  f"on val takes ({n} seeds: split, query takes and marker noise); errors per joint and frame, "
+                + f"\n\nk = {r['choice']['k']}, the joint-centre prior weight "
+                  f"{fmt(r['choice'].get('prior_weight', 1.0), 0)} and duration_weight = "
+                  f"{fmt(r['choice']['duration_weight'], 0)}: the most frequent choices on val takes; each seed's "
+                  f"test uses its own ({n} seeds: split, query takes and marker noise); errors per joint and frame, "
                   f"markers ± {fmt(s['noise_mm'], 1)} mm. {prov}")
 
     # markers: per database, per content
