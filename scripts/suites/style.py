@@ -366,9 +366,9 @@ def autoencoder_block(r: dict[str, Any], seeds: int, prov: str) -> str:
     return (f"The reproduction's motion autoencoder (Du §5.3.1) on the **test** split's windows ({windows}, "
             f"{r['data']}): MPJPE in cm, integrated from the root over the window (root drift counts) and "
             "root-local (the pose alone). The seed varies initialization and batches; the data split is fixed. "
-            "These runs used the earlier schedule (60 epochs, `model.lr_gamma` = 0.97, chosen on validation windows "
-            "by suite autoencoder_decay); the default is now the cosine schedule suite autoencoder_schedule chose "
-            "(benchmarks/autoencoder.md).\n\n"
+            "The autoencoder is trained as the reproduction's budget at the recorded commit says (schedule and "
+            "epochs: configs/experiment/autoencoder.yaml and the budget; which data chose them: docs/style.md, "
+            "\"Defaults\").\n\n"
             + md_table(["seed", "MPJPE integrated (cm)", "MPJPE root-local (cm)"], rows) + f"\n\n{prov}")
 
 
@@ -449,7 +449,8 @@ def render(record: dict[str, Any]) -> dict[str, str]:
     minutes = [v.get("stage_minutes") for v in r["per_seed"].values()]
     blocks["per_seed"] = (md_table(["seed", "primitive", "rows on diagonal", "columns on diagonal",
                                     "classifier held-out accuracy", "run folder"], per_seed_rows)
-                          + f"\n\nTraining stages took {', '.join(fmt(m, 1) for m in minutes)} min per seed (seeds run "
-                          f"concurrently on a loaded machine: no timing figure; the command's own seconds below count "
-                          f"only what it did not reuse). {prov}")
+                          + f"\n\nTraining stages took {', '.join(fmt(m, 1) for m in minutes)} min per seed, summed "
+                          f"over stages (the reproduction trains several at once, so its wall time is shorter; not a "
+                          f"timing figure: suite reproduce_speed times the reproduction alone). The command's own "
+                          f"seconds below count only what it did not reuse. {prov}")
     return blocks
