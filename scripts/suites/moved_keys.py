@@ -101,14 +101,13 @@ def _straight_cases(takes, fps: float, args: argparse.Namespace) -> list[dict[st
             for t in takes for spacing in args.straight_spacings for a, b in key_pairs(t.positions, fps, spacing)]
 
 
-def _val_score(outcomes: list[dict[str, Any]]) -> list[float]:
-    """(failed cases, Σ over the kinds (turned, straight) of the mean |duration error| s of the joined ones): lower
-    is better, compared in that order; a kind none of whose cases joined adds infinity."""
-    total = 0.0
-    for kind in sorted({o["kind"] for o in outcomes}):
-        joined = [abs(o["duration_error_s"]) for o in outcomes if o["kind"] == kind and o["joined"]]
-        total += float(np.mean(joined)) if joined else float("inf")
-    return [float(sum(not o["joined"] for o in outcomes)), total]
+def _val_score(figures: dict[str, Any]) -> list[float]:
+    """(failed cases, Σ over the kinds (turned, straight) present of the mean |duration error| s of the joined ones)
+    from :func:`_val_figures`: lower is better, compared in that order; a kind none of whose cases joined adds
+    infinity."""
+    kinds = [figures[kind] for kind in ("turned", "straight") if figures[kind]["attempted"]]
+    total = sum(float("inf") if k["duration_error_s"] is None else k["duration_error_s"] for k in kinds)
+    return [float(figures["attempted"] - figures["joined"]), total]
 
 
 def _budget_outcomes(graph, cases: list[dict[str, Any]], radius: float, budgets: list[int]
@@ -194,8 +193,8 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
                             o = {**o, "seconds": round(o["seconds"] + f["seconds"], 3)}
                         outcomes.append(o)
                     key = f"{radius:g}/{budget}/{first_budget}"
-                    scores[key] = _val_score(outcomes)
                     val_figures[key] = _val_figures(outcomes)
+                    scores[key] = _val_score(val_figures[key])
                     print(f"seed {seed} val turn_radius_m {radius:g}, max_iterations {budget}, facing_first "
                           f"{first_budget}: {scores[key]}", flush=True)
         best = min(scores, key=lambda c: tuple(scores[c]))
