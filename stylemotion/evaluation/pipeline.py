@@ -229,7 +229,7 @@ class RealSide:
         classifier: the style classifier fitted on the train split of every style.
         classifier_result: its held-out accuracy and confusion (``report.json`` layout).
         training: the neutral train-split clips (the training data).
-        heldout_neutral: the neutral val+test clips.
+        heldout_neutral: the neutral held-out clips (``settings.heldout_splits``: val + test by default).
         truth: each model's ground truth clips (its style, never seen by it).
     """
 
@@ -280,7 +280,7 @@ def real_side(primitive: str, models: Sequence[EvalModel], takeset: TakeSet, set
     length = _canonical_length(primitive, models, takeset, settings, split, segmentation)
     log.info(f"{primitive}: real clips")
     data = primitive_data(takeset, primitive, length, settings.neutral_style, _segment_values(settings), split,
-                          segmentation)
+                          segmentation, settings.heldout_splits)
     for m in models:
         if m.style not in data.styles:
             raise MissingExampleError(f"{m.checkpoint or m.label} models style {m.style!r}, which dataset "

@@ -42,6 +42,8 @@ class PrimitiveData:
         clips: the segmented clips of the data (``ClipDataModule`` set up with every style).
         rest_heights: ``(2, 2)`` resting heights of (foot, [heel, ball]), metres: median over the
             action's train-split takes (the reference of the foot-skating contact test).
+        heldout_splits: the splits :meth:`heldout` returns (``val`` and ``test``; ``val`` alone reads no test
+            clip).
     """
 
     primitive: str
@@ -50,6 +52,7 @@ class PrimitiveData:
     neutral_style: str
     clips: ClipDataModule
     rest_heights: np.ndarray
+    heldout_splits: tuple[str, ...] = ("val", "test")
 
     @property
     def stance_foot(self) -> int | None:
@@ -65,8 +68,8 @@ class PrimitiveData:
         return [c for c in self.clips.clips[part] if style is None or c.style == style]
 
     def heldout(self, style: str | None = None) -> list[Clip]:
-        """Val + test clips (of one style)."""
-        return self.split("val", style) + self.split("test", style)
+        """Val + test clips (of one style); val only when :attr:`heldout_splits` says so."""
+        return [c for part in self.heldout_splits for c in self.split(part, style)]
 
     def style_clips(self, style: str) -> list[Clip]:
         """Every clip of ``style`` in every split."""
@@ -102,7 +105,8 @@ class PrimitiveData:
 
 def primitive_data(takeset: TakeSet, primitive: str, length: int, neutral_style: str = "normal",
                    segment: Mapping[str, Any] | None = None, split: Mapping[str, Any] | None = None,
-                   segmentation: Segmentation | None = None) -> PrimitiveData:
+                   segmentation: Segmentation | None = None,
+                   heldout_splits: Sequence[str] = ("val", "test")) -> PrimitiveData:
     """Segment, split and time-normalize the real clips of ``primitive`` (see :class:`PrimitiveData`).
 
     Args:
@@ -114,6 +118,7 @@ def primitive_data(takeset: TakeSet, primitive: str, length: int, neutral_style:
         split: split settings (as for training; the data config's ``split``).
         segmentation: the action's takes already segmented with ``segment``
             (:func:`stylemotion.primitives.actions.segment_action`); None segments them here.
+        heldout_splits: the splits held out of the models (:attr:`PrimitiveData.heldout_splits`).
     """
     action, name = parse_primitive(primitive)
     module = ClipDataModule(takeset=takeset, action=action, primitives=[name], styles=None, timeline=int(length),
@@ -128,4 +133,5 @@ def primitive_data(takeset: TakeSet, primitive: str, length: int, neutral_style:
     if not takes:
         raise ValueError(f"dataset {takeset.name!r} has no {action} take in the train split")
     rest = np.median(np.stack([foot_signals(t.positions, takeset.fps).rest_heights for t in takes]), axis=0)
-    return PrimitiveData(primitive, int(length), float(takeset.fps), neutral_style, module, rest)
+    return PrimitiveData(primitive, int(length), float(takeset.fps), neutral_style, module, rest,
+                         tuple(heldout_splits))

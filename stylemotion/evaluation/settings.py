@@ -13,6 +13,9 @@ from stylemotion.config import ConfigError
 from stylemotion.primitives.segmentation import SegmentSettings
 from stylemotion.primitives.skating import SKATE_SPEED_MPS
 
+#: The data splits that may be held out of the models (the default: both).
+HELDOUT_SPLITS = ("val", "test")
+
 
 @dataclass
 class SampleCounts:
@@ -72,6 +75,10 @@ class EvalSettings:
         shift_baseline: add, per style example, the row ``shift:<style>`` to Tables 5.1–5.3: a neutral VAE sample
             plus (example − neutral mean) in the autoencoder's feature space
             (:class:`stylemotion.evaluation.pipeline.ShiftBaseline`).
+        heldout_splits: the splits whose clips count as held out: the classifier's held-out accuracy, the
+            neutral model's ground truth and, with the train clips, a style model's ground truth
+            (:meth:`stylemotion.evaluation.reference.PrimitiveData.ground_truth`). ``[val]`` reads no test clip
+            there: a choice made on the report then reads validation clips only (suite ``style_channels``).
         seed: sampling seed (every model is sampled with it) and classifier seed; set from the
             command's top-level ``seed``.
     """
@@ -85,9 +92,14 @@ class EvalSettings:
     autoencoder_test: WindowSettings = field(default_factory=WindowSettings)
     segment: SegmentSettings = field(default_factory=SegmentSettings)
     shift_baseline: bool = True
+    heldout_splits: list[str] = field(default_factory=lambda: list(HELDOUT_SPLITS))
     seed: int = 0
 
     def __post_init__(self) -> None:
+        parts = list(self.heldout_splits)
+        if not parts or len(set(parts)) != len(parts) or not set(parts) <= set(HELDOUT_SPLITS):
+            raise ConfigError(f"evaluation.heldout_splits must be a non-empty list of distinct splits out of "
+                              f"{list(HELDOUT_SPLITS)}, got {parts}")
         counts = self.samples
         for name in ("table_5_1", "variance", "metrics"):
             value = getattr(counts, name)

@@ -200,3 +200,31 @@ def test_variation_against_the_style_is_near_one_for_real_clips_and_zero_for_a_c
                            copy.normalized_frames.numpy())
     real = results["variance_real"]["walk_leftStance"]["elderly"]
     assert stats["pose_across_sd"] == pytest.approx(0.0, abs=1e-9) and stats["pose_sd"] > 0.5 * real["pose_sd"]
+
+
+def test_heldout_splits_val_reads_no_test_clip() -> None:
+    """``heldout_splits=[val]``: the held-out clips, the neutral ground truth and a style model's ground truth hold
+    no test-split clip, and every clip they lose is a test clip; the default holds both splits."""
+    both = primitive_data(tiny_takeset(), "walk_leftStance", 16, split=TINY_DATA["split"])
+    val = primitive_data(tiny_takeset(), "walk_leftStance", 16, split=TINY_DATA["split"], heldout_splits=("val",))
+    assert both.heldout_splits == ("val", "test")
+    test_keys = {(c.take, c.start) for c in both.split("test")}
+    assert test_keys, "the tiny data must have test clips for this test to mean anything"
+    key = lambda clips: {(c.take, c.start) for c in clips}  # noqa: E731
+    assert key(both.heldout()) == key(both.split("val")) | test_keys
+    assert key(val.heldout()) == key(val.split("val")) and not key(val.heldout()) & test_keys
+    for style in both.styles:
+        model = EvalModel(NEUTRAL if style == "normal" else style, "walk_leftStance", style,
+                          RealClipSource(both.training_data(), 16), timeline_frames=16)
+        full, narrowed = key(both.ground_truth(model)), key(val.ground_truth(model))
+        assert narrowed <= full and not narrowed & test_keys and full - narrowed <= test_keys
+        assert full - narrowed, f"{style}: the default ground truth should hold test clips of the style"
+
+
+def test_heldout_splits_are_checked() -> None:
+    from stylemotion.config import ConfigError
+
+    assert EvalSettings(heldout_splits=["val"]).heldout_splits == ["val"]
+    for bad in (["train"], [], ["val", "val"]):
+        with pytest.raises(ConfigError, match="evaluation.heldout_splits"):
+            EvalSettings(heldout_splits=bad)

@@ -1,0 +1,202 @@
+"""Suite ``style_channels``: which channels the style CVAE's Gram term sees (``model.style_channels``: ``all``, the
+thesis', or ``pose``, root velocity and yaw rate left out), chosen on **validation** clips of every Bandai style at
+the reproduction's full budget, against issue 27's aims.
+
+    python scripts/benchmarks.py run style_channels --seeds 100 101
+
+Per training seed (not a reported seed: suite ``style_bandai`` reports seeds 0, 1, 2) and candidate, the user's
+``stylemotion-reproduce data=bandai`` (both walk stances, every style) runs with ``evaluation.heldout_splits=[val]``:
+the evaluation's held-out clips are the val split only, so a style's ground truth is its train + val clips besides
+its example and no test clip is read by the figures the rule uses. The candidates of one seed share the
+autoencoder and neutral VAE stages (copied from the first candidate's run; the reproduction checks their settings
+hash), so they differ in their CVAEs only.
+
+Per (seed, stance, style) the rule reads the report: the style's Table 5.1 row on the diagonal, the share of
+samples the classifier (fitted on train clips) gives the style, and V_SD, step_SD and diversity of the samples over
+the style's real clips. It meets issue 27's aims when the row is on the diagonal, recognition ≥ 0.9, V_SD and
+step_SD ≥ 0.8 and diversity ≥ 0.7 (:data:`AIMS`). Rule (:func:`choose`): a candidate is eligible when its rows on
+the diagonal are no fewer than the default's and its mean recognition is at least min(0.9, the default's); among
+the eligible ones, most cases meeting every aim, then the highest mean over cases of the log of V_SD, step_SD and
+diversity each capped at 1 (variation up to the real clips' own). Raw foot skating is recorded beside, not ruled on.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import shutil
+from pathlib import Path
+from typing import Any
+
+from suites import style
+from suites.common import fmt, md_table, provenance_line, spread
+
+DESCRIPTION = ("the style CVAE's Gram over all channels or pose channels only, chosen on Bandai validation clips at "
+               "full budget against issue 27's aims")
+DEFAULT_SEEDS = (100, 101)
+#: candidate → the ``train`` overrides appended to the CVAE stages (the first is the config's default)
+CANDIDATES: dict[str, list[str]] = {"all": [], "pose": ["model.style_channels=pose"]}
+#: issue 27's aims per style: recognition, V_SD, step_SD, diversity (samples over the style's real clips)
+AIMS = {"recognition": 0.9, "v_sd": 0.8, "step_sd": 0.8, "diversity": 0.7}
+VARIATION = ("v_sd", "step_sd", "diversity")
+#: the stages every candidate of one seed shares (copied from the first candidate's run)
+SHARED_STAGES = ("autoencoder", "vae")
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--data", choices=sorted(style.DATA), default="bandai",
+                        help="bandai: dataset-2 walks; synthetic: a smoke run of the suite only")
+    parser.add_argument("--runs", type=Path, default=style.ROOT / "runs" / "benchmarks" / "style_channels",
+                        help="folder of the candidates' reproduction runs (reused and resumed)")
+    parser.add_argument("--workers", type=int, default=2, help="training stages at once (the reproduction's workers)")
+    parser.add_argument("--candidates", nargs="+", choices=sorted(CANDIDATES), default=list(CANDIDATES),
+                        help="candidates; the first is the reference of the rule (default: all, pose)")
+    parser.add_argument("--override", nargs="*", default=[], metavar="KEY=VALUE",
+                        help="more reproduce overrides for every candidate (e.g. budget.* for a smoke run)")
+
+
+def case_figures(report: dict[str, Any], styles: list[str]) -> dict[str, dict[str, Any]]:
+    """Per ``<primitive>/<style>`` of the report's CVAE styles: Table 5.1 row on the diagonal, recognition, the
+    variation over the style's real clips, the samples' raw skating, and whether every aim is met."""
+    out: dict[str, dict[str, Any]] = {}
+    for primitive, table in report["table_5_1"].items():
+        rows = set(table["diagonal"]["rows"])
+        recognized = report["style_recognition"]["per_model_detail"][primitive]
+        variation = report["variation_vs_style"][primitive]
+        skating = report.get("foot_skating_detail", {}).get(primitive, {})
+        for s in styles:
+            figures = {"row_on_diagonal": s in rows, "recognition": recognized[s]["share"],
+                       **{k: variation[s].get(k) for k in VARIATION},
+                       "skating_samples": (skating.get(s) or {}).get("samples", {}).get("ratio"),
+                       "skating_real": (skating.get(s) or {}).get("real", {}).get("ratio")}
+            figures["meets_aims"] = bool(figures["row_on_diagonal"] and all(
+                figures[k] is not None and figures[k] >= aim for k, aim in AIMS.items()))
+            out[f"{primitive}/{s}"] = figures
+    return out
+
+
+def candidate_summary(cases: list[dict[str, Any]]) -> dict[str, Any]:
+    """Over every (seed, stance, style) case of a candidate: the rule's figures and spreads."""
+    def capped_log(c: dict[str, Any]) -> float:
+        values = [c[k] for k in VARIATION]
+        if any(v is None or not v > 0 for v in values):
+            return -math.inf
+        return sum(math.log(min(1.0, v)) for v in values) / len(values)
+
+    return {"cases": len(cases), "rows_on_diagonal": sum(c["row_on_diagonal"] for c in cases),
+            "meets_aims": sum(c["meets_aims"] for c in cases),
+            "recognition": spread(c["recognition"] for c in cases),
+            **{k: spread(c[k] for c in cases) for k in VARIATION},
+            "skating_samples": spread(c["skating_samples"] for c in cases),
+            "skating_real": spread(c["skating_real"] for c in cases),
+            "capped_log_variation": sum(capped_log(c) for c in cases) / len(cases) if cases else -math.inf}
+
+
+def choose(summaries: dict[str, dict[str, Any]]) -> dict[str, Any]:
+    """The module doc's rule over candidate summaries (the first is the default); returns eligibility and choice."""
+    default = summaries[next(iter(summaries))]
+    floor = min(AIMS["recognition"], default["recognition"]["mean"])
+    eligible = {name: s["rows_on_diagonal"] >= default["rows_on_diagonal"] and s["recognition"]["mean"] >= floor
+                for name, s in summaries.items()}
+    ranked = sorted((name for name in summaries if eligible[name]),
+                    key=lambda n: (-summaries[n]["meets_aims"], -summaries[n]["capped_log_variation"]))
+    return {"eligible": eligible, "recognition_floor": floor, "chosen": ranked[0]}
+
+
+def share_stages(first: Path, out: Path) -> list[str]:
+    """Copy the finished shared stages of ``first`` into ``out`` (those ``out`` lacks); returns their names."""
+    copied = []
+    for name in SHARED_STAGES:
+        source, target = first / name, out / name
+        if source.is_dir() and not target.exists():
+            shutil.copytree(source, target, symlinks=False)
+            copied.append(name)
+    return copied
+
+
+def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
+    import torch
+
+    from stylemotion.io.jsonfile import read_json_object
+
+    torch.set_num_threads(1)
+    names = list(dict.fromkeys(args.candidates))
+    per_seed: dict[str, dict[str, Any]] = {}
+    for seed in seeds:
+        first = None
+        for name in names:
+            out = args.runs / args.data / f"seed{seed}" / name
+            out.mkdir(parents=True, exist_ok=True)
+            copied = share_stages(first, out) if first is not None else []
+            report = style.reproduce_seed(args.data, seed, out, args.workers,
+                                          extra=["evaluation.heldout_splits=[val]", *args.override],
+                                          cvae=CANDIDATES[name])
+            styles = read_json_object(out / "data.json", "the reproduction's data summary",
+                                      "rerun the suite")["cvae_styles"]
+            per_seed.setdefault(str(seed), {})[name] = {
+                "run": str(out.relative_to(style.ROOT) if out.is_relative_to(style.ROOT) else out),
+                "shared_from_first": copied, "heldout_splits": report["meta"]["settings"]["heldout_splits"],
+                "cases": case_figures(report, styles)}
+            first = first or out
+    summaries = {name: candidate_summary([c for s in per_seed.values() for c in s[name]["cases"].values()])
+                 for name in names}
+    return {"data": args.data, "candidates": {n: CANDIDATES[n] for n in names}, "aims": AIMS,
+            "overrides": args.override,
+            "splits": {"choose": "evaluation.heldout_splits=[val]: a style's ground truth is its train + val clips "
+                                 "besides its example, the classifier is fitted on train clips; no test clip is read "
+                                 "by the figures the rule uses",
+                       "seeds": "training seeds of the candidates, not reported seeds"},
+            "per_seed": per_seed, "summary": summaries, "choice": choose(summaries)}
+
+
+def render(record: dict[str, Any]) -> dict[str, str]:
+    r = record["results"]
+    choice, summary = r["choice"], r["summary"]
+    default = next(iter(r["candidates"]))
+    label = "**Synthetic data: a smoke run of the suite, not evidence.** " if r["data"] == "synthetic" else ""
+    if r.get("overrides"):
+        label += f"**Not the full budget: overrides {', '.join(r['overrides'])}.** "
+
+    def sd(s: dict[str, Any], digits: int = 2) -> str:
+        return f"{fmt(s.get('mean'), digits)} ± {fmt(s.get('sd'), digits)} ({fmt(s.get('min'), digits)}–" \
+               f"{fmt(s.get('max'), digits)})" if s.get("n") else "—"
+
+    rows = [[f"**{n}**" if n == choice["chosen"] else n, ", ".join(r["candidates"][n]) or "(the config's default)",
+             f"{s['rows_on_diagonal']}/{s['cases']}", f"{s['meets_aims']}/{s['cases']}", sd(s["recognition"], 3),
+             *(sd(s[k]) for k in VARIATION), sd(s["skating_samples"]), sd(s["skating_real"]),
+             fmt(s["capped_log_variation"], 3), "yes" if choice["eligible"][n] else "no"]
+            for n, s in summary.items()]
+    cases = sorted({c for seed in r["per_seed"].values() for cand in seed.values() for c in cand["cases"]})
+    case_rows = []
+    for case in cases:
+        cells = []
+        for n in summary:
+            got = [seed[n]["cases"].get(case) for seed in r["per_seed"].values()]
+            cells.append(" / ".join(f"{'✓' if g['row_on_diagonal'] else '✗'} {fmt(g['recognition'], 2)} "
+                                    f"{fmt(g['v_sd'], 2)} {fmt(g['step_sd'], 2)} {fmt(g['diversity'], 2)}"
+                                    if g else "—" for g in got))
+        case_rows.append([case, *cells])
+    verdict = (f"the config's default ({default}) stays" if choice["chosen"] == default
+               else f"{choice['chosen']} is chosen over the config's {default}")
+    aims = ", ".join(f"{k} ≥ {v:g}" for k, v in r["aims"].items())
+    seeds = ", ".join(r["per_seed"])
+    return {"headline": (
+        f"{label}The style CVAE's Gram channels chosen on **validation** clips ({r['data']}, both walk stances, every "
+        f"style, the reproduction's budget, training seeds {seeds}: not reported seeds). Each candidate's "
+        f"reproduction evaluated with `evaluation.heldout_splits=[val]`: a style's ground truth is its train + val "
+        f"clips besides its example, the classifier is fitted on train clips; no test clip enters the rule. Per "
+        f"(seed, stance, style) case: Table 5.1 row on the diagonal, recognition, and V_SD, step_SD, diversity of "
+        f"the samples over the style's real clips (mean ± sd (min–max) over cases); issue 27's aims: row on the "
+        f"diagonal, {aims}. Rule: eligible when its rows on the diagonal are no fewer than the default's and its mean "
+        f"recognition is at least {fmt(choice['recognition_floor'], 3)} (min of 0.9 and the default's); then most "
+        f"cases meeting every aim, then the highest mean log of the three variation ratios capped at 1. Raw foot "
+        f"skating (share of contact foot-frames moving > 0.2 m/s; samples and the style's real clips) is shown, not "
+        f"ruled on. Chosen: **{choice['chosen']}**: {verdict}.\n\n"
+        + md_table(["candidate", "CVAE overrides", "rows on diagonal", "cases meeting every aim", "recognition",
+                    "V_SD / style", "step_SD / style", "diversity / style", "skating, samples", "skating, real",
+                    "mean capped log variation", "eligible"], rows)
+        + f"\n\n{provenance_line(record)}"),
+        "cases": (
+        f"{label}Per case, per seed ({seeds}, separated by /): Table 5.1 row on the diagonal (✓/✗), recognition, "
+        f"V_SD, step_SD and diversity over the style's real clips (validation protocol as in the headline).\n\n"
+        + md_table(["stance/style", *summary], case_rows) + f"\n\n{provenance_line(record)}")}
