@@ -15,7 +15,7 @@ method works. ``--data bandai`` runs Bandai dataset-2's walks (30–60 min per s
 from __future__ import annotations
 
 import argparse
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from concurrent.futures import ProcessPoolExecutor
 from multiprocessing import get_context
 from pathlib import Path
@@ -117,17 +117,18 @@ def reproduce_overrides(data: str, seed: int, out: Path, workers: int, primitive
 
 def reproduce_seed(data: str, seed: int, out: Path, workers: int, primitives: list[str] | None = None,
                    styles: list[str] | None = None, alpha: float | None = None, extra: Sequence[str] = (),
-                   cvae: Sequence[str] = ()) -> dict[str, Any]:
+                   stages: Mapping[str, Sequence[str]] | None = None) -> dict[str, Any]:
     """Run (or reuse) ``stylemotion-reproduce`` for ``seed`` into ``out``; returns its ``report.json``.
-    ``extra``: more ``reproduce`` overrides (e.g. ``evaluation.*``); ``cvae``: ``train`` overrides appended to the
-    CVAE stages' (``stages.cvae``)."""
+    ``extra``: more ``reproduce`` overrides (e.g. ``evaluation.*``); ``stages``: stage kind (``autoencoder``,
+    ``vae``, ``cvae``) → ``train`` overrides appended to that kind's (``stages.<kind>``)."""
     from hydra.core.global_hydra import GlobalHydra
 
     from stylemotion.io.jsonfile import read_json_object
     from stylemotion.training.reproduction import reproduce
 
     cfg = compose_reproduce([*reproduce_overrides(data, seed, out, workers, primitives, styles, alpha), *extra])
-    cfg.stages.cvae.extend(cvae)
+    for kind, overrides in (stages or {}).items():
+        cfg.stages[kind].extend(overrides)
     try:
         with progress_printed(f"[seed {seed}]"):
             reproduce(cfg)

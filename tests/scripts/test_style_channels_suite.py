@@ -81,3 +81,12 @@ def test_the_block_marks_the_choice_and_the_protocol() -> None:
     assert "`evaluation.heldout_splits=[val]`" in blocks["headline"] and "Not the full budget" not in \
         blocks["headline"]
     assert "| p/a | ✓ 0.95 0.20 0.50 0.50 | ✓ 0.95 0.60 0.50 0.50 |" in blocks["cases"]
+
+
+def test_a_tie_in_variation_goes_to_the_cheaper_candidate() -> None:
+    both = summaries(all=(["a", "b"], 0.95, 0.2), pose=(["a", "b"], 0.95, 0.6), cheap=(["a", "b"], 0.95, 0.58))
+    both["all"]["cvae_minutes"], both["pose"]["cvae_minutes"], both["cheap"]["cvae_minutes"] = 10.0, 25.0, 12.0
+    got = style_channels.choose(both)  # log 0.58 is within TIE of log 0.6 (mean over three ratios, two fixed)
+    assert got["tied"] == ["pose", "cheap"] and got["chosen"] == "cheap"
+    both["cheap"] = summaries(cheap=(["a", "b"], 0.95, 0.3))["cheap"] | {"cvae_minutes": 12.0}
+    assert style_channels.choose(both)["chosen"] == "pose"  # outside the tie band the variation decides
