@@ -195,7 +195,16 @@ def render(record: dict[str, Any]) -> dict[str, str]:
                else f"{choice['chosen']} is chosen over the config's {default}")
     aims = ", ".join(f"{k} ≥ {v:g}" for k, v in r["aims"].items())
     seeds = ", ".join(r["per_seed"])
-    return {"headline": (
+    line = "; ".join(f"{n} V_SD {fmt(s['v_sd'].get('mean'), 2)} / step_SD {fmt(s['step_sd'].get('mean'), 2)} / "
+                     f"diversity {fmt(s['diversity'].get('mean'), 2)} of the style's clips, recognized "
+                     f"{fmt(100 * (s['recognition'].get('mean') or 0), 0)} %, rows on the diagonal "
+                     f"{s['rows_on_diagonal']}/{s['cases']}, CVAE {fmt(s.get('cvae_minutes'), 1)} min a run"
+                     for n, s in summary.items())
+    return {"line": (
+        f"{label}The style CVAE's Gram channels chosen on **validation** clips ({r['data']}, both walk stances, every "
+        f"style, training seeds {seeds}; means over (seed, stance, style)): {line}. Chosen: **{choice['chosen']}**. "
+        f"Rule and per-case figures: benchmarks/evaluation.md. {provenance_line(record)}"),
+        "headline": (
         f"{label}The style CVAE's Gram channels chosen on **validation** clips ({r['data']}, both walk stances, every "
         f"style, the reproduction's budget, training seeds {seeds}: not reported seeds). Each candidate's "
         f"reproduction evaluated with `evaluation.heldout_splits=[val]`: a style's ground truth is its train + val "

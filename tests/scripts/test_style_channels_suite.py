@@ -81,6 +81,8 @@ def test_the_block_marks_the_choice_and_the_protocol() -> None:
     assert "`evaluation.heldout_splits=[val]`" in blocks["headline"] and "Not the full budget" not in \
         blocks["headline"]
     assert "| p/a | ✓ 0.95 0.20 0.50 0.50 | ✓ 0.95 0.60 0.50 0.50 |" in blocks["cases"]
+    assert "pose V_SD 0.60 / step_SD 0.50 / diversity 0.50 of the style's clips, recognized 95 %, rows on the " \
+           "diagonal 2/2" in blocks["line"] and "Chosen: **pose**." in blocks["line"]
 
 
 def test_a_tie_in_variation_goes_to_the_cheaper_candidate() -> None:
