@@ -18,10 +18,15 @@ STAGE = ["experiment=style_cvae", "trainer.max_epochs=60", "model.samples_per_it
 
 def test_each_arm_changes_only_its_own_values() -> None:
     ours = style_thesis.arm_overrides(STAGE, "ours", 15)
+    # ours pins the Gram over every channel, as the suite measured it (the commands' default became pose-only)
     assert ours == ["experiment=style_cvae", "model.samples_per_item=10", "callbacks.checkpoint_last.every_n_epochs=1",
-                    "model.style_weight=5.0", "trainer.max_epochs=15", "callbacks.samples=null"]
+                    "model.style_weight=5.0", "trainer.max_epochs=15", "callbacks.samples=null",
+                    "model.style_channels=all", "model.style_subset=0"]
     assert style_thesis.arm_overrides(STAGE, "alpha200", 15) == [*ours[:3], "trainer.max_epochs=15",
-                                                                 "callbacks.samples=null", "model.style_weight=200.0"]
+                                                                 "callbacks.samples=null", "model.style_channels=all",
+                                                                 "model.style_subset=0", "model.style_weight=200.0"]
+    pose = style_thesis.arm_overrides(STAGE, "pose_gram", 15)
+    assert pose[-2:] == ["model.style_channels=pose", "model.style_subset=128"]
     assert style_thesis.arm_overrides(STAGE, "lr1e-5", 15) == [*ours, "model.lr=1e-05"]
     # the preset brings its own α (200): the stage's α of our preset is not passed on
     thesis = style_thesis.arm_overrides(STAGE, "thesis", 15)

@@ -68,17 +68,24 @@ def test_sample_metrics_read_the_samples_style_distance_not_the_logged_one() -> 
 
 
 def test_prior_sample_figures_against_a_direct_gram_distance(tiny_run) -> None:
-    """``samples/style`` of a style CVAE is the mean ‖FFᵀ/T − G_example‖_F of its seeded prior samples' features,
-    recomputed here with numpy from the checkpoint's own target Gram; a plain VAE has no style figure."""
+    """``samples/style`` of a style CVAE is the mean ‖FFᵀ/T − G_example‖_F of its seeded prior samples' features (the
+    pose-only features its term sees), recomputed here with numpy from the checkpoint's own target Gram; a plain VAE
+    has no style figure."""
     import numpy as np
+    import torch
 
+    from stylemotion.models.cvae import pose_features
     from stylemotion.models.loading import load_generative
     from stylemotion.training.style_weight import prior_sample_figures, prior_sample_spread
 
     cvae = next(p for p in sorted((tiny_run.folder / "cvae").rglob("best.ckpt")))
     figures = prior_sample_figures(cvae, samples=32, seed=3)
     model = load_generative(cvae)
-    features = model.sample(32, seed=3).features.numpy().astype(np.float64)
+    drawn = model.sample(32, seed=3).features
+    # the commands' default Gram sees pose channels only (suite style_channels): the same features the term sees
+    assert model.style_channels == "pose"
+    with torch.no_grad():
+        features = pose_features(model.autoencoder, drawn).numpy().astype(np.float64)
     grams = features @ features.transpose(0, 2, 1) / features.shape[-1]
     target = model.style_gram.numpy().astype(np.float64)
     expected = np.linalg.norm(grams - target, axis=(1, 2)).mean()
