@@ -7,6 +7,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 import numpy as np
+import torch
 from sklearn.decomposition import PCA
 from sklearn.linear_model import LogisticRegression
 from sklearn.preprocessing import StandardScaler
@@ -34,3 +35,18 @@ def hand_share(train_clips: Sequence, length: int, frames: np.ndarray, duration_
                                                                                labels)
     predicted = regression.predict(pca.transform(scaler.transform(descriptors(frames, duration_s))))
     return float((predicted == style).mean())
+
+
+def example_gram(judge, data, model) -> torch.Tensor:
+    """Table 5.1's column of a style model, by hand: the mean of ``F Fᵀ / T`` over the judge autoencoder's features
+    ``F`` of the model's example clip(s) (found in ``data``, a :class:`~stylemotion.evaluation.reference.
+    PrimitiveData`), resampled to the length the model recorded for them. The column is this plain Gram whatever
+    the model's own style term saw (e.g. the pose-only Gram of the commands' default)."""
+    clips = [data.find_example(record) for record in model.examples]
+    grams = []
+    for clip, record in zip(clips, model.examples):
+        frames = time_normalize(clip.frames, int(record.get("encoded_frames") or model.timeline_frames))
+        with torch.no_grad():
+            features = judge.encode(torch.from_numpy(np.asarray(frames))[None].float())[0]
+        grams.append(features @ features.T / features.shape[-1])
+    return torch.stack(grams).mean(0)
