@@ -44,15 +44,10 @@ CHANNELS_RESULTS = style.ROOT / "benchmarks" / "results" / "style_channels.json"
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--data", choices=sorted(style.DATA), default="bandai",
-                        help="bandai: dataset-2 walks; synthetic: a smoke run of the suite only")
-    parser.add_argument("--runs", type=Path, default=style.ROOT / "runs" / "benchmarks" / "style_channels",
-                        help="suite style_channels' run folder (its chosen candidate's runs are the off arm)")
-    parser.add_argument("--workers", type=int, default=2, help="training stages at once (the reproduction's workers)")
+    style_channels.run_arguments(parser, "suite style_channels' run folder (its chosen candidate's runs are the off "
+                                         "arm)")
     parser.add_argument("--base", default=None, metavar="CANDIDATE",
                         help="suite style_channels' candidate both arms build on (default: its recorded choice)")
-    parser.add_argument("--override", nargs="*", default=[], metavar="KEY=VALUE",
-                        help="more reproduce overrides for both arms (e.g. budget.* for a smoke run)")
 
 
 def chosen_channels(path: Path = CHANNELS_RESULTS) -> str:

@@ -49,16 +49,22 @@ VARIATION = ("v_sd", "step_sd", "diversity")
 SHARED_STAGES = ("autoencoder", "vae")
 
 
-def add_arguments(parser: argparse.ArgumentParser) -> None:
+def run_arguments(parser: argparse.ArgumentParser, runs_help: str) -> None:
+    """``--data``, ``--runs``, ``--workers`` and ``--override``: the options of a suite that runs whole reproductions
+    on validation clips (this one, suite ``contact_full``)."""
     parser.add_argument("--data", choices=sorted(style.DATA), default="bandai",
                         help="bandai: dataset-2 walks; synthetic: a smoke run of the suite only")
     parser.add_argument("--runs", type=Path, default=style.ROOT / "runs" / "benchmarks" / "style_channels",
-                        help="folder of the candidates' reproduction runs (reused and resumed)")
+                        help=runs_help)
     parser.add_argument("--workers", type=int, default=2, help="training stages at once (the reproduction's workers)")
+    parser.add_argument("--override", nargs="*", default=[], metavar="KEY=VALUE",
+                        help="more reproduce overrides for every run (e.g. budget.* for a smoke run)")
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    run_arguments(parser, "folder of the candidates' reproduction runs (reused and resumed)")
     parser.add_argument("--candidates", nargs="+", choices=sorted(CANDIDATES), default=list(CANDIDATES),
                         help="candidates; the first is the reference of the rule (default: all three)")
-    parser.add_argument("--override", nargs="*", default=[], metavar="KEY=VALUE",
-                        help="more reproduce overrides for every candidate (e.g. budget.* for a smoke run)")
 
 
 def case_figures(report: dict[str, Any], styles: list[str]) -> dict[str, dict[str, Any]]:
