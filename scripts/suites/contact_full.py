@@ -94,9 +94,14 @@ def choose(summaries: dict[str, dict[str, Any]]) -> dict[str, Any]:
     """The module doc's rule: ``contact`` against ``off``; returns each test and the choice."""
     off, on = summaries["off"], summaries["contact"]
     eligible = style_channels.choose({"off": off["styled"], "contact": on["styled"]})["eligible"]["contact"]
-    tests = {"neutral_skates_less": on["neutral_skating_relative"]["mean"] < off["neutral_skating_relative"]["mean"],
+    def means(key: str) -> tuple[float, float] | None:  # None: an arm without the figure (its feet never plant)
+        pair = (on[key].get("mean"), off[key].get("mean"))
+        return None if None in pair else pair
+
+    neutral, styled = means("neutral_skating_relative"), means("styled_skating_relative")
+    tests = {"neutral_skates_less": neutral is not None and neutral[0] < neutral[1],
              "styled_eligible": eligible,
-             "styled_skate_no_more": on["styled_skating_relative"]["mean"] <= off["styled_skating_relative"]["mean"]}
+             "styled_skate_no_more": styled is not None and styled[0] <= styled[1]}
     return {"tests": tests, "chosen": "contact" if all(tests.values()) else "off"}
 
 

@@ -70,3 +70,10 @@ def test_the_block_states_the_verdict() -> None:
     assert "the weights of the narrowed run are **adopted**" in text
     assert "| **contact** | autoencoder: model.contact_weight=0.1; vae: model.contact_weight=100; cvae: " \
            "model.contact_weight=0 | 15.0 ± 0.0 (15.0–15.0) | 10.0 ± 0.0 (10.0–10.0) | 1.50 ± 0.00" in text
+
+
+def test_an_arm_whose_samples_never_plant_is_not_adopted() -> None:
+    never = report(0.3, 0.2)
+    never["foot_skating_detail"]["p"]["neutral"]["samples"]["ratio"] = None  # no contact frame in any sample
+    got = choice(report(0.3, 0.2), never)
+    assert got["tests"]["neutral_skates_less"] is False and got["chosen"] == "off"
