@@ -137,6 +137,12 @@ def reproduce_seed(data: str, seed: int, out: Path, workers: int, primitives: li
     return read_json_object(out / "report" / "report.json", "the reproduction's report", "rerun the suite")
 
 
+def stage_minutes(stages: Sequence[Mapping[str, Any]], kind: str | None = None) -> float:
+    """Training minutes summed over a reproduction's recorded stages (``reproduce.json``'s ``stages``), of one
+    ``kind`` (``autoencoder``, ``vae``, ``cvae``) or all; a reused stage counts the seconds it took when trained."""
+    return sum(float(st.get("seconds") or 0) for st in stages if kind is None or st.get("kind") == kind) / 60
+
+
 def train_candidate(container: dict[str, Any], folder: str) -> dict[str, float]:
     """Train one α candidate (a resolved ``train`` config) into ``folder``, or reuse its recorded result; returns
     its validation metrics at the best ``val/loss`` epoch (``metrics.json``'s ``val``). Runs in a worker process."""
@@ -310,7 +316,7 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
         per_seed[str(seed)] = seed_figures(report) | {
             "run": str(out.relative_to(ROOT) if out.is_relative_to(ROOT) else out),
             # training time of the stages (also when an earlier command trained them and this one reused them)
-            "stage_minutes": round(sum(float(st.get("seconds") or 0) for st in stages) / 60, 1),
+            "stage_minutes": round(stage_minutes(stages), 1),
             "stage_status": sorted({str(st.get("status")) for st in stages})}
     first = next(iter(per_seed.values()))
     primitives = list(first["primitives"])

@@ -152,8 +152,7 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
             stages = read_json_object(out / "reproduce.json", "the reproduction's summary", "rerun the suite")["stages"]
             per_seed.setdefault(str(seed), {})[name] = {
                 "run": str(out.relative_to(style.ROOT) if out.is_relative_to(style.ROOT) else out),
-                "cvae_minutes": round(sum(float(st.get("seconds") or 0) for st in stages
-                                          if st.get("kind") == "cvae") / 60, 2),
+                "cvae_minutes": round(style.stage_minutes(stages, "cvae"), 2),
                 "shared_from_first": copied, "heldout_splits": report["meta"]["settings"]["heldout_splits"],
                 "cases": case_figures(report, styles)}
             first = first or out
