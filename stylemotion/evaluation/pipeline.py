@@ -627,7 +627,7 @@ def shift_baselines(real: RealSide, autoencoder) -> dict[str, ShiftBaseline]:
 def _frechet_reference(real: RealSide, model: EvalModel, f_truth: np.ndarray,
                        neutral_features: np.ndarray | None) -> dict[str, Any]:
     """Neutral-model samples against the same ground truth, and the real-vs-real floor (train-split
-    clips of the style against its val+test clips, examples left out)."""
+    clips of the style against its held-out clips, examples left out)."""
     ref: dict[str, Any] = {"ground_truth_clips": len(f_truth)}
     if neutral_features is not None:
         ref["neutral_samples"] = frechet_distance(neutral_features, f_truth)
