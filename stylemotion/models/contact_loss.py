@@ -29,6 +29,11 @@ The feature models (VAE, CVAE, zero-shot) decode their reconstructions through t
 rate is each clip's playback rate ``(L − 1) / duration`` (:func:`stylemotion.primitives.segmentation.playback_fps`);
 the real clip's contacts, detected on its recorded frames, are carried to that timeline by
 :func:`timeline_contacts`.
+
+Generated motion has no real clip. For the style CVAE's draws (``sample_contact_weight``) the contacts are
+those the detector finds on the *decoded* motion itself (:func:`own_contacts`, not differentiated): the term
+then asks the feet the motion plants to stay still, wherever it plants them, so it does not pull the
+draws' step timing towards the neutral content clips (as the term on the content clips' reconstructions does).
 """
 
 from __future__ import annotations
@@ -40,7 +45,7 @@ from stylemotion.primitives.contacts import foot_contacts
 from stylemotion.representation import frames_to_positions
 from stylemotion.skeleton import FOOT_POINTS
 
-__all__ = ["contact_velocity_loss", "planted_speed_squared", "timeline_contacts", "window_contacts"]
+__all__ = ["contact_velocity_loss", "own_contacts", "planted_speed_squared", "timeline_contacts", "window_contacts"]
 
 
 def planted_speed_squared(frames: torch.Tensor, fps: float | torch.Tensor) -> torch.Tensor:
@@ -128,3 +133,24 @@ def timeline_contacts(positions: torch.Tensor, num_frames: torch.Tensor, fps: fl
         contact = foot_contacts(p[rows, :count], fps)  # (k, count, 2)
         out[rows] = contact[:, np.rint(grid * (count - 1)).astype(np.int64)]
     return torch.from_numpy(out).to(positions.device)
+
+
+def own_contacts(frames: torch.Tensor, fps: torch.Tensor) -> torch.Tensor:
+    """Contacts of decoded (generated) motions detected on themselves by
+    :func:`~stylemotion.primitives.contacts.foot_contacts` (resting heights estimated per motion).
+
+    Args:
+        frames: ``(n, T, 66)`` raw frames, ``T ≥ 2`` (not differentiated).
+        fps: ``(n,)`` frames per second of each motion (e.g. its playback rate).
+
+    Returns:
+        ``(n, T, 2)`` bool on ``frames``' device.
+    """
+    rate = fps.detach().double().cpu().reshape(-1)
+    if len(rate) != frames.shape[0]:
+        raise ValueError(f"fps must hold one rate per motion ({frames.shape[0]}), got {len(rate)}")
+    positions = frames_to_positions(frames.detach().double().cpu(), rate[:, None]).numpy()
+    out = np.zeros(frames.shape[:-1] + (2,), dtype=bool)
+    for i, (motion, motion_fps) in enumerate(zip(positions, rate.tolist())):  # the speed thresholds are per second
+        out[i] = foot_contacts(motion, motion_fps)
+    return torch.from_numpy(out).to(frames.device)

@@ -40,6 +40,13 @@ their data mean, encoded again), which frees speed and turning from the example;
 per style decode, so ``style_subset`` = k > 0 takes the style term's mean over a random k of the decodes of each
 step (an unbiased estimate of the same mean; 0 = all).
 
+Planted feet in the draws (issue 27 item 1; off by default): ``sample_contact_weight`` = β > 0 adds
+β · the foot-contact velocity loss of the style term's decodes (the same draws, decoded by the frozen autoencoder
+on the primitive's timeline at each draw's own duration), with the contacts the detector finds on each draw itself
+(:func:`~stylemotion.models.contact_loss.own_contacts`): the feet a styled draw plants must stay still, wherever it
+plants them. The PrimitiveVAE's ``contact_weight`` instead holds the reconstructions of the neutral content clips to
+the content clips' contacts, which pulls the draws' steps towards neutral ones (suite ``contact_loss``).
+
 One model per (primitive, style). The style, the example clip(s) (take, frame range, primitive,
 duration) and how they were encoded are recorded in ``hparams.spec``; the target Gram matrix is a
 buffer, so the checkpoint is self-contained.
@@ -52,6 +59,7 @@ from typing import Any
 import torch
 
 from stylemotion.models.autoencoder import IncompatibleModelError
+from stylemotion.models.contact_loss import contact_velocity_loss, own_contacts
 from stylemotion.models.style import GRAM_NORMALIZATIONS, feature_style_distance, gram_factor, mean_gram
 from stylemotion.models.vae import PrimitiveVAE
 from stylemotion.representation import VELOCITY_DIMS, YAW_RATE_DIM
@@ -75,12 +83,14 @@ class StyleCVAE(PrimitiveVAE):
         gram_normalization: ``mean`` (÷ T) or ``sum`` (eq. 5.9 as written).
         style_channels: ``all`` or ``pose`` (root velocity and yaw rate left out, :func:`pose_features`).
         style_subset: the style term's mean over a random this many decodes per step (0 = all).
+        sample_contact_weight: β of the draws' foot-contact velocity loss (m²/s²; 0 = off; see the module doc).
         **kwargs: :class:`PrimitiveVAE` arguments.
     """
 
     def __init__(self, style_weight: float = 5.0, style_latents: str = "prior", style_term: str = "distance",
                  style_margin: float = 1.0, style_centred: bool = False, gram_normalization: str = "mean",
-                 style_channels: str = "all", style_subset: int = 0, **kwargs: Any):
+                 style_channels: str = "all", style_subset: int = 0, sample_contact_weight: float = 0.0,
+                 **kwargs: Any):
         super().__init__(**kwargs)
         if not style_weight >= 0:
             raise ValueError(f"style_weight must be ≥ 0, got {style_weight}")
@@ -96,11 +106,14 @@ class StyleCVAE(PrimitiveVAE):
             raise ValueError(f"style_channels must be one of {STYLE_CHANNELS}, got {style_channels!r}")
         if isinstance(style_subset, bool) or int(style_subset) != style_subset or style_subset < 0:
             raise ValueError(f"style_subset must be an integer ≥ 0 (0 = every decode), got {style_subset!r}")
+        if not sample_contact_weight >= 0:
+            raise ValueError(f"sample_contact_weight must be ≥ 0, got {sample_contact_weight}")
         self.save_hyperparameters({**dict(self.hparams), "style_weight": float(style_weight),
                                    "style_latents": str(style_latents), "style_term": str(style_term),
                                    "style_margin": float(style_margin), "style_centred": bool(style_centred),
                                    "gram_normalization": str(gram_normalization),
-                                   "style_channels": str(style_channels), "style_subset": int(style_subset)})
+                                   "style_channels": str(style_channels), "style_subset": int(style_subset),
+                                   "sample_contact_weight": float(sample_contact_weight)})
 
     def _build(self, spec: dict[str, Any]) -> None:
         super()._build(spec)
@@ -200,12 +213,32 @@ class StyleCVAE(PrimitiveVAE):
         subset = int(self.hparams.get("style_subset", 0))
         if 0 < subset < decoded.shape[0]:  # a random subset of the decodes (module doc)
             decoded = decoded[torch.randperm(decoded.shape[0], generator=generator, device=decoded.device)[:subset]]
-        features, _ = self.denormalize(decoded, clamp=False)
+        features, duration = self.denormalize(decoded)  # the clamp acts on the duration only
         distance = self.style_distance(features)
         if self.hparams.style_term == "margin":  # the distance is logged, the excess optimized
-            return {"style": (distance.mean(), 0.0),
-                    "style_excess": (margin_excess(distance, self.style_radius), self.hparams.style_weight)}
-        return {"style": (distance.mean(), self.hparams.style_weight)}
+            terms = {"style": (distance.mean(), 0.0),
+                     "style_excess": (margin_excess(distance, self.style_radius), self.hparams.style_weight)}
+        else:
+            terms = {"style": (distance.mean(), self.hparams.style_weight)}
+        weight = float(self.hparams.get("sample_contact_weight", 0.0))
+        if weight > 0:
+            terms["sample_contact"] = (self.sample_contact_term(features, duration), weight)
+        return terms
+
+    def sample_contact_term(self, features: torch.Tensor, duration_s: torch.Tensor) -> torch.Tensor:
+        """The foot-contact velocity loss of draws on their own contacts (module doc).
+
+        Args:
+            features: ``(n, C, T')`` raw features of decoded draws (differentiable).
+            duration_s: ``(n,)`` their decoded durations, seconds (not differentiated).
+
+        Returns:
+            Scalar, m²/s² (:func:`~stylemotion.models.contact_loss.contact_velocity_loss`).
+        """
+        length = self.timeline_frames
+        frames = self.autoencoder.decode(features, length).float()  # (n, L, 66)
+        rate = (length - 1) / duration_s.detach().to(frames)  # playback fps of the timeline
+        return contact_velocity_loss(frames, own_contacts(frames, rate), rate)
 
 
 def content_spread(features: torch.Tensor, normalization: str = "mean") -> float:

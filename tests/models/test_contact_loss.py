@@ -20,10 +20,12 @@ from stylemotion.datamodules import MotionWindowDataModule
 from stylemotion.models.autoencoder import ConvAutoencoder, MotionAutoencoder
 from stylemotion.models.contact_loss import (
     contact_velocity_loss,
+    own_contacts,
     planted_speed_squared,
     timeline_contacts,
     window_contacts,
 )
+from stylemotion.models.cvae import StyleCVAE
 from stylemotion.models.vae import PrimitiveVAE
 from stylemotion.primitives.contacts import foot_contacts
 from stylemotion.representation import FRAME_DIM, VELOCITY_DIMS, frames_to_positions, positions_to_frames
@@ -120,6 +122,50 @@ def test_contacts_are_those_of_the_detector_carried_to_the_timeline() -> None:
     assert np.array_equal(window_contacts(torch.as_tensor(frames[None]), FPS)[0].numpy(), foot_contacts(back, FPS))
 
 
+def test_own_contacts_are_the_detectors_on_each_decoded_motion_at_its_own_rate() -> None:
+    positions = tiny_takeset().takes[0].positions[:40]
+    frames, _, _ = positions_to_frames(positions, FPS)
+    back = frames_to_positions(frames, FPS)
+    pair = torch.as_tensor(np.stack([frames, frames]))
+    got = own_contacts(pair, torch.tensor([FPS, 2 * FPS]))
+    assert got.shape == (2, 40, 2) and got.dtype == torch.bool
+    assert np.array_equal(got[0].numpy(), foot_contacts(back, FPS))
+    # the same frames read at twice the rate: the root travels and the feet move twice as fast per second
+    assert np.array_equal(got[1].numpy(), foot_contacts(frames_to_positions(frames, 2 * FPS), 2 * FPS))
+    assert not np.array_equal(got[0].numpy(), got[1].numpy())
+    with pytest.raises(ValueError, match="one rate per motion"):
+        own_contacts(pair, torch.tensor([FPS]))
+
+
+def test_the_cvae_draws_contact_term_holds_their_own_planted_feet(ae_ckpt) -> None:
+    """sample_contact_weight: the term is the contact velocity loss of the style term's decodes on their own
+    contacts at their own durations, weighted by β; its gradient reaches the decoder, not the autoencoder."""
+    dm = feature_module(ae_ckpt, style="elderly")
+    pl.seed_everything(0, verbose=False)
+    model = StyleCVAE(samples_per_item=2, style_latents="prior", sample_contact_weight=3.0)
+    fit(model, dm, steps=100)  # until the draws plant their feet (untrained ones never do)
+    model.train()
+    y = model.normalize(dm.datasets["train"].features[:4], dm.datasets["train"].duration_s[:4])[None]
+    terms = model._extra_losses(y.repeat(2, 1, 1), torch.Generator().manual_seed(5))
+    value, weight = terms["sample_contact"]
+    assert weight == 3.0 and float(value.detach()) > 0
+    # by hand: the same 8 prior draws, decoded at their own durations, on their own contacts
+    z = torch.randn(8, model.hparams.latent_dim, generator=torch.Generator().manual_seed(5))
+    features, duration = model.denormalize(model.net.decode(z))
+    length = model.timeline_frames
+    frames = model.autoencoder.decode(features, length).float()
+    rate = (length - 1) / duration
+    expected = contact_velocity_loss(frames, own_contacts(frames, rate), rate)
+    torch.testing.assert_close(value, expected, rtol=1e-4, atol=1e-7)
+    grad, = torch.autograd.grad(value, model.net.decoder[-1].weight)
+    assert float(grad.abs().sum()) > 0
+    assert all(p.grad is None for p in model.autoencoder.parameters())
+    model.hparams.sample_contact_weight = 0.0
+    assert "sample_contact" not in model._extra_losses(y.repeat(2, 1, 1))
+    with pytest.raises(ValueError, match="sample_contact_weight"):
+        StyleCVAE(sample_contact_weight=-1.0)
+
+
 def test_the_gradient_reaches_the_decoder_not_only_the_output() -> None:
     torch.manual_seed(0)
     net = ConvAutoencoder(hidden_units=8)
@@ -167,6 +213,15 @@ def test_contact_weight_flows_from_each_models_config(experiment: str, target: s
     assert type(model).__name__ == target and model.hparams.contact_weight == 7.0
 
 
+def test_the_draws_contact_weight_flows_from_the_cvae_config() -> None:
+    base = ["experiment=style_cvae", "autoencoder_ckpt=x"]
+    with initialize_config_dir(config_dir(), version_base="1.3"):
+        default = compose("train", overrides=base)
+        set_ = compose("train", overrides=[*base, "model.sample_contact_weight=7"])
+    assert default.model.sample_contact_weight == 0.0
+    assert instantiate(set_.model, _convert_="all").hparams.sample_contact_weight == 7.0
+
+
 def decoded_contact_speed_vae(ae_ckpt: Path, weight: float, folder: Path) -> float:
     """val/contact (m²/s²) of a VAE trained for a few epochs on the tiny data with ``contact_weight`` = weight."""
     dm = feature_module(ae_ckpt)
@@ -199,3 +254,23 @@ def test_training_with_the_contact_weight_slows_the_decoded_contact_feet_autoenc
     plain = decoded_contact_speed_autoencoder(0.0)
     held = decoded_contact_speed_autoencoder(1.0)
     assert held < 0.7 * plain, (plain, held)
+
+
+def draws_contact_and_style(ae_ckpt: Path, weight: float) -> tuple[float, float]:
+    """The draws' own-contact term (m²/s²) and mean style distance of 64 prior draws of a CVAE trained for 150
+    steps on the tiny data with ``sample_contact_weight`` = weight."""
+    dm = feature_module(ae_ckpt, style="elderly")
+    pl.seed_everything(0, verbose=False)
+    model = StyleCVAE(samples_per_item=2, style_weight=20.0, sample_contact_weight=weight)
+    fit(model, dm, steps=150)
+    z = torch.randn(64, model.hparams.latent_dim, generator=torch.Generator().manual_seed(5))
+    with torch.no_grad():
+        features, duration = model.denormalize(model.net.decode(z))
+        return float(model.sample_contact_term(features, duration)), float(model.style_distance(features).mean())
+
+
+def test_training_with_the_draws_contact_weight_slows_their_planted_feet_and_keeps_the_style(ae_ckpt) -> None:
+    plain_contact, plain_style = draws_contact_and_style(ae_ckpt, 0.0)
+    held_contact, held_style = draws_contact_and_style(ae_ckpt, 30.0)
+    assert held_contact < 0.5 * plain_contact, (plain_contact, held_contact)
+    assert held_style < 1.2 * plain_style, (plain_style, held_style)
