@@ -131,14 +131,7 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
 def render(record: dict[str, Any]) -> dict[str, str]:
     r = record["results"]
     choice = r["choice"]
-    label = "**Synthetic data: a smoke run of the suite, not evidence.** " if r["data"] == "synthetic" else ""
-    if r.get("overrides"):
-        label += f"**Not the full budget: overrides {', '.join(r['overrides'])}.** "
-
-    def sd(s: dict[str, Any], digits: int = 2, scale: float = 1.0) -> str:
-        return (f"{fmt(scale * s['mean'], digits)} ± {fmt(scale * s['sd'], digits)} ({fmt(scale * s['min'], digits)}–"
-                f"{fmt(scale * s['max'], digits)})") if s.get("n") else "—"
-
+    label, sd = contact_full.run_label(r), contact_full.sd
     rows = []
     for name, s in r["summary"].items():
         st = s["styled"]

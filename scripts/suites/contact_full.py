@@ -145,16 +145,23 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
             "per_seed": per_seed, "summary": summaries, "choice": choose(summaries)}
 
 
+def run_label(results: dict[str, Any]) -> str:
+    """The bold warning a block of a synthetic or narrowed run opens with (empty for a full Bandai run)."""
+    label = "**Synthetic data: a smoke run of the suite, not evidence.** " if results["data"] == "synthetic" else ""
+    if results.get("overrides"):
+        label += f"**Not the full budget: overrides {', '.join(results['overrides'])}.** "
+    return label
+
+
+def sd(s: dict[str, Any], digits: int = 2, scale: float = 1.0) -> str:
+    """A spread as ``mean ± sd (min–max)``, each × ``scale``; ``—`` when empty."""
+    return (f"{fmt(scale * s['mean'], digits)} ± {fmt(scale * s['sd'], digits)} ({fmt(scale * s['min'], digits)}–"
+            f"{fmt(scale * s['max'], digits)})") if s.get("n") else "—"
+
+
 def render(record: dict[str, Any]) -> dict[str, str]:
     r = record["results"]
-    label = "**Synthetic data: a smoke run of the suite, not evidence.** " if r["data"] == "synthetic" else ""
-    if r.get("overrides"):
-        label += f"**Not the full budget: overrides {', '.join(r['overrides'])}.** "
-
-    def sd(s: dict[str, Any], digits: int = 2, scale: float = 1.0) -> str:
-        return (f"{fmt(scale * s['mean'], digits)} ± {fmt(scale * s['sd'], digits)} ({fmt(scale * s['min'], digits)}–"
-                f"{fmt(scale * s['max'], digits)})") if s.get("n") else "—"
-
+    label = run_label(r)
     rows = []
     for arm, s in r["summary"].items():
         st = s["styled"]
