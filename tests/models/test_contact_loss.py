@@ -200,15 +200,17 @@ def test_the_vae_contact_term_reaches_its_decoder_and_leaves_the_autoencoder_fro
     assert float(with_term["loss"] - without["loss"]) == pytest.approx(5.0 * float(with_term["contact"]), rel=1e-4)
 
 
-@pytest.mark.parametrize(("experiment", "target"), [("autoencoder", "MotionAutoencoder"),
-                                                    ("primitive_vae", "PrimitiveVAE"),
-                                                    ("style_cvae", "StyleCVAE"), ("zero_shot", "ZeroShotStyleVAE")])
-def test_contact_weight_flows_from_each_models_config(experiment: str, target: str) -> None:
+@pytest.mark.parametrize(("experiment", "target", "default_weight"), [("autoencoder", "MotionAutoencoder", 0.1),
+                                                               ("primitive_vae", "PrimitiveVAE", 100.0),
+                                                               ("style_cvae", "StyleCVAE", 0.0),
+                                                               ("zero_shot", "ZeroShotStyleVAE", 0.0)])
+def test_contact_weight_flows_from_each_models_config(experiment: str, target: str, default_weight: float) -> None:
+    """The configs' defaults are the weights suite contact_full confirmed (the CVAE and the zero-shot network 0)."""
     base = [f"experiment={experiment}"] + ([] if experiment == "autoencoder" else ["autoencoder_ckpt=x"])
     with initialize_config_dir(config_dir(), version_base="1.3"):
         default = compose("train", overrides=base)
         set_ = compose("train", overrides=[*base, "model.contact_weight=7"])
-    assert default.model.contact_weight == 0.0
+    assert default.model.contact_weight == default_weight
     model = instantiate(set_.model, _convert_="all")
     assert type(model).__name__ == target and model.hparams.contact_weight == 7.0
 
