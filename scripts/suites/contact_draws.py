@@ -30,7 +30,7 @@ from suites.common import fmt, md_table, provenance_line, spread
 DESCRIPTION = ("the style CVAE's draws' own-contact loss weight chosen at full budget on Bandai validation clips of "
                "every style (raw skating of styled samples against the style's real clips)")
 DEFAULT_SEEDS = (100, 101)
-DEFAULT_WEIGHTS = (10.0, 100.0)
+DEFAULT_WEIGHTS = (100.0, 1000.0)
 CONTACT_RESULTS = style.ROOT / "benchmarks" / "results" / "contact_full.json"
 
 
