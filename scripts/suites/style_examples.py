@@ -142,25 +142,29 @@ def variation_figures(real, motions) -> dict[str, float]:
     return {**{k: float(stats[k]) for k in VARIATION[:-1]}, "diversity": diversity(real.features(motions))}
 
 
+def curve_start(judge: Judge, primitive: str, style: str) -> tuple[Any, dict[str, float], list, dict[str, Any]]:
+    """``(truth features, held-out figures, train-split clips, the curve's header)`` of one style: what every k of
+    its curve is measured against and drawn from."""
+    from stylemotion.evaluation.sources import motions_from_clips
+
+    real, _, _ = judge.side(primitive)
+    heldout = motions_from_clips(real.data.heldout(style), real.length)
+    reference = variation_figures(real, heldout)
+    train = real.data.split("train", style)
+    return (real.features(real.truth[style]), reference, train,
+            {"train_clips": len(train), "heldout_clips": len(heldout.num_frames), "real": reference, "ks": {}})
+
+
 def style_curve(judge: Judge, network, primitive: str, style: str, ks: list[int], samples: int,
                 seed: int, poolings: tuple[str, ...] = ("mean",)) -> dict[str, Any]:
     """The curve of one left-out network: per k its recognition, Table 5.1 row and variation (and shares of the
     held-out real clips'), and the held-out real clips' figures."""
     from stylemotion.datamodules.features import describe_clip
-    from stylemotion.evaluation.pipeline import recognition
-    from stylemotion.evaluation.sources import motions_from_clips
-    from stylemotion.evaluation.zero_shot import _table_row, generator_autoencoder
+    from stylemotion.evaluation.zero_shot import generator_autoencoder
     from stylemotion.models.loading import EvalModel
 
-    real, columns, grams = judge.side(primitive)
-    settings = judge.source.settings
     generator_autoencoder(network)  # it decodes with the autoencoder it was trained on
-    heldout = motions_from_clips(real.data.heldout(style), real.length)
-    reference = variation_figures(real, heldout)
-    truth = real.features(real.truth[style])
-    train = real.data.split("train", style)
-    out: dict[str, Any] = {"train_clips": len(train), "heldout_clips": len(heldout.num_frames), "real": reference,
-                           "ks": {}}
+    truth, reference, train, out = curve_start(judge, primitive, style)
     draws = draw_examples(train, ks, seed, primitive, style)
     for label in row_labels(list(draws), list(poolings)):
         k, pooling = int(label.split()[0]), (label.split()[1:] or ["mean"])[0]
@@ -170,16 +174,25 @@ def style_curve(judge: Judge, network, primitive: str, style: str, ks: list[int]
         model = EvalModel(f"zero_shot:{style}", primitive, style, bound, records, dict(network.spec["autoencoder"]),
                           network.checkpoint_file, network.timeline_frames, bound.target_gram,
                           network.spec.get("dataset"), "canonical")
-        drawn = bound.sample(samples, seed=seed)
-        judged = recognition(real, model, real.features(drawn), truth)
-        row = _table_row(judge.autoencoder, drawn.normalized_frames, style, columns, grams, settings)
-        figures = variation_figures(real, drawn)
-        out["ks"][label] = {
-            "recognition": judged.share, "own_column_is_minimum": bool(row["own_column_is_minimum"]),
+        out["ks"][label] = judged_samples(judge, model, bound.sample(samples, seed=seed), truth, reference, records)
+    return out
+
+
+def judged_samples(judge: Judge, model, drawn, truth, reference: dict[str, float],
+                   records: list[dict[str, Any]]) -> dict[str, Any]:
+    """One curve point: the judge's recognition of ``drawn`` (samples of ``model``) as its style, their Table 5.1
+    row, their variation and its share of the held-out real clips' (``reference``), and the example clips."""
+    from stylemotion.evaluation.pipeline import recognition
+    from stylemotion.evaluation.zero_shot import _table_row
+
+    real, columns, grams = judge.side(model.primitive)
+    judged = recognition(real, model, real.features(drawn), truth)
+    row = _table_row(judge.autoencoder, drawn.normalized_frames, model.style, columns, grams, judge.source.settings)
+    figures = variation_figures(real, drawn)
+    return {"recognition": judged.share, "own_column_is_minimum": bool(row["own_column_is_minimum"]),
             "nearest_column": row["nearest_column"], "table_5_1_row": row["table_5_1_row"], **figures,
             "vs_real": {m: figures[m] / reference[m] if reference[m] else None for m in VARIATION},
             "examples": [{k_: r[k_] for k_ in ("take", "start", "stop")} for r in records]}
-    return out
 
 
 def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
@@ -234,9 +247,24 @@ def _narrowed_upstream(per_seed: dict[str, Any], left_out: list[tuple[str, str]]
     return bool(data) and bool(data - {s for _, s in left_out})
 
 
+def zero_shot_protocol(args: argparse.Namespace) -> dict[str, Any]:
+    """Where this suite's models come from and what each split serves (recorded with its results)."""
+    return {"loso": relative(args.loso.expanduser()),
+            "splits": {"examples": "k clips of the left-out style drawn from its train-split clips (nested: one seeded "
+                                   "permutation per seed, primitive and style)",
+                       "reference": "the left-out style's held-out (val + test split) real clips",
+                       "judge": "suite zero_shot's judge run: its autoencoder (Table 5.1) and style classifier "
+                                "(fitted on the train-split clips of every style, the left-out one included)",
+                       "networks": "suite zero_shot's leave-one-style-out trainings (autoencoder and network without "
+                                   "the style); nothing trained here",
+                       "seed_varies": "the trainings (a seed each), the example draws and the samples; the judge "
+                                      "is fixed"}}
+
+
 def summarize(per_seed: dict[str, Any], ks: list[int], args: argparse.Namespace,
-              poolings: list[str] | None = None) -> dict[str, Any]:
-    """Spreads over seeds per style and k, the headline per k (means over styles), and the aims met at each k."""
+              poolings: list[str] | None = None, protocol: dict[str, Any] | None = None) -> dict[str, Any]:
+    """Spreads over seeds per style and k, the headline per k (means over styles), and the aims met at each k;
+    ``protocol`` (default :func:`zero_shot_protocol`) says where the models come from."""
     rows = row_labels(ks, poolings or ["mean"])
     first = next(iter(per_seed.values()))
     left_out = [(p, s) for p, styles in first["curves"].items() for s in styles]
@@ -268,7 +296,7 @@ def summarize(per_seed: dict[str, Any], ks: list[int], args: argparse.Namespace,
         headline[str(k)] = {**{key: spread(b[key] for b in by_seed.values())
                                for key in ("recognition", "own_column_is_minimum", "aims_met", *VARIATION)},
                             "rows_per_seed": max((b["rows"] for b in by_seed.values()), default=0)}
-    return {"data": args.data, "loso": relative(args.loso.expanduser()), "ks": ks, "rows": rows,
+    return {"data": args.data, **(protocol or zero_shot_protocol(args)), "ks": ks, "rows": rows,
             "poolings": poolings or ["mean"], "samples": args.samples,
             "judge": sorted({v["judge"] for v in per_seed.values()}),
             "left_out": [f"{p}/{s}" for p, s in left_out],
@@ -277,17 +305,9 @@ def summarize(per_seed: dict[str, Any], ks: list[int], args: argparse.Namespace,
                           "styles": args.styles or (sorted({s for _, s in left_out})
                                                     if _narrowed_upstream(per_seed, left_out) else None)},
             "aims": {"k": 4, **{f"{m}_vs_real": a for m, a in AIMS.items()}, "recognition": AIM_RECOGNITION},
-            "splits": {"examples": "k clips of the left-out style drawn from its train-split clips (nested: one seeded "
-                                   "permutation per seed, primitive and style)",
-                       "reference": "the left-out style's held-out (val + test split) real clips",
-                       "judge": "suite zero_shot's judge run: its autoencoder (Table 5.1) and style classifier "
-                                "(fitted on the train-split clips of every style, the left-out one included)",
-                       "networks": "suite zero_shot's leave-one-style-out trainings (autoencoder and network without "
-                                   "the style); nothing trained here",
-                       "seed_varies": "the trainings (a seed each), the example draws and the samples; the judge "
-                                      "is fixed"},
             "headline": headline, "per_style": per_style,
-            "per_seed": {k: {"loso": v["loso"], "judge": v["judge"]} for k, v in per_seed.items()}}
+            "per_seed": {k: {key: value for key, value in v.items() if key not in ("curves", "data_styles")}
+                         for k, v in per_seed.items()}}
 
 
 def _mean(values) -> float | None:
@@ -297,9 +317,6 @@ def _mean(values) -> float | None:
 
 def render(record: dict[str, Any]) -> dict[str, str]:
     r = record["results"]
-    seeds = len(record.get("seeds", []))
-    prov = provenance_line(record)
-    label = data_label(r)
     protocol = (f"Networks of suite zero_shot (`{r['loso']}`: per seed an autoencoder and a network that never saw "
                 f"the left-out style), each conditioned on k clips of the style drawn from its train split (nested "
                 f"draws), pooled by their mean embedding and anchor (as `stylemotion-style example=[…]` pools them) "
@@ -307,6 +324,18 @@ def render(record: dict[str, Any]) -> dict[str, str]:
                 f"{r['samples']:,} samples per network, k and seed, judged by run(s) {', '.join(r['judge'])} (its "
                 f"autoencoder's Table 5.1 columns and its style classifier). Variation as a share of the style's "
                 f"held-out (val + test) real clips.")
+    return render_curve(record, "Zero-shot style network from k examples of a style it never saw", "left-out style",
+                        protocol)
+
+
+def render_curve(record: dict[str, Any], title: str, style_noun: str, protocol: str) -> dict[str, str]:
+    """The blocks of a k-examples curve: ``headline`` (per k, means over styles), ``per_style`` and ``real``
+    (the held-out clips' own figures); ``title`` names the model, ``style_noun`` its styles (``left-out style``
+    or ``style``), ``protocol`` says where its models and clips come from."""
+    r = record["results"]
+    seeds = len(record.get("seeds", []))
+    prov = provenance_line(record)
+    label = data_label(r, f"{style_noun}s")
     rows = []
     for k in r.get("rows") or r["ks"]:
         h = r["headline"][str(k)]
@@ -314,9 +343,9 @@ def render(record: dict[str, Any]) -> dict[str, str]:
                      f"{fmt_spread(h['own_column_is_minimum'], 1)} of {h['rows_per_seed']}",
                      *(fmt_spread(h[m], 2) for m in ("v_sd", "step_sd", "pose_across_sd", "pose_sd", "diversity")),
                      f"{fmt_spread(h['aims_met'], 1)} of {h['rows_per_seed']}"])
-    headline = (f"{label}Zero-shot style network from k examples of a style it never saw ({r['data']}, {seeds} seeds; "
-                f"left out: {', '.join(r['left_out'])}). Means over left-out styles, then mean ± sd (min–max for "
-                "recognition) over seeds.\n\n"
+    listed = "left out" if style_noun == "left-out style" else f"{style_noun}s"
+    headline = (f"{label}{title} ({r['data']}, {seeds} seeds; {listed}: {', '.join(r['left_out'])}). Means over "
+                f"{style_noun}s, then mean ± sd (min–max for recognition) over seeds.\n\n"
                 + md_table(["k (pooling: mean unless named)", "recognition",
                             "Table 5.1 rows whose minimum is the own example", "V_SD / real", "step_SD / real",
                             "pose_across_SD / real", "pose_SD / real", "diversity / real",
@@ -334,13 +363,13 @@ def render(record: dict[str, Any]) -> dict[str, str]:
                                                                                  "diversity"))])
     clips = "; ".join(f"{p}/{s}: {v['train_clips']} train, {v['heldout_clips']} held-out"
                       for p, styles in r["per_style"].items() for s, v in styles.items())
-    per_style = (f"{label}Per left-out style and k ({r['data']}, {seeds} seeds): mean ± sd over seeds; seeds whose "
+    per_style = (f"{label}Per {style_noun} and k ({r['data']}, {seeds} seeds): mean ± sd over seeds; seeds whose "
                  "Table 5.1 row has the style's own example as its minimum.\n\n"
-                 + md_table(["primitive", "left-out style", "k", "recognition", "own column", "V_SD / real",
+                 + md_table(["primitive", style_noun, "k", "recognition", "own column", "V_SD / real",
                              "step_SD / real", "pose_across_SD / real", "diversity / real"], style_rows)
                  + f"\n\nClips of each style: {clips}. {protocol} {prov}")
     return {"headline": headline, "per_style": per_style,
-            "real": md_table(["primitive", "left-out style", *VARIATION],
+            "real": md_table(["primitive", style_noun, *VARIATION],
                              [[p, s, *(fmt(v["real"][m], 3) for m in VARIATION)]
                               for p, styles in r["per_style"].items() for s, v in styles.items()])
             + f"\n\nThe held-out real clips' own figures (pose_SD, step_SD, pose_across_SD in cm; V_SD in m/s ⊕ "

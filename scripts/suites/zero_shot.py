@@ -179,13 +179,14 @@ def read_splits(per_seed: dict[str, Any], base: Path, seeds: list[int]) -> dict[
     return dict(record["splits"])
 
 
-def data_label(r: dict[str, Any]) -> str:
-    """The label a block starts with: synthetic data (a smoke test) and narrowed left-out styles."""
+def data_label(r: dict[str, Any], which: str = "left-out styles") -> str:
+    """The label a block starts with: synthetic data (a smoke test) and narrowed styles (``which``: what
+    ``r["left_out"]`` lists)."""
     label = ("**Synthetic data: a smoke test of the pipeline, not evidence that the method works.** "
              if r["data"] == "synthetic" else "")
     sub = r.get("subsample") or {}
     if sub.get("styles") or sub.get("primitives"):
-        label += ("**Narrowed to fit the machine** (not every style and primitive of the data): left-out styles "
+        label += (f"**Narrowed to fit the machine** (not every style and primitive of the data): {which} "
                   + ", ".join(r["left_out"]) + ". ")
     return label
 
