@@ -14,7 +14,7 @@ For each seed ``k`` the suite reads suite ``style``'s (or ``style_bandai``'s) fi
    :func:`stylemotion.style_example.base_run.train_config`, as ``stylemotion-style`` does) with those k clips as its
    examples (``datamodule.examples``, each named by take, start frame, content and split; the style term's target
    is their mean Gram matrix), one thread per training, ``--workers`` at once, into
-   ``<--out>/seed<k>/<p>_<s>_k<k>`` (a finished training is reused, an interrupted one resumes);
+   ``<--train-dir>/seed<k>/<p>_<s>_k<k>`` (a finished training is reused, an interrupted one resumes);
 3. draws ``--samples`` samples (seed ``k``) of its best checkpoint and measures them as suite ``style_examples``
    does (:func:`suites.style_examples.judged_samples`), judged by the same reproduction: recognition, the Table 5.1
    row (its columns are the run's examples), and V_SD, step_SD, pose spread and diversity as shares of the style's
@@ -48,7 +48,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--runs", type=Path, default=None,
                         help="suite style's reproductions: a folder with seed<k>/ per seed (default "
                              "runs/benchmarks/style/<data>/full, suite style_bandai's); read only")
-    parser.add_argument("--out", type=Path, default=None,
+    parser.add_argument("--train-dir", type=Path, default=None,
                         help="where the CVAEs are trained (default runs/benchmarks/style_examples_cvae/<data>)")
     parser.add_argument("--data", choices=("synthetic", "bandai"), default="bandai",
                         help="the data the reproductions are of (checked)")
@@ -98,7 +98,7 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
     if not ks or ks[0] < 1:
         raise ZeroShotRunError(f"--ks must be whole numbers ≥ 1, got {args.ks}")
     runs = (args.runs or ROOT / "runs" / "benchmarks" / "style" / args.data / "full").expanduser()
-    out = (args.out or ROOT / "runs" / "benchmarks" / "style_examples_cvae" / args.data).expanduser()
+    out = (args.train_dir or ROOT / "runs" / "benchmarks" / "style_examples_cvae" / args.data).expanduser()
     judges: dict[int, Judge] = {}
     starts: dict[tuple[int, str, str], Any] = {}
     draws: dict[tuple[int, str, str], dict[int, list]] = {}

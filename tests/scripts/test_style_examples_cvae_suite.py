@@ -17,7 +17,7 @@ from suites import style_examples, style_examples_cvae  # noqa: E402
 
 
 def args(runs: Path, out: Path, **changes) -> argparse.Namespace:
-    values = {"runs": runs, "out": out, "data": "synthetic", "ks": [2, 1], "samples": 40, "styles": ["elderly"],
+    values = {"runs": runs, "train_dir": out, "data": "synthetic", "ks": [2, 1], "samples": 40, "styles": ["elderly"],
               "primitives": ["walk_leftStance"], "workers": 1}
     return argparse.Namespace(**{**values, **changes})
 
