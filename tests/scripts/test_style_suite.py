@@ -59,3 +59,35 @@ def test_spreads_over_seeds_and_the_shift_rows_only_where_they_have_figures():
     assert "| walk_leftStance | shift:angry |" in blocks["variation"]
     assert "shift:angry" not in blocks["recognition"] and "shift:angry" not in blocks["variation_vs_style"]
     assert "| walk_leftStance | angry |" in blocks["recognition"]
+
+
+def with_skating(report: dict, samples: float, real: float, no_plant: float) -> dict:
+    """``report`` with its ``foot_skating_detail``: the CVAE's samples slide ``samples``, its real clips ``real``."""
+    detail = {"angry": {"samples": {"ratio": samples, "no_plant_share": no_plant, "planted_mid_mps": 0.3},
+                        "real": {"ratio": real, "no_plant_share": 0.0, "planted_mid_mps": 0.02}}}
+    return {**report, "foot_skating_detail": {PRIMITIVE: detail}}
+
+
+def test_raw_skating_is_read_per_seed_with_its_ratio_to_the_real_clips():
+    per_seed = {str(i): style.seed_figures(with_skating(planted_report(0.9, 0.5), samples, 0.1, no_plant))
+                for i, (samples, no_plant) in enumerate([(0.2, 0.0), (0.4, 0.5), (0.3, 0.1)])}
+    summary, _ = style.summarize(per_seed)
+    angry = summary[PRIMITIVE]["foot_skating"]["angry"]
+    assert angry["samples_ratio"]["mean"] == pytest.approx(0.3) and angry["real_ratio"]["mean"] == pytest.approx(0.1)
+    assert [angry["times_real"]["min"], angry["times_real"]["max"]] == pytest.approx([2.0, 4.0])
+    assert angry["samples_no_plant_share"]["max"] == pytest.approx(0.5)
+    record = json.loads((ROOT / "benchmarks" / "results" / "style_bandai.json").read_text())
+    record["results"]["summary"] = {PRIMITIVE: summary[PRIMITIVE]}
+    record["results"]["primitives"] = [PRIMITIVE]
+    block = style.render(record)["skating"]
+    assert "| walk_leftStance | angry | 0.300 ± 0.100 (0.200–0.400) | 0.100 ± 0.000 | 3.0 ± 1.0 (2.0–4.0) |" in block
+
+
+def test_a_report_without_skating_figures_renders_no_skating_block():
+    per_seed = {"0": style.seed_figures(planted_report(0.9, 0.5))}
+    summary, _ = style.summarize(per_seed)
+    assert summary[PRIMITIVE]["foot_skating"] == {}
+    record = json.loads((ROOT / "benchmarks" / "results" / "style_bandai.json").read_text())
+    record["results"]["summary"] = {PRIMITIVE: summary[PRIMITIVE]}
+    record["results"]["primitives"] = [PRIMITIVE]
+    assert "skating" not in style.render(record)
