@@ -282,6 +282,23 @@ def skating_spread(figures: list[dict[str, dict[str, float | None]]]) -> dict[st
     return out
 
 
+def skating_line(r: dict[str, Any], seeds: int, label: str, prov: str) -> str:
+    """One paragraph of block ``skating``: per primitive, the neutral model's and the range of the styled models'
+    sliding share over their real clips', and the largest never-planted share of styled samples (means over seeds)."""
+    parts = []
+    for p in r["primitives"]:
+        skating = r["summary"][p].get("foot_skating", {})
+        styled = {m: k for m, k in skating.items() if m != "neutral" and ":" not in m}
+        times = [k["times_real"]["mean"] for k in styled.values() if k["times_real"]["mean"] is not None]
+        never = [k["samples_no_plant_share"]["mean"] for k in styled.values()]
+        neutral = skating.get("neutral", {}).get("times_real", {}).get("mean")
+        parts.append(f"{p}: neutral VAE {fmt(neutral, 1)}×, style CVAEs {fmt(min(times, default=None), 1)}–"
+                     f"{fmt(max(times, default=None), 1)}× (stance foot never planted in up to "
+                     f"{fmt(max(never, default=None), 2)} of a CVAE's samples)")
+    return (f"{label}Raw foot skating of samples ÷ that of the real clips each model is judged against ({r['data']}, "
+            f"{seeds} seeds, means over seeds; issue 27's aim ≤ 1.5×): " + "; ".join(parts) + f". {prov}")
+
+
 def summarize(per_seed: dict[str, dict[str, Any]]) -> tuple[dict[str, Any], dict[str, Any]]:
     """Spreads over seeds of :func:`seed_figures`: per primitive (``summary``) and over all (``overall``)."""
     first = next(iter(per_seed.values()))
@@ -488,6 +505,7 @@ def render(record: dict[str, Any]) -> dict[str, str]:
                                          "samples ÷ real", "never planted, samples", "never planted, real",
                                          "mid-stance speed, samples / real"], skating_rows)
                              + f"\n\n{split_line} {prov}")
+        blocks["skating_line"] = skating_line(r, seeds, label, prov)
     if "autoencoder" in o:  # results recorded before the suite read the autoencoder's figures have none
         blocks["autoencoder"] = autoencoder_block(r, seeds, prov)
     per_seed_rows = [[k, p, f"{v['primitives'][p]['diagonal_rows']}/{v['primitives'][p]['models']}",

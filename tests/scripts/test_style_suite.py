@@ -81,6 +81,8 @@ def test_raw_skating_is_read_per_seed_with_its_ratio_to_the_real_clips():
     record["results"]["primitives"] = [PRIMITIVE]
     block = style.render(record)["skating"]
     assert "| walk_leftStance | angry | 0.300 ± 0.100 (0.200–0.400) | 0.100 ± 0.000 | 3.0 ± 1.0 (2.0–4.0) |" in block
+    line = style.render(record)["skating_line"]
+    assert "walk_leftStance: neutral VAE —×, style CVAEs 3.0–3.0× (stance foot never planted in up to 0.20" in line
 
 
 def test_a_report_without_skating_figures_renders_no_skating_block():
