@@ -32,7 +32,7 @@ import argparse
 from pathlib import Path
 from typing import Any
 
-from suites.common import progress_printed, run_jobs
+from suites.common import progress_printed, provenance_line, run_jobs
 from suites.style_examples import KS, relative
 
 DESCRIPTION = ("per-style CVAE trained on k = 1, 2, 4, 8 train-split examples of its style (the reproduction's CVAE "
@@ -161,4 +161,28 @@ def render(record: dict[str, Any]) -> dict[str, str]:
                 f"(the style term's target: their mean Gram matrix); {r['samples']:,} samples per CVAE, judged by "
                 f"the same reproduction (its autoencoder's Table 5.1 columns and its style classifier). Variation "
                 f"as a share of the style's held-out (val + test) real clips. Nothing is chosen from this table.")
-    return render_curve(record, "Style CVAE trained on k examples of its style", "style", protocol)
+    return {**render_curve(record, "Style CVAE trained on k examples of its style", "style", protocol),
+            "reading": reading(r, provenance_line(record))}
+
+
+def reading(r: dict[str, Any], prov: str) -> str:
+    """The curve in one paragraph: how the means over styles move from the smallest to the largest k, the
+    recognition range, the styles meeting the k = 4 aims, diversity by style at the largest k and the own-column
+    count."""
+    from suites.common import fmt
+
+    rows = r.get("rows") or [str(k) for k in r["ks"]]
+    first, last = r["headline"][str(rows[0])], r["headline"][str(rows[-1])]
+    moves = ", ".join(f"{name} {fmt(first[m]['mean'], 2)} → {fmt(last[m]['mean'], 2)}"
+                      for m, name in (("v_sd", "V_SD"), ("step_sd", "step_SD"), ("diversity", "diversity")))
+    recognition = [r["headline"][str(k)]["recognition"]["mean"] for k in rows]
+    aims = r["headline"].get("4", {}).get("aims_met", {})
+    diversity = [v["ks"][str(rows[-1])]["vs_real"]["diversity"]["mean"]
+                 for styles in r["per_style"].values() for v in styles.values()]
+    own = [int(round(r["headline"][str(k)]["own_column_is_minimum"]["mean"])) for k in rows]
+    return (f"From k = {rows[0]} to k = {rows[-1]} the means over styles move {moves} of the held-out clips; "
+            f"recognition stays {fmt(min(recognition), 3)}–{fmt(max(recognition), 3)}. Styles meeting every k = 4 aim: "
+            f"{fmt(aims.get('min'), 0)}–{fmt(aims.get('max'), 0)} of {r['headline'][str(rows[0])]['rows_per_seed']} "
+            f"over seeds. Diversity at k = {rows[-1]} by style: {fmt(min(diversity, default=None), 2)}–"
+            f"{fmt(max(diversity, default=None), 2)} (aim ≥ 0.7). Rows whose minimum is the style's own column, mean "
+            f"over seeds per k: {', '.join(str(o) for o in own)}. {prov}")

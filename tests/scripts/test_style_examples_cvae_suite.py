@@ -63,6 +63,8 @@ def test_the_block_names_the_model_and_its_narrowing(curve) -> None:
     assert blocks["headline"].startswith("**Synthetic data")
     assert "Style CVAE trained on k examples of its style" in blocks["headline"]
     assert "styles walk_leftStance/elderly" in blocks["headline"] and "left-out" not in blocks["headline"]
+    assert blocks["reading"].startswith("From k = 1 to k = 2 the means over styles move V_SD ")
+    assert "Rows whose minimum is the style's own column, mean over seeds per k: " in blocks["reading"]
 
 
 def test_a_run_of_other_data_is_refused(curve) -> None:
