@@ -183,9 +183,13 @@ def main(argv: list[str] | None = None) -> int:
         print(__doc__.strip().splitlines()[0] + "\nusage: benchmarks.py {run <suite>,render [--check],list}",
               file=sys.stderr)
         return 2
+    from stylemotion.io.errors import UserInputError
+
     try:
         return commands[argv[0]](argv[1:])
-    except BenchmarkError as exc:
+    except (BenchmarkError, UserInputError) as exc:  # bad input to the runner or a suite: one line, as commands do
+        if os.environ.get("STYLEMOTION_DEBUG") and not isinstance(exc, BenchmarkError):
+            raise
         print(f"error: {exc}", file=sys.stderr)
         return 2
 

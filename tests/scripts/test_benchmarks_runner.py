@@ -70,3 +70,12 @@ def test_run_writes_results_with_command_commit_machine_load_and_seeds(runner, t
     capsys.readouterr()
     assert runner.main(["run", "silent", "--out", str(tmp_path / "silent.json")]) == 2
     assert "no 'splits' entry" in capsys.readouterr().err and not (tmp_path / "silent.json").exists()
+
+
+def test_a_suites_bad_input_is_one_line_and_writes_nothing(runner, tmp_path, capsys) -> None:
+    out = tmp_path / "cvae.json"
+    assert runner.main(["run", "style_examples_cvae", "--runs", str(tmp_path / "none"), "--seeds", "0",
+                        "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and f"run={tmp_path / 'none' / 'seed0'} is not a finished" in err
+    assert not out.exists()
