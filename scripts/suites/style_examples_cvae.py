@@ -127,8 +127,8 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
     per_seed: dict[str, Any] = {}
     for (seed, p, s), (truth, reference, _, header) in starts.items():
         judge = judges[seed]
-        curve = per_seed.setdefault(str(seed), {"runs": relative(runs / f"seed{seed}"),
-                                                "judge": relative(runs / f"seed{seed}"), "curves": {}})
+        # the seed's run is its own judge
+        curve = per_seed.setdefault(str(seed), {"judge": relative(runs / f"seed{seed}"), "curves": {}})
         curve["curves"].setdefault(p, {})[s] = header
         for k, clips in draws[(seed, p, s)].items():
             folder = Path(jobs[(seed, p, s, k)][1])
