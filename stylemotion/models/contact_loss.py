@@ -34,6 +34,9 @@ Generated motion has no real clip. For the style CVAE's draws (``sample_contact_
 those the detector finds on the *decoded* motion itself (:func:`own_contacts`, not differentiated): the term
 then asks the feet the motion plants to stay still, wherever it plants them, so it does not pull the
 draws' step timing towards the neutral content clips (as the term on the content clips' reconstructions does).
+A draw that never plants has no own contact; ``sample_contacts=content`` holds every draw on the primitive's
+contact template instead (the content clips' majority contacts, :func:`contact_runs` of it) and adds
+:func:`midstance_loss`, which holds heel and ball both in the middle of each contact run.
 """
 
 from __future__ import annotations
@@ -45,7 +48,8 @@ from stylemotion.primitives.contacts import foot_contacts
 from stylemotion.representation import frames_to_positions
 from stylemotion.skeleton import FOOT_POINTS
 
-__all__ = ["contact_velocity_loss", "own_contacts", "planted_speed_squared", "timeline_contacts", "window_contacts"]
+__all__ = ["contact_runs", "contact_velocity_loss", "midstance_loss", "own_contacts", "planted_speed_squared",
+           "timeline_contacts", "window_contacts"]
 
 
 def planted_speed_squared(frames: torch.Tensor, fps: float | torch.Tensor) -> torch.Tensor:
@@ -89,6 +93,52 @@ def contact_velocity_loss(frames: torch.Tensor, contacts: torch.Tensor, fps: flo
     mask = (contacts[:, 1:] & contacts[:, :-1]).to(frames.dtype)
     squared = planted_speed_squared(frames, fps)
     return (squared * mask).sum() / mask.sum().clamp_min(1.0)
+
+
+def contact_runs(contacts: torch.Tensor) -> list[tuple[int, int, int]]:
+    """The contact runs of one contact pattern ``(T, 2)`` bool: ``(foot, first, last)`` frames of each maximal run
+    of at least 2 frames (a single frame has no step)."""
+    runs = []
+    flags = contacts.detach().cpu().bool().numpy()
+    for foot in range(flags.shape[1]):
+        edges = np.diff(np.concatenate([[0], flags[:, foot].astype(np.int8), [0]]))
+        runs += [(foot, int(a), int(b) - 1) for a, b in zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1))
+                 if b - a >= 2]
+    return runs
+
+
+def midstance_loss(frames: torch.Tensor, runs: list[tuple[int, int, int]], fps: float | torch.Tensor
+                   ) -> torch.Tensor:
+    """Mean squared horizontal speed of heel **and** ball over the middle half of each contact run (m²/s²).
+
+    In the middle of a stance the whole foot is flat on the ground, so neither point moves; at its ends the foot
+    rolls about one point while the other moves (why :func:`contact_velocity_loss` takes the slower point per
+    frame). The per-frame slower point can be cheated: heel and ball that take turns to stay still let the foot
+    walk backwards under a moving root at no cost. Here both points are held over frames ``a + ⌊(b − a)/4⌋`` to
+    ``b − ⌊(b − a)/4⌋`` of each run ``(foot, a, b)`` (the same frames for every motion, e.g. a primitive's contact
+    template), steps between consecutive frames.
+
+    Args:
+        frames: ``(n, T, 66)`` decoded raw frames (differentiable).
+        runs: contact runs on those frames (:func:`contact_runs`).
+        fps: frames per second, a number or ``(n,)``.
+
+    Returns:
+        Scalar (0 without runs).
+    """
+    if not runs:
+        return frames.new_zeros(())
+    rate = torch.as_tensor(fps, dtype=frames.dtype, device=frames.device)
+    rate = rate.reshape(-1, 1) if rate.dim() else rate
+    positions = frames_to_positions(frames, rate)  # (n, T, 21, 3)
+    points = torch.as_tensor(FOOT_POINTS, device=frames.device)  # (2 feet, 2 points)
+    per_second = rate.reshape(-1, 1, 1) if rate.dim() else rate
+    parts = []
+    for foot, a, b in runs:
+        quarter = (b - a) // 4
+        mid = positions[:, a + quarter:b - quarter + 1][:, :, points[foot]][..., [0, 2]]  # (n, m, 2 points, 2)
+        parts.append((mid[:, 1:] - mid[:, :-1]).square().sum(-1).mul(per_second.square()).flatten(1))
+    return torch.cat(parts, dim=1).mean()
 
 
 def window_contacts(frames: torch.Tensor, fps: float) -> torch.Tensor:

@@ -40,12 +40,20 @@ their data mean, encoded again), which frees speed and turning from the example;
 per style decode, so ``style_subset`` = k > 0 takes the style term's mean over a random k of the decodes of each
 step (an unbiased estimate of the same mean; 0 = all).
 
-Planted feet in the draws (issue 27 item 1; off by default): ``sample_contact_weight`` = β > 0 adds
-β · the foot-contact velocity loss of the style term's decodes (the same draws, decoded by the frozen autoencoder
-on the primitive's timeline at each draw's own duration), with the contacts the detector finds on each draw itself
+Planted feet in the draws (issue 27 item 1; off by default): ``sample_contact_weight`` = β > 0 adds β · the foot-
+contact velocity loss of the style term's decodes (the same draws, decoded by the frozen autoencoder on the
+primitive's timeline at each draw's own duration), with the contacts the detector finds on each draw itself
 (:func:`~stylemotion.models.contact_loss.own_contacts`): the feet a styled draw plants must stay still, wherever it
-plants them. The PrimitiveVAE's ``contact_weight`` instead holds the reconstructions of the neutral content clips to
-the content clips' contacts, which pulls the draws' steps towards neutral ones (suite ``contact_loss``).
+plants them. A draw whose stance foot slides so fast that the detector never finds it planted has no contact, so
+that term cannot reach it; ``sample_contacts=content`` takes instead the primitive's contact template: the timeline
+frames where most content (neutral) training clips have that foot in contact (:func:`content_contact_template`,
+computed once from the clips' recorded contacts), the same frames for every draw, and adds the speed of heel and
+ball over the middle half of each of the template's contact runs
+(:func:`~stylemotion.models.contact_loss.midstance_loss`: the per-frame term alone lets heel and ball take turns to
+stay still while the foot walks backwards under the root). Primitives are cut at contacts, so the stance foot is
+planted on the whole timeline in clips of every style. The PrimitiveVAE's ``contact_weight`` instead holds the
+reconstructions of the neutral content clips to the content clips' contacts, which pulls the draws' steps towards
+neutral ones (suite ``contact_loss``).
 
 One model per (primitive, style). The style, the example clip(s) (take, frame range, primitive,
 duration) and how they were encoded are recorded in ``hparams.spec``; the target Gram matrix is a
@@ -59,7 +67,13 @@ from typing import Any
 import torch
 
 from stylemotion.models.autoencoder import IncompatibleModelError
-from stylemotion.models.contact_loss import contact_velocity_loss, own_contacts
+from stylemotion.models.contact_loss import (
+    contact_runs,
+    contact_velocity_loss,
+    midstance_loss,
+    own_contacts,
+    timeline_contacts,
+)
 from stylemotion.models.style import GRAM_NORMALIZATIONS, feature_style_distance, gram_factor, mean_gram
 from stylemotion.models.vae import PrimitiveVAE
 from stylemotion.representation import VELOCITY_DIMS, YAW_RATE_DIM
@@ -70,6 +84,10 @@ STYLE_LATENTS = ("posterior", "prior", "both")
 STYLE_TERMS = ("distance", "margin")
 #: Which motion channels the style term's Gram sees (see :class:`StyleCVAE`).
 STYLE_CHANNELS = ("all", "pose")
+#: Where the draws' contact term holds the feet (see :class:`StyleCVAE`).
+SAMPLE_CONTACTS = ("own", "content")
+#: Share of content clips in contact above which a timeline frame is in the contact template (a majority).
+CONTENT_CONTACT_MAJORITY = 0.5
 
 
 class StyleCVAE(PrimitiveVAE):
@@ -84,13 +102,15 @@ class StyleCVAE(PrimitiveVAE):
         style_channels: ``all`` or ``pose`` (root velocity and yaw rate left out, :func:`pose_features`).
         style_subset: the style term's mean over a random this many decodes per step (0 = all).
         sample_contact_weight: β of the draws' foot-contact velocity loss (m²/s²; 0 = off; see the module doc).
+        sample_contacts: where that loss holds the draws' feet: ``own`` (the contacts each draw plants) or
+            ``content`` (the primitive's contact template from the content clips).
         **kwargs: :class:`PrimitiveVAE` arguments.
     """
 
     def __init__(self, style_weight: float = 5.0, style_latents: str = "prior", style_term: str = "distance",
                  style_margin: float = 1.0, style_centred: bool = False, gram_normalization: str = "mean",
                  style_channels: str = "all", style_subset: int = 0, sample_contact_weight: float = 0.0,
-                 **kwargs: Any):
+                 sample_contacts: str = "own", **kwargs: Any):
         super().__init__(**kwargs)
         if not style_weight >= 0:
             raise ValueError(f"style_weight must be ≥ 0, got {style_weight}")
@@ -108,12 +128,15 @@ class StyleCVAE(PrimitiveVAE):
             raise ValueError(f"style_subset must be an integer ≥ 0 (0 = every decode), got {style_subset!r}")
         if not sample_contact_weight >= 0:
             raise ValueError(f"sample_contact_weight must be ≥ 0, got {sample_contact_weight}")
+        if sample_contacts not in SAMPLE_CONTACTS:
+            raise ValueError(f"sample_contacts must be one of {SAMPLE_CONTACTS}, got {sample_contacts!r}")
         self.save_hyperparameters({**dict(self.hparams), "style_weight": float(style_weight),
                                    "style_latents": str(style_latents), "style_term": str(style_term),
                                    "style_margin": float(style_margin), "style_centred": bool(style_centred),
                                    "gram_normalization": str(gram_normalization),
                                    "style_channels": str(style_channels), "style_subset": int(style_subset),
-                                   "sample_contact_weight": float(sample_contact_weight)})
+                                   "sample_contact_weight": float(sample_contact_weight),
+                                   "sample_contacts": str(sample_contacts)})
 
     def _build(self, spec: dict[str, Any]) -> None:
         super()._build(spec)
@@ -121,6 +144,8 @@ class StyleCVAE(PrimitiveVAE):
         self.register_buffer("style_gram", torch.zeros(channels, channels))
         #: median Gram distance of the content (neutral) training clips to their mean Gram
         self.register_buffer("content_spread", torch.tensor(float("nan")))
+        #: ``(L, 2)`` share of the content training clips with each foot in contact at each timeline frame
+        self.register_buffer("content_contacts", torch.zeros(int(spec["timeline_frames"]), 2))
 
     def _adapt_spec(self, spec: dict[str, Any]) -> dict[str, Any]:
         if not spec.get("style"):
@@ -143,8 +168,11 @@ class StyleCVAE(PrimitiveVAE):
         with torch.no_grad():
             self.style_gram.copy_(mean_gram([self._style_features(f) for f in datamodule.style_features],
                                             self.gram_normalization))
-            self.content_spread.fill_(content_spread(self._style_features(datamodule.datasets["train"].features),
-                                                     self.gram_normalization))
+            train = datamodule.datasets["train"]
+            self.content_spread.fill_(content_spread(self._style_features(train.features), self.gram_normalization))
+            if self.hparams.get("sample_contacts", "own") == "content":
+                self.content_contacts.copy_(timeline_contacts(train.positions, train.num_frames, self.fps,
+                                                              self.timeline_frames).float().mean(0))
 
     @property
     def gram_normalization(self) -> str:
@@ -174,7 +202,11 @@ class StyleCVAE(PrimitiveVAE):
     def on_load_checkpoint(self, checkpoint: dict[str, Any]) -> None:
         super().on_load_checkpoint(checkpoint)
         # checkpoints from before the margin term have no content_spread (their loss never used it)
-        checkpoint.get("state_dict", {}).setdefault("content_spread", torch.tensor(float("nan")))
+        state = checkpoint.get("state_dict", {})
+        state.setdefault("content_spread", torch.tensor(float("nan")))
+        # checkpoints from before the contact template have none (their loss never used it)
+        if "content_contacts" not in state:
+            state["content_contacts"] = torch.zeros(int(checkpoint["hyper_parameters"]["spec"]["timeline_frames"]), 2)
 
     @property
     def style_radius(self) -> float:
@@ -226,7 +258,7 @@ class StyleCVAE(PrimitiveVAE):
         return terms
 
     def sample_contact_term(self, features: torch.Tensor, duration_s: torch.Tensor) -> torch.Tensor:
-        """The foot-contact velocity loss of draws on their own contacts (module doc).
+        """The foot-contact velocity loss of draws on their own contacts or the content template (module doc).
 
         Args:
             features: ``(n, C, T')`` raw features of decoded draws (differentiable).
@@ -238,7 +270,17 @@ class StyleCVAE(PrimitiveVAE):
         length = self.timeline_frames
         frames = self.autoencoder.decode(features, length).float()  # (n, L, 66)
         rate = (length - 1) / duration_s.detach().to(frames)  # playback fps of the timeline
+        if self.hparams.get("sample_contacts", "own") == "content":
+            template = content_contact_template(self.content_contacts)
+            return (contact_velocity_loss(frames, template.expand(frames.shape[0], -1, -1), rate)
+                    + midstance_loss(frames, contact_runs(template), rate))
         return contact_velocity_loss(frames, own_contacts(frames, rate), rate)
+
+
+def content_contact_template(shares: torch.Tensor) -> torch.Tensor:
+    """The contact template ``(L, 2)`` bool of contact shares ``(L, 2)``: frames where more than
+    :data:`CONTENT_CONTACT_MAJORITY` of the content clips have the foot in contact."""
+    return shares > CONTENT_CONTACT_MAJORITY
 
 
 def content_spread(features: torch.Tensor, normalization: str = "mean") -> float:

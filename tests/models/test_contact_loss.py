@@ -19,13 +19,15 @@ from stylemotion.config import config_dir
 from stylemotion.datamodules import MotionWindowDataModule
 from stylemotion.models.autoencoder import ConvAutoencoder, MotionAutoencoder
 from stylemotion.models.contact_loss import (
+    contact_runs,
     contact_velocity_loss,
+    midstance_loss,
     own_contacts,
     planted_speed_squared,
     timeline_contacts,
     window_contacts,
 )
-from stylemotion.models.cvae import StyleCVAE
+from stylemotion.models.cvae import CONTENT_CONTACT_MAJORITY, StyleCVAE, content_contact_template
 from stylemotion.models.vae import PrimitiveVAE
 from stylemotion.primitives.contacts import foot_contacts
 from stylemotion.representation import FRAME_DIM, VELOCITY_DIMS, frames_to_positions, positions_to_frames
@@ -103,6 +105,51 @@ def test_the_planted_point_is_the_slower_of_heel_and_ball() -> None:
     assert torch.allclose(planted_speed_squared(frames, FPS)[..., 0], torch.full((1, steps), 0.09, dtype=frames.dtype))
 
 
+def test_contact_runs_are_the_maximal_runs_of_two_or_more_frames_per_foot() -> None:
+    pattern = torch.tensor([[1, 0], [1, 1], [1, 1], [0, 1], [1, 0], [1, 0], [0, 0], [1, 0]], dtype=torch.bool)
+    assert contact_runs(pattern) == [(0, 0, 2), (0, 4, 5), (1, 1, 3)]  # the single frame 7 is no run
+    assert contact_runs(torch.zeros(5, 2, dtype=torch.bool)) == []
+
+
+def inchworm(frames: torch.Tensor, step_m: float) -> torch.Tensor:
+    """``frames`` whose left heel and ball take turns to move back by ``step_m`` (root-local −X): every frame
+    one of them is still, so the per-frame slower point never moves, while the foot travels."""
+    out = frames.clone()
+    heel, ball = FOOT_POINTS[0]
+    shift = torch.zeros(2, frames.shape[1], dtype=frames.dtype)
+    for t in range(1, frames.shape[1]):
+        shift[:, t] = shift[:, t - 1]
+        shift[t % 2, t] -= step_m  # odd frames move the ball, even frames the heel
+    out[0, :, 3 * heel] += shift[0]
+    out[0, :, 3 * ball] += shift[1]
+    return out
+
+
+def test_the_midstance_term_holds_heel_and_ball_both_where_the_slower_point_can_be_cheated() -> None:
+    still = standing(13)
+    runs = [(0, 0, 12)]  # the left foot's run over all 13 frames: its middle half is frames 3 .. 9
+    assert float(midstance_loss(still, runs, FPS)) == pytest.approx(0.0, abs=1e-12)
+    walked = inchworm(still, 0.01)
+    contacts = torch.zeros(1, 13, 2, dtype=torch.bool)
+    contacts[..., 0] = True
+    assert float(contact_velocity_loss(walked, contacts, FPS)) == pytest.approx(0.0, abs=1e-12)
+    # each step one point moves 1 cm per frame (0.3 m/s, 0.09 m²/s²), the other is still: the mean is 0.045
+    assert float(midstance_loss(walked, runs, FPS)) == pytest.approx(0.045)
+    # outside the middle half nothing counts: a slide over frames 0 .. 3 and 9 .. 12 only
+    ends = still.clone()
+    heel, ball = FOOT_POINTS[0]
+    for j in (heel, ball):
+        ends[0, :4, 3 * j] += torch.linspace(-0.3, 0.0, 4, dtype=ends.dtype)
+        ends[0, 9:, 3 * j] += torch.linspace(0.0, 0.3, 4, dtype=ends.dtype)
+    assert float(midstance_loss(ends, runs, FPS)) == pytest.approx(0.0, abs=1e-12)
+    assert float(midstance_loss(still, [], FPS)) == 0.0
+
+
+def test_the_content_template_is_the_majority_of_the_content_clips_contacts() -> None:
+    shares = torch.tensor([[1.0, CONTENT_CONTACT_MAJORITY], [0.51, 0.2]])
+    assert content_contact_template(shares).tolist() == [[True, False], [True, False]]
+
+
 def test_contacts_are_those_of_the_detector_carried_to_the_timeline() -> None:
     positions = tiny_takeset().takes[0].positions[:40]
     expected = foot_contacts(positions, FPS)
@@ -164,6 +211,31 @@ def test_the_cvae_draws_contact_term_holds_their_own_planted_feet(ae_ckpt) -> No
     assert "sample_contact" not in model._extra_losses(y.repeat(2, 1, 1))
     with pytest.raises(ValueError, match="sample_contact_weight"):
         StyleCVAE(sample_contact_weight=-1.0)
+
+
+def test_the_cvae_draws_content_term_uses_the_content_clips_template(ae_ckpt) -> None:
+    """sample_contacts=content: the template is the majority of the content train clips' timeline contacts (a
+    buffer, so it travels with the checkpoint); the term is the velocity loss on it plus the mid-stance term."""
+    dm = feature_module(ae_ckpt, style="elderly")
+    pl.seed_everything(0, verbose=False)
+    model = StyleCVAE(samples_per_item=2, style_latents="prior", sample_contact_weight=3.0,
+                      sample_contacts="content")
+    fit(model, dm, steps=2)
+    train = dm.datasets["train"]
+    length = model.timeline_frames
+    shares = timeline_contacts(train.positions, train.num_frames, model.fps, length).float().mean(0)
+    torch.testing.assert_close(model.content_contacts, shares)
+    template = content_contact_template(shares)
+    assert bool(template.any())
+    z = torch.randn(6, model.hparams.latent_dim, generator=torch.Generator().manual_seed(2))
+    features, duration = model.denormalize(model.net.decode(z))
+    frames = model.autoencoder.decode(features, length).float()
+    rate = (length - 1) / duration.detach()
+    expected = (contact_velocity_loss(frames, template.expand(6, -1, -1), rate)
+                + midstance_loss(frames, contact_runs(template), rate))
+    torch.testing.assert_close(model.sample_contact_term(features, duration), expected, rtol=1e-4, atol=1e-7)
+    with pytest.raises(ValueError, match="sample_contacts"):
+        StyleCVAE(sample_contacts="everywhere")
 
 
 def test_the_gradient_reaches_the_decoder_not_only_the_output() -> None:

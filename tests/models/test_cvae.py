@@ -151,16 +151,18 @@ def test_margin_and_centred_terms_in_the_model(elderly) -> None:
         StyleCVAE(style_margin=0.0)
 
 
-def test_checkpoints_from_before_the_margin_term_still_load(elderly, tmp_path) -> None:
+def test_checkpoints_from_before_the_margin_term_and_the_contact_template_still_load(elderly, tmp_path) -> None:
     cvae = StyleCVAE(samples_per_item=2)
     fit(cvae, elderly, steps=2, folder=tmp_path)
     checkpoint = torch.load(tmp_path / "best.ckpt", weights_only=True)
     del checkpoint["state_dict"]["content_spread"]
-    for key in ("style_term", "style_margin", "style_centred"):
+    del checkpoint["state_dict"]["content_contacts"]
+    for key in ("style_term", "style_margin", "style_centred", "sample_contacts"):
         checkpoint["hyper_parameters"].pop(key)
     torch.save(checkpoint, tmp_path / "old.ckpt")
     loaded = StyleCVAE.load_from_checkpoint(tmp_path / "old.ckpt")
     assert loaded.hparams.style_term == "distance" and torch.isnan(loaded.content_spread)
+    assert loaded.content_contacts.shape == (loaded.timeline_frames, 2) and not bool(loaded.content_contacts.any())
     assert torch.allclose(loaded.style_gram, cvae.style_gram)
 
 

@@ -1,0 +1,79 @@
+"""Suite ``contact_template`` (scripts/suites/contact_template.py): its arms, the stance figures read from the
+report, the rule (eligible by rows, recognition and variation against ``off``, then the lowest mid-stance speed
+over real by more than the tie band) and the block (hand-made reports, no training)."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(ROOT / "scripts"))
+
+from suites import contact_template, style_channels  # noqa: E402
+
+
+def report(mid: float, share: float = 0.95, rows: tuple[str, ...] = ("a",), v_sd: float = 0.5,
+           no_plant: float = 0.0) -> dict:
+    """One stance, style a: its samples' stance foot at ``mid`` m/s in mid-stance against real clips at 0.02."""
+    return {"table_5_1": {"p": {"diagonal": {"rows": list(rows)}}},
+            "style_recognition": {"per_model_detail": {"p": {"a": {"share": share}}}},
+            "variation_vs_style": {"p": {"a": {"v_sd": v_sd, "step_sd": 0.5, "diversity": 0.5}}},
+            "foot_skating_detail": {"p": {"a": {
+                "samples": {"ratio": 0.3, "no_plant_share": no_plant, "planted_mid_mps": mid},
+                "real": {"ratio": 0.1, "no_plant_share": 0.0, "planted_mid_mps": 0.02}}}}}
+
+
+def run(rep: dict) -> dict:
+    return {"cases": style_channels.case_figures(rep, ["a"]), "stance": contact_template.case_stance(rep, ["a"]),
+            "cvae_minutes": 10.0}
+
+
+def choice(*reports: dict) -> dict:
+    names = ["off", "own100", "content100"][:len(reports)]
+    return contact_template.choose({n: contact_template.arm_summary([run(r)]) for n, r in zip(names, reports)})
+
+
+def test_the_arms_are_off_then_own_then_content_at_one_weight() -> None:
+    assert contact_template.arms(100.0, ["off", "own", "content"]) == {
+        "off": [], "own100": ["model.sample_contact_weight=100", "model.sample_contacts=own"],
+        "content100": ["model.sample_contact_weight=100", "model.sample_contacts=content"]}
+    assert list(contact_template.arms(1000.0, ["content"])) == ["off", "content1000"]
+
+
+def test_the_stance_figures_come_from_the_reports_skating_detail() -> None:
+    figures = contact_template.case_stance(report(0.4, no_plant=0.6), ["a"])
+    assert figures == {"p/a": {"no_plant_samples": 0.6, "no_plant_real": 0.0, "mid_mps_samples": 0.4,
+                               "mid_mps_real": 0.02}}
+    summary = contact_template.arm_summary([run(report(0.4, no_plant=0.6))])
+    assert abs(summary["mid_excess"]["mean"] - 0.38) < 1e-9 and summary["no_plant_samples"]["mean"] == 0.6
+
+
+def test_the_slowest_eligible_mid_stance_wins_only_beyond_the_tie_band() -> None:
+    assert choice(report(0.5), report(0.3), report(0.1))["chosen"] == "content100"
+    # excess over real (0.02 m/s): own 0.08, content 0.077, within 5 % of own: own holds
+    assert choice(report(0.5), report(0.1), report(0.097))["chosen"] == "own100"
+    assert choice(report(0.5), report(0.49))["chosen"] == "off"  # excess 0.47 against 0.48: a tie, off stays
+    assert choice(report(0.5), report(0.6))["chosen"] == "off"
+
+
+def test_an_arm_that_loses_a_row_recognition_or_variation_is_not_eligible() -> None:
+    lost_row = choice(report(0.5), report(0.1, rows=()))
+    assert lost_row["eligible"] == {"off": True, "own100": False} and lost_row["chosen"] == "off"
+    assert choice(report(0.5, share=0.95), report(0.1, share=0.85))["chosen"] == "off"
+    narrower = choice(report(0.5), report(0.1, v_sd=0.4))  # capped log variation down ≈ 0.074 > 0.05
+    assert narrower["eligible"]["own100"] is False and narrower["chosen"] == "off"
+
+
+def test_the_block_states_the_verdict() -> None:
+    per_seed = {"100": {"off": run(report(0.5, no_plant=0.5)), "content100": run(report(0.04))}}
+    summary = {n: contact_template.arm_summary([per_seed["100"][n]]) for n in ("off", "content100")}
+    results = {"data": "bandai", "weight": 100.0, "arms": {"off": [], "content100": []}, "overrides": [],
+               "per_seed": per_seed, "summary": summary, "choice": contact_template.choose(summary)}
+    record = {"suite": "contact_template", "command": "c", "commit": "0" * 40, "started": "2026-12-07T06:00:00",
+              "machine": {"cpu": "x", "cores": 2}, "seeds": [100], "seconds": 1.0, "results": results}
+    text = contact_template.render(record)["headline"]
+    assert "Verdict: **content100** is chosen" in text
+    assert ("| **content100** | 0.04 ± 0.00 (0.04–0.04) | 0.020 ± 0.000 (0.020–0.020) | 0.02 ± 0.00 (0.02–0.02) |"
+            in text)
+    assert "| off | 0.50 ± 0.00 (0.50–0.50) |" in text and "0.50 ± 0.00 (0.50–0.50) | 30.0" in text
