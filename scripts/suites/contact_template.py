@@ -35,6 +35,7 @@ shown beside.
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 from typing import Any
 
 from suites import contact_full, style, style_channels
@@ -53,6 +54,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.set_defaults(runs=style.ROOT / "runs" / "benchmarks" / "contact_template")
     parser.add_argument("--weight", type=float, default=DEFAULT_WEIGHT, metavar="BETA",
                         help="β of the own and content arms (model.sample_contact_weight)")
+    parser.add_argument("--stance-samples", type=int, default=300, metavar="N",
+                        help="samples per model of the stance block (0: no stance block)")
     parser.add_argument("--arms", nargs="+", choices=("off", "own", "content"), default=["off", "own", "content"],
                         help="arms to run; off is always first (the rule's reference)")
 
@@ -122,6 +125,42 @@ def choose(summaries: dict[str, dict[str, Any]]) -> dict[str, Any]:
             "chosen": chosen}
 
 
+def stance_figures(out: Path, report: dict[str, Any], styles: list[str], samples: int, seed: int,
+                   real_cache: dict[str, dict[str, Any]]) -> dict[str, dict[str, Any]]:
+    """``<primitive>/<model>`` → stance travel of ``samples`` samples of the run's neutral VAE and CVAEs (seed
+    ``seed``); the style's real clips (train + val) go into ``real_cache`` (the same for every arm of a seed)."""
+    from stylemotion.datasets.registry import build_dataset
+    from stylemotion.evaluation.reference import primitive_data
+    from stylemotion.evaluation.sources import motions_from_clips
+    from stylemotion.models.loading import load_generative
+    from stylemotion.primitives.segmentation import parse_primitive, stance_foot
+    from stylemotion.primitives.stance import stance_travel
+
+    meta = report["meta"]
+    takeset = None
+    figures: dict[str, dict[str, Any]] = {}
+    for primitive in report["primitives"]:
+        folders = {"neutral": out / "vae" / primitive, **{st: out / "cvae" / f"{primitive}_{st}" for st in styles}}
+        for name, folder in folders.items():
+            model = load_generative(folder / "checkpoints" / "best.ckpt")
+            motions = model.sample(samples, seed=seed)
+            foot = stance_foot(parse_primitive(primitive)[1])
+            figures[f"{primitive}/{name}"] = stance_travel(motions.positions.numpy(), motions.num_frames.numpy(),
+                                                           motions.fps, foot).as_dict()
+            key = f"{primitive}/{name}"
+            if key not in real_cache:
+                if takeset is None:
+                    takeset = build_dataset(meta["data"])
+                data = primitive_data(takeset, primitive, model.timeline_frames, meta["settings"]["neutral_style"],
+                                      meta["settings"]["segment"], meta["data"].get("split"), heldout_splits=("val",))
+                style_name = meta["settings"]["neutral_style"] if name == "neutral" else name
+                real = motions_from_clips(data.split("train", style_name) + data.split("val", style_name),
+                                          model.timeline_frames)
+                real_cache[key] = stance_travel(real.positions.numpy(), real.num_frames.numpy(), real.fps,
+                                                data.stance_foot).as_dict()
+    return figures
+
+
 def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
     import torch
 
@@ -130,6 +169,7 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
     torch.set_num_threads(1)
     table = arms(args.weight, list(args.arms))
     per_seed: dict[str, dict[str, Any]] = {}
+    stance_real: dict[str, dict[str, Any]] = {}
     for seed in seeds:
         first = args.runs / args.data / f"seed{seed}" / "off"
         for name, overrides in table.items():
@@ -149,12 +189,16 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
                 "heldout_splits": report["meta"]["settings"]["heldout_splits"],
                 "cvae_minutes": round(style.stage_minutes(recorded, "cvae"), 2),
                 "cases": style_channels.case_figures(report, styles), "stance": case_stance(report, styles)}
+            if args.stance_samples > 0:
+                per_seed[str(seed)][name]["stance_travel"] = stance_figures(
+                    out, report, styles, args.stance_samples, seed, stance_real.setdefault(str(seed), {}))
     summaries = {name: arm_summary([s[name] for s in per_seed.values()]) for name in table}
     return {"data": args.data, "weight": args.weight, "arms": table, "overrides": args.override,
             "splits": {"choose": "evaluation.heldout_splits=[val], as suites style_channels and contact_draws: no "
                                  "test clip is read by the figures the rule uses",
                        "seeds": "training seeds, not reported seeds"},
-            "per_seed": per_seed, "summary": summaries, "choice": choose(summaries)}
+            "per_seed": per_seed, "summary": summaries, "choice": choose(summaries),
+            "stance_samples": args.stance_samples, "stance_real": stance_real}
 
 
 def render(record: dict[str, Any]) -> dict[str, str]:
@@ -189,4 +233,39 @@ def render(record: dict[str, Any]) -> dict[str, str]:
                     "never planted, samples", "skating, samples (%)", "skating, real (%)", "skating ÷ real",
                     "rows on diagonal", "recognition", "V_SD / style", "step_SD / style", "diversity / style",
                     "mean capped log variation", "CVAE minutes per run", "eligible"], rows)
-        + f"\n\n{provenance_line(record)}")}
+        + f"\n\n{provenance_line(record)}"),
+        **({"stance": f"{render_stance(r)}\n\n{provenance_line(record)}"} if r.get("stance_samples") else {})}
+
+
+#: Columns of the stance block: key of :class:`stylemotion.primitives.stance.StanceTravel`, header, digits.
+STANCE_COLUMNS = (("travel_ratio", "root ÷ leg travel", 2), ("foot_drift_m", "stance foot drift (m)", 3),
+                  ("root_speed_mps", "root speed (m/s)", 2), ("duration_s", "duration (s)", 2))
+
+
+def render_stance(r: dict[str, Any]) -> str:
+    """The stance block: per model (neutral, then styles) and arm, mean ± sd (min–max) over seeds and stances."""
+    sd = contact_full.sd
+    arms_ = list(r["summary"])
+    models: list[str] = []
+    for seed in r["per_seed"].values():
+        for key in seed[arms_[0]].get("stance_travel", {}):
+            model = key.split("/", 1)[1]
+            if model not in models:
+                models.append(model)
+
+    def values(source: list[dict[str, Any]], model: str, column: str) -> dict[str, Any]:
+        return spread(v[column] for d in source for k, v in d.items() if k.split("/", 1)[1] == model)
+
+    rows = []
+    for model in models:
+        real = list(r["stance_real"].values())
+        rows.append([model, "real clips (train + val)", *(sd(values(real, model, c), d) for c, _, d in STANCE_COLUMNS)])
+        for arm in arms_[:1] if model == "neutral" else arms_:  # the arms share the neutral VAE stage
+            source = [seed[arm].get("stance_travel", {}) for seed in r["per_seed"].values()]
+            label = "VAE samples (every arm's)" if model == "neutral" else arm
+            rows.append(["", label, *(sd(values(source, model, c), d) for c, _, d in STANCE_COLUMNS)])
+    return (f"Stance travel over the middle half of each motion ({r['stance_samples']} samples per model and seed; "
+            "real clips: the style's train + val clips), mean ± sd (min–max) over training seeds and both stances. "
+            "Root ÷ leg travel: the root's travel over that of the root relative to the stance foot (median over "
+            "motions; 1 when the foot holds the ground); drift: the stance foot's own travel. Not ruled on.\n\n"
+            + md_table(["model", "arm", *(h for _, h, _ in STANCE_COLUMNS)], rows))

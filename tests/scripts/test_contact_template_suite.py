@@ -77,3 +77,23 @@ def test_the_block_states_the_verdict() -> None:
     assert ("| **content100** | 0.04 ± 0.00 (0.04–0.04) | 0.020 ± 0.000 (0.020–0.020) | 0.02 ± 0.00 (0.02–0.02) |"
             in text)
     assert "| off | 0.50 ± 0.00 (0.50–0.50) |" in text and "0.50 ± 0.00 (0.50–0.50) | 30.0" in text
+
+
+def test_the_stance_block_pools_seeds_and_stances_and_shows_the_shared_vae_once() -> None:
+    def travel(ratio: float) -> dict:
+        return {"travel_ratio": ratio, "foot_drift_m": 0.1, "root_speed_mps": 1.0, "duration_s": 0.5}
+
+    per_seed = {seed: {arm: {"stance_travel": {"walk_leftStance/neutral": travel(0.9),
+                                               "walk_rightStance/neutral": travel(0.9),
+                                               "walk_leftStance/a": travel(ratio),
+                                               "walk_rightStance/a": travel(ratio + 0.1)}}
+                       for arm, ratio in (("off", 0.4), ("content100", 0.9))} for seed in ("100", "101")}
+    real = {seed: {"walk_leftStance/neutral": travel(1.0), "walk_rightStance/neutral": travel(1.0),
+                   "walk_leftStance/a": travel(1.0), "walk_rightStance/a": travel(1.0)} for seed in per_seed}
+    results = {"summary": {"off": {}, "content100": {}}, "per_seed": per_seed, "stance_real": real,
+               "stance_samples": 300}
+    text = contact_template.render_stance(results)
+    assert "| neutral | real clips (train + val) | 1.00 ± 0.00 (1.00–1.00) |" in text
+    assert "|  | VAE samples (every arm's) | 0.90 ± 0.00 (0.90–0.90) |" in text
+    assert text.count("VAE samples") == 1
+    assert "|  | off | 0.45 ± 0.06 (0.40–0.50) |" in text and "|  | content100 | 0.95 ± 0.06 (0.90–1.00) |" in text
