@@ -533,13 +533,16 @@ def leave_one_style_out(run: str | Path, out: str | Path, styles: Sequence[str] 
             trained[s] = {"checkpoint": str(path), "train_seconds": seconds}
         cvaes = [load_model(source.cvaes[(q, s)], source.settings.neutral_style, judge)
                  for q, s in source.cvaes if q == p]
-        unseen = ({s: _unseen_cvae(source, p, s, out, seed, threads, generators[s], cvaes) for s in wanted}
-                  if cvae_unseen and not shared_autoencoder else None)
+        unseen_trained = ({s: _unseen_cvae(source, p, s, out, seed, threads, generators[s], cvaes) for s in wanted}
+                          if cvae_unseen and not shared_autoencoder else {})
+        unseen = {s: model for s, (model, _) in unseen_trained.items()} or None
         results[p] = evaluate_primitive(p, networks, cvaes, takeset, judge, source.settings,
                                         source.data_cfg.get("split"), samples, seed, shared_autoencoder, unseen)
         for s, record in trained.items():
             row = results[p]["styles"][s]
             row["zero_shot"]["train_seconds"] = record["train_seconds"]
+            if s in unseen_trained:
+                row[UNSEEN_ROW]["train_seconds"] = unseen_trained[s][1]
             row["generator_autoencoder"].update({k: v for k, v in generators[s].items() if k != "path"},
                                                 path=str(generators[s]["path"]))
     payload = {"primitives": results, "summary": _summary(results), "splits": splits_record(source, shared_autoencoder),
@@ -562,9 +565,10 @@ def unseen_cvae_folder(out: Path, primitive: str, style: str) -> Path:
 
 
 def _unseen_cvae(source: ReproduceRun, primitive: str, style: str, out: Path, seed: int, threads: Any,
-                 generator: Mapping[str, Any], run_cvaes: Sequence[EvalModel]) -> EvalModel:
+                 generator: Mapping[str, Any], run_cvaes: Sequence[EvalModel]) -> tuple[EvalModel, float | None]:
     """The CVAE of ``style`` trained as the run's CVAE stage of ``(primitive, style)`` (its overrides and values) but
-    on the ``generator`` autoencoder (trained without the style), loaded with that autoencoder.
+    on the ``generator`` autoencoder (trained without the style), loaded with that autoencoder, and its training
+    seconds (None when reused).
 
     Raises:
         ZeroShotRunError: its example clips differ from the run's CVAE's (the comparison would not be like for like).
@@ -575,14 +579,14 @@ def _unseen_cvae(source: ReproduceRun, primitive: str, style: str, out: Path, se
     with hydra_configs():
         cfg = stage_train_config(list(stage.get("overrides") or []), dict(stage.get("values") or {}), source.data_cfg,
                                  folder, seed, threads, autoencoder_ckpt=str(generator["path"]))
-    path, _ = train_once(_quiet(cfg), f"{primitive} CVAE of {style} on the autoencoder without it")
+    path, seconds = train_once(_quiet(cfg), f"{primitive} CVAE of {style} on the autoencoder without it")
     model = load_model(path, source.settings.neutral_style)
     run_examples = next(m.examples for m in run_cvaes if m.style == style)
     clip = ("take", "start", "stop", "primitive")
     if [tuple(e.get(k) for k in clip) for e in model.examples] != [tuple(e.get(k) for k in clip) for e in run_examples]:
         raise ZeroShotRunError(f"{path}: its example clips {model.examples} are not the run's CVAE's {run_examples}; "
                                "delete it and check the run's CVAE stage settings")
-    return model
+    return model, seconds
 
 
 def _generator_autoencoder(source: ReproduceRun, style: str, out: Path, seed: int, threads: Any,
