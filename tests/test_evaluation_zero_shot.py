@@ -33,6 +33,7 @@ from stylemotion.evaluation.zero_shot import (
     model_folder,
     read_run,
     train_config,
+    unseen_cvae_folder,
 )
 from stylemotion.io.outputs import OutputExistsError
 from stylemotion.models.checkpoints import fingerprint, load_autoencoder
@@ -215,6 +216,46 @@ def test_a_generator_with_other_normalization_statistics_is_judged_by_its_motion
     z = torch.randn(4, network.hparams.latent_dim, generator=gen)
     assert not torch.allclose(wrong.decode_latent(z, example=condition).frames,
                               generator.decode_latent(z, example=condition).frames, atol=1e-3)
+
+
+@pytest.mark.slow  # an autoencoder, a network and a CVAE trained without elderly, one evaluation
+def test_the_cvae_on_the_autoencoder_without_the_style_is_a_row_beside_the_network(run, tmp_path) -> None:
+    """``cvae_unseen``: the run's CVAE stage (its settings, its example clips) on the generator's autoencoder, which
+    never saw the style: its recognition recomputed by hand; variation figures on every row; reused when resumed."""
+    out = tmp_path / "loso"
+    results = leave_one_style_out(run, out, [STYLE], [PRIMITIVE], epochs=2, samples=SAMPLES, seed=SEED,
+                                  overrides=NETWORK, threads=1, cvae_unseen=True)
+    source = read_run(run)
+    row = results["primitives"][PRIMITIVE]["styles"][STYLE]
+    ae_ckpt = Path(row["generator_autoencoder"]["path"])
+    unseen = load_model(unseen_cvae_folder(out, PRIMITIVE, STYLE) / "checkpoints" / "best.ckpt",
+                        source.settings.neutral_style)
+    run_cvae = load_model(source.cvaes[(PRIMITIVE, STYLE)], source.settings.neutral_style)
+    assert unseen.source.spec["autoencoder"]["fingerprint"] == fingerprint(load_autoencoder(ae_ckpt))
+    assert run_cvae.source.spec["autoencoder"]["fingerprint"] != unseen.source.spec["autoencoder"]["fingerprint"]
+    assert [e["take"] for e in unseen.examples] == [e["take"] for e in run_cvae.examples]
+    stage = next(st for st in source.stages("cvae") if st["values"] == {"primitive": PRIMITIVE, "style": STYLE})
+    assert unseen.source.hparams.style_weight == run_cvae.source.hparams.style_weight and stage["overrides"]
+    judge = load_autoencoder(source.autoencoder_ckpt)
+    length = results["primitives"][PRIMITIVE]["timeline_frames"]
+    data = primitive_data(build_dataset(source.data_cfg), PRIMITIVE, length, source.settings.neutral_style,
+                          asdict(source.settings.segment), source.data_cfg.get("split"))
+    drawn = unseen.source.sample(SAMPLES, seed=SEED)  # decoded by its own autoencoder, judged in the run's space
+    share, own = hand_row(source, judge, data.split, drawn.normalized_frames, drawn.duration_s, STYLE,
+                          example_gram(judge, data, run_cvae), length)
+    assert row["cvae_unseen"]["recognition"] == share
+    assert row["cvae_unseen"]["table_5_1_row"][STYLE] == pytest.approx(own, rel=1e-5)
+    for kind in ("zero_shot", "cvae", "cvae_unseen", "real"):
+        assert set(row[kind]["variation"]) == {"pose_sd", "v_sd", "step_sd", "diversity"}
+        assert all(v > 0 for v in row[kind]["variation"].values()), kind
+    assert results["summary"]["cvae_unseen"]["rows"] == 1 and results["meta"]["cvae_unseen"] is True
+    with logged_lines("stylemotion.evaluation.zero_shot") as resumed:
+        again = leave_one_style_out(run, out, [STYLE], [PRIMITIVE], epochs=2, samples=SAMPLES, seed=SEED,
+                                    overrides=NETWORK, threads=1, resume=True, cvae_unseen=True)
+    assert sum("reused" in line for line in resumed) == 3
+    assert again["primitives"][PRIMITIVE]["styles"][STYLE]["cvae_unseen"] == {**row["cvae_unseen"],
+                                                                              "train_seconds": None}
+    assert row["cvae_unseen"]["train_seconds"] > 0
 
 
 def test_the_train_configs_leave_the_style_out_of_the_runs_data(run, tmp_path) -> None:

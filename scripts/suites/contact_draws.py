@@ -68,16 +68,25 @@ def candidate_summary(runs: list[dict[str, Any]]) -> dict[str, Any]:
             "cvae_minutes": sum(run["cvae_minutes"] for run in runs) / len(runs) if runs else None}
 
 
-def choose(summaries: dict[str, dict[str, Any]]) -> dict[str, Any]:
-    """The module doc's rule; the first key is β = 0."""
+def eligibility(summaries: dict[str, dict[str, Any]]) -> tuple[dict[str, bool], float, float]:
+    """Which candidates keep the first one's styled rows, recognition (floor min(0.9, its mean)) and capped log
+    variation (its own minus :data:`suites.style_channels.TIE`); returns (eligible, recognition floor, variation
+    floor). The first candidate is always eligible."""
     names = list(summaries)
-    zero = summaries[names[0]]
-    floor = min(style_channels.AIMS["recognition"], zero["styled"]["recognition"]["mean"])
-    variation_floor = zero["styled"]["capped_log_variation"] - style_channels.TIE
-    eligible = {n: n == names[0] or (s["styled"]["rows_on_diagonal"] >= zero["styled"]["rows_on_diagonal"]
+    first = summaries[names[0]]["styled"]
+    floor = min(style_channels.AIMS["recognition"], first["recognition"]["mean"])
+    variation_floor = first["capped_log_variation"] - style_channels.TIE
+    eligible = {n: n == names[0] or (s["styled"]["rows_on_diagonal"] >= first["rows_on_diagonal"]
                                      and s["styled"]["recognition"]["mean"] >= floor
                                      and s["styled"]["capped_log_variation"] >= variation_floor)
                 for n, s in summaries.items()}
+    return eligible, floor, variation_floor
+
+
+def choose(summaries: dict[str, dict[str, Any]]) -> dict[str, Any]:
+    """The module doc's rule; the first key is β = 0."""
+    names = list(summaries)
+    eligible, floor, variation_floor = eligibility(summaries)
 
     def skating(n: str) -> float:
         mean = summaries[n]["styled_skating_relative"].get("mean")

@@ -38,7 +38,7 @@ import argparse
 from pathlib import Path
 from typing import Any
 
-from suites import contact_full, style, style_channels
+from suites import contact_draws, contact_full, style, style_channels
 from suites.common import fmt, md_table, provenance_line, spread
 
 DESCRIPTION = ("where the style CVAE's draws' contact term holds their feet (their own contacts or the content "
@@ -105,13 +105,7 @@ def arm_summary(runs: list[dict[str, Any]]) -> dict[str, Any]:
 def choose(summaries: dict[str, dict[str, Any]]) -> dict[str, Any]:
     """The module doc's rule; the first key is ``off``."""
     names = list(summaries)
-    off = summaries[names[0]]
-    floor = min(style_channels.AIMS["recognition"], off["styled"]["recognition"]["mean"])
-    variation_floor = off["styled"]["capped_log_variation"] - style_channels.TIE
-    eligible = {n: n == names[0] or (s["styled"]["rows_on_diagonal"] >= off["styled"]["rows_on_diagonal"]
-                                     and s["styled"]["recognition"]["mean"] >= floor
-                                     and s["styled"]["capped_log_variation"] >= variation_floor)
-                for n, s in summaries.items()}
+    eligible, floor, variation_floor = contact_draws.eligibility(summaries)
 
     def mid(n: str) -> float:
         mean = summaries[n]["mid_excess"].get("mean")

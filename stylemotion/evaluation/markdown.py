@@ -78,6 +78,10 @@ DEFINITIONS = {
                     "real train takes) whose planted-point speed (slower of heel and ball) exceeds skate_speed_mps; "
                     "contact_share, no_plant_share (stance foot never in contact) and planted_mid_mps (stance "
                     "foot speed over the middle half) catch feet that slide too fast to be detected as contact.",
+    "stance_travel": "over the middle half of each motion of a stance primitive, the root's horizontal travel ÷ its "
+                     "travel relative to the stance foot (median over motions; 1 when the foot holds the ground), "
+                     "the stance foot's own travel (drift, m), the root speed and the duration "
+                     "(stylemotion.primitives.stance): a leg sweep the root does not follow makes the foot slide.",
     "nearest_training": "RMS joint distance (root-local poses on the canonical timeline, metres) from each motion "
                         "to its nearest training clip (neutral train clips + the model's example); medians. Samples "
                         "much closer than real unseen clips are copies.",
@@ -278,6 +282,15 @@ def _metric_sections(results: dict[str, Any]) -> list[str]:
                          fmt(r["planted_mid_mps"], 3)])
     out += [md_table(["primitive", "model", "skating", "real", "contact", "real", "no plant", "real",
                        "planted mid m/s", "real"], body), ""]
+    body = [[p, m, fmt(d["samples"]["travel_ratio"], 3), fmt(d["real"]["travel_ratio"], 3),
+             fmt(d["samples"]["foot_drift_m"], 3), fmt(d["real"]["foot_drift_m"], 3),
+             fmt(d["samples"]["root_speed_mps"], 3), fmt(d["real"]["root_speed_mps"], 3),
+             fmt(d["samples"]["duration_s"], 3), fmt(d["real"]["duration_s"], 3)]
+            for p, models in results.get("stance_travel", {}).items() for m, d in models.items()]
+    if body:
+        out += ["Stance travel (middle half of each motion; real: the model's ground-truth clips):", "",
+                md_table(["primitive", "model", "root ÷ leg travel", "real", "stance foot drift m", "real",
+                          "root speed m/s", "real", "duration s", "real"], body), ""]
     out += ["## Nearest training clip (copying check)", "", "Medians, cm (RMS joint distance of root-local poses).", ""]
     body = []
     for p, models in results.get("nearest_training", {}).items():

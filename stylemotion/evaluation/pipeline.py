@@ -67,6 +67,7 @@ from stylemotion.models.sampling import MotionSamples, decode_features
 from stylemotion.models.style import mean_gram
 from stylemotion.primitives.actions import segment_action
 from stylemotion.primitives.segmentation import Segmentation, parse_primitive, time_normalize
+from stylemotion.primitives.stance import stance_travel
 
 log = logging.getLogger(__name__)
 
@@ -120,7 +121,7 @@ def evaluate_models(models: Sequence[EvalModel], takeset: TakeSet, autoencoder, 
                 "no VAE/CVAE of that primitive is evaluated (such rows stand beside one)"))
     results: dict[str, Any] = {key: {} for key in (
         "table_5_1", "variance", "variance_ratio", "variance_real", "variation_vs_style", "frechet",
-        "frechet_reference", "diversity", "foot_skating_detail", "nearest_training")}
+        "frechet_reference", "diversity", "foot_skating_detail", "stance_travel", "nearest_training")}
     recognition: dict[str, Any] = {"per_primitive": {}, "per_model_detail": {}}
     skating: dict[str, list] = defaultdict(list)
     skating_real: dict[str, list] = defaultdict(list)
@@ -432,6 +433,15 @@ def skating(real: RealSide, model: EvalModel, samples: MotionSamples, settings: 
                      data.stance_foot, settings.skate_speed_mps))
 
 
+def stance(real: RealSide, model: EvalModel, samples: MotionSamples) -> dict[str, Any]:
+    """Root travel against the stance leg's sweep (:func:`stylemotion.primitives.stance.stance_travel`) of a model's
+    samples and of its real ground truth (``report.json`` ``stance_travel.<primitive>.<model>``)."""
+    truth, foot = real.truth[model.name], real.data.stance_foot
+    return {"samples": stance_travel(samples.positions.numpy(), samples.num_frames.numpy(), samples.fps,
+                                     foot).as_dict(),
+            "real": stance_travel(truth.positions.numpy(), truth.num_frames.numpy(), truth.fps, foot).as_dict()}
+
+
 @dataclass
 class StyleTable:
     """Table 5.1 of one primitive: ``distance[i][j]`` = D(models[i], examples[j]).
@@ -527,7 +537,7 @@ def _evaluate_primitive(primitive: str, models: list[EvalModel], takeset: TakeSe
     variance = real_variance(real)
     train_poses = pose_sequences(real.training.normalized_frames.numpy())
     out: dict[str, Any] = {"frechet": {}, "frechet_reference": {}, "diversity": {}, "foot_skating_detail": {},
-                           "nearest_training": {}, "recognition": {}, "skating": {},
+                           "stance_travel": {}, "nearest_training": {}, "recognition": {}, "skating": {},
                            "classifier": real.classifier_result}
     table_frames = []
     neutral_features = None
@@ -551,6 +561,8 @@ def _evaluate_primitive(primitive: str, models: list[EvalModel], takeset: TakeSe
         sk = skating(real, m, s, settings)
         out["skating"][m.name] = {"samples": sk.samples, "real": sk.real}
         out["foot_skating_detail"][m.name] = sk.as_dict()
+        if real.data.stance_foot is not None:
+            out["stance_travel"][m.name] = stance(real, m, s)
         out["nearest_training"][m.name] = _nearest(train_poses, real.examples[m.name], s, real.truth[m.name],
                                                    real.heldout_neutral, real.length)
         log.debug("%s/%s evaluated in %.1f s", primitive, m.name, time.perf_counter() - t0)

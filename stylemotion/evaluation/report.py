@@ -111,6 +111,12 @@ def write_csvs(results: dict[str, Any], folder: Path) -> list[str]:
             for kind in ("samples", "real")]
     if rows:
         put("foot_skating.csv", ["primitive", "model", "motions_of"] + keys, rows)
+    keys = ["travel_ratio", "foot_drift_m", "root_speed_mps", "duration_s", "root_travel_m", "leg_travel_m", "motions"]
+    rows = [[p, m, kind] + [d[kind][k] for k in keys]
+            for p, ms in results.get("stance_travel", {}).items() for m, d in ms.items()
+            for kind in ("samples", "real")]
+    if rows:
+        put("stance_travel.csv", ["primitive", "model", "motions_of"] + keys, rows)
     keys = ["samples_median_m", "heldout_neutral_median_m", "ground_truth_median_m", "to_example_median_m",
             "ground_truth_to_example_median_m", "training_clips"]
     rows = [[p, m] + [d.get(k) for k in keys] for p, ms in results.get("nearest_training", {}).items()

@@ -58,10 +58,11 @@ from omegaconf import DictConfig, OmegaConf, open_dict
 
 from stylemotion.config import config_dir, positive_int, set_torch_threads
 from stylemotion.datasets import TakeSet, build_dataset
+from stylemotion.evaluation.metrics import diversity
 from stylemotion.evaluation.pipeline import example_column_gram, real_side, recognition
 from stylemotion.evaluation.settings import EvalSettings
 from stylemotion.evaluation.sources import MixedAutoencodersError, check_one_autoencoder
-from stylemotion.evaluation.tables import across_sample_sd, distance_table
+from stylemotion.evaluation.tables import across_sample_sd, distance_table, variance_stats
 from stylemotion.io.atomic import atomic_write_bytes
 from stylemotion.io.errors import UserInputError
 from stylemotion.io.jsonfile import read_json_object as read_record
@@ -81,6 +82,8 @@ log = logging.getLogger(__name__)
 #: The rows of each left-out style: the two models, the style's real clips, and those clips through the
 #: generator's autoencoder.
 ROWS = ("zero_shot", "cvae", "real", "reconstructed")
+#: The row ``cvae_unseen=True`` adds: a CVAE of the style trained as the run's, on the generator's autoencoder.
+UNSEEN_ROW = "cvae_unseen"
 #: What ``meta.leaky`` says of an output of the shared-autoencoder protocol.
 LEAKY = ("the networks were trained on the run's autoencoder, which was trained on every style, the left-out one "
          "included: the left-out style leaked into the generator (not evidence of generalization to an unseen style)")
@@ -306,14 +309,22 @@ def _table_row(autoencoder, frames, style: str, columns: list[str], grams: torch
             "pose_across_sd": across_sample_sd(frames.numpy())}
 
 
+def _variation(real, motions, settings: EvalSettings) -> dict[str, float]:
+    """pose_SD (cm), V_SD, step_SD (cm) (:func:`~stylemotion.evaluation.tables.variance_stats`) and diversity (mean
+    pairwise distance in the classifier's features, :func:`~stylemotion.evaluation.metrics.diversity`) of motions."""
+    stats = variance_stats(motions.frames.numpy(), motions.positions.numpy(), motions.num_frames.numpy())
+    return {**{k: float(stats[k]) for k in ("pose_sd", "v_sd", "step_sd")},
+            "diversity": float(diversity(real.features(motions), settings.diversity_items))}
+
+
 def _model_row(real, autoencoder, model: EvalModel, columns: list[str], grams: torch.Tensor, samples: int,
                seed: int, settings: EvalSettings) -> dict[str, Any]:
-    """Recognition, Table 5.1 row and spread of ``samples`` samples of one model of a left-out style."""
+    """Recognition, Table 5.1 row, spread and variation of ``samples`` samples of one model of a left-out style."""
     drawn = model.source.sample(samples, seed=seed)
     judged = recognition(real, model, real.features(drawn), real.features(real.truth[model.style]))
     return {"checkpoint": model.checkpoint, "recognition": judged.share, "predicted": judged.predicted,
             **_table_row(autoencoder, drawn.normalized_frames, model.style, columns, grams, settings),
-            "samples": int(samples)}
+            "variation": _variation(real, drawn, settings), "samples": int(samples)}
 
 
 def _real_row(real, autoencoder, style: str, columns: list[str], grams: torch.Tensor,
@@ -323,7 +334,7 @@ def _real_row(real, autoencoder, style: str, columns: list[str], grams: torch.Te
     predicted = real.classifier.predict_features(real.features(truth))
     return {"recognition": float((predicted == style).mean()),
             **_table_row(autoencoder, truth.normalized_frames, style, columns, grams, settings),
-            "clips": len(truth)}
+            "variation": _variation(real, truth, settings), "clips": len(truth)}
 
 
 @torch.no_grad()
@@ -357,7 +368,8 @@ def generator_autoencoder(network: ZeroShotStyleVAE) -> dict[str, Any]:
 
 def evaluate_primitive(primitive: str, left_out: Mapping[str, ZeroShotStyleVAE], cvaes: Sequence[EvalModel],
                        takeset: TakeSet, autoencoder, settings: EvalSettings, split: Mapping[str, Any] | None,
-                       samples: int, seed: int, shared_autoencoder: bool = False) -> dict[str, Any]:
+                       samples: int, seed: int, shared_autoencoder: bool = False,
+                       unseen_cvaes: Mapping[str, EvalModel] | None = None) -> dict[str, Any]:
     """Each left-out network of ``primitive`` against the CVAE of its style, in one judge space (module doc).
 
     Args:
@@ -370,6 +382,7 @@ def evaluate_primitive(primitive: str, left_out: Mapping[str, ZeroShotStyleVAE],
             reach it as decoded frames and are re-encoded with its own frame normalization.
         samples, seed: samples per model and their seed.
         shared_autoencoder: the networks must decode with the judge autoencoder itself (the leaky protocol).
+        unseen_cvaes: style → a CVAE of it trained on the network's autoencoder (row ``cvae_unseen``), or None.
 
     Raises:
         ZeroShotRunError: a left-out style without a CVAE, or a network on another timeline.
@@ -413,6 +426,9 @@ def evaluate_primitive(primitive: str, left_out: Mapping[str, ZeroShotStyleVAE],
             "real": _real_row(real, autoencoder, style, columns, grams, settings),
             "reconstructed": _reconstructed_row(real, autoencoder, network.autoencoder, style, columns, grams,
                                                 settings)}
+        if unseen_cvaes and style in unseen_cvaes:
+            out["styles"][style][UNSEEN_ROW] = _model_row(real, autoencoder, unseen_cvaes[style], columns, grams,
+                                                          samples, seed, settings)
     return out
 
 
@@ -422,8 +438,10 @@ def evaluate_primitive(primitive: str, left_out: Mapping[str, ZeroShotStyleVAE],
 def _summary(per_primitive: Mapping[str, Any]) -> dict[str, Any]:
     """Per row kind: the mean recognition and how many rows have their own column as minimum."""
     out = {}
-    for kind in ROWS:
-        rows = [s[kind] for p in per_primitive.values() for s in p["styles"].values()]
+    for kind in (*ROWS, UNSEEN_ROW):
+        rows = [s[kind] for p in per_primitive.values() for s in p["styles"].values() if kind in s]
+        if not rows and kind == UNSEEN_ROW:
+            continue
         out[kind] = {"mean_recognition": sum(r["recognition"] for r in rows) / len(rows) if rows else math.nan,
                      "own_column_is_minimum": sum(r["own_column_is_minimum"] for r in rows), "rows": len(rows)}
     return out
@@ -450,7 +468,8 @@ def splits_record(source: ReproduceRun, shared_autoencoder: bool) -> dict[str, A
 def leave_one_style_out(run: str | Path, out: str | Path, styles: Sequence[str] | None = None,
                         primitives: Sequence[str] | None = None, epochs: int | None = None, samples: int = 1000,
                         seed: int | None = None, overrides: Sequence[str] = (), threads: Any = None,
-                        force: bool = False, resume: bool = False, shared_autoencoder: bool = False) -> dict[str, Any]:
+                        force: bool = False, resume: bool = False, shared_autoencoder: bool = False,
+                        cvae_unseen: bool = False) -> dict[str, Any]:
     """The leave-one-style-out evaluation (see the module doc); returns what ``zero_shot.json`` holds.
 
     Args:
@@ -465,6 +484,10 @@ def leave_one_style_out(run: str | Path, out: str | Path, styles: Sequence[str] 
         threads: torch threads.
         resume: keep ``out`` and reuse the trainings that finished there (same settings), resume interrupted ones.
         shared_autoencoder: the earlier, **leaky** protocol: networks on the run's autoencoder (``meta.leaky``).
+        cvae_unseen: also train, per left-out style and primitive, a CVAE exactly as the run's CVAE stage but on
+            the generator's autoencoder (which never saw the style; the same example clips) into
+            ``<out>/models/<p>_cvae_on_without_<s>``: row ``cvae_unseen``, what ``stylemotion-style method=cvae``
+            gives a user whose style the run's autoencoder never saw.
 
     Raises:
         OutputExistsError: ``out`` exists and neither ``force`` nor ``resume`` is on (before any work).
@@ -510,17 +533,22 @@ def leave_one_style_out(run: str | Path, out: str | Path, styles: Sequence[str] 
             trained[s] = {"checkpoint": str(path), "train_seconds": seconds}
         cvaes = [load_model(source.cvaes[(q, s)], source.settings.neutral_style, judge)
                  for q, s in source.cvaes if q == p]
+        unseen_trained = ({s: _unseen_cvae(source, p, s, out, seed, threads, generators[s], cvaes) for s in wanted}
+                          if cvae_unseen and not shared_autoencoder else {})
+        unseen = {s: model for s, (model, _) in unseen_trained.items()} or None
         results[p] = evaluate_primitive(p, networks, cvaes, takeset, judge, source.settings,
-                                        source.data_cfg.get("split"), samples, seed, shared_autoencoder)
+                                        source.data_cfg.get("split"), samples, seed, shared_autoencoder, unseen)
         for s, record in trained.items():
             row = results[p]["styles"][s]
             row["zero_shot"]["train_seconds"] = record["train_seconds"]
+            if s in unseen_trained:
+                row[UNSEEN_ROW]["train_seconds"] = unseen_trained[s][1]
             row["generator_autoencoder"].update({k: v for k, v in generators[s].items() if k != "path"},
                                                 path=str(generators[s]["path"]))
     payload = {"primitives": results, "summary": _summary(results), "splits": splits_record(source, shared_autoencoder),
                "meta": {"run": str(source.folder.resolve()), "data": source.data_cfg, "seed": seed,
                         "samples": samples, "epochs": epochs, "overrides": list(overrides),
-                        "leaky": LEAKY if shared_autoencoder else False,
+                        "leaky": LEAKY if shared_autoencoder else False, "cvae_unseen": bool(unseen),
                         "autoencoders": "shared (the run's)" if shared_autoencoder else "one per left-out style",
                         "judge_autoencoder": judge_info,
                         "settings": asdict(source.settings), **provenance(),
@@ -528,6 +556,37 @@ def leave_one_style_out(run: str | Path, out: str | Path, styles: Sequence[str] 
     write_json(out / "zero_shot.json", payload)
     atomic_write_bytes(out / "zero_shot.md", markdown(payload).encode())
     return payload
+
+
+def unseen_cvae_folder(out: Path, primitive: str, style: str) -> Path:
+    """Where the CVAE of ``style`` on the autoencoder without it is trained:
+    ``<out>/models/<p>_cvae_on_without_<s>``."""
+    return inside(out, "models", f"{primitive}_cvae_on_without_{safe_name(style, 'style label')}")
+
+
+def _unseen_cvae(source: ReproduceRun, primitive: str, style: str, out: Path, seed: int, threads: Any,
+                 generator: Mapping[str, Any], run_cvaes: Sequence[EvalModel]) -> tuple[EvalModel, float | None]:
+    """The CVAE of ``style`` trained as the run's CVAE stage of ``(primitive, style)`` (its overrides and values) but
+    on the ``generator`` autoencoder (trained without the style), loaded with that autoencoder, and its training
+    seconds (None when reused).
+
+    Raises:
+        ZeroShotRunError: its example clips differ from the run's CVAE's (the comparison would not be like for like).
+    """
+    stage = next(st for st in source.stages("cvae")
+                 if (st["values"]["primitive"], st["values"]["style"]) == (primitive, style))
+    folder = unseen_cvae_folder(out, primitive, style)
+    with hydra_configs():
+        cfg = stage_train_config(list(stage.get("overrides") or []), dict(stage.get("values") or {}), source.data_cfg,
+                                 folder, seed, threads, autoencoder_ckpt=str(generator["path"]))
+    path, seconds = train_once(_quiet(cfg), f"{primitive} CVAE of {style} on the autoencoder without it")
+    model = load_model(path, source.settings.neutral_style)
+    run_examples = next(m.examples for m in run_cvaes if m.style == style)
+    clip = ("take", "start", "stop", "primitive")
+    if [tuple(e.get(k) for k in clip) for e in model.examples] != [tuple(e.get(k) for k in clip) for e in run_examples]:
+        raise ZeroShotRunError(f"{path}: its example clips {model.examples} are not the run's CVAE's {run_examples}; "
+                               "delete it and check the run's CVAE stage settings")
+    return model, seconds
 
 
 def _generator_autoencoder(source: ReproduceRun, style: str, out: Path, seed: int, threads: Any,
@@ -579,14 +638,17 @@ def markdown(results: Mapping[str, Any]) -> str:
              "style; `real`: the style's real clips (all but its example; the classifier was fitted on its "
              "train-split ones). Spread: pose_across_SD of the samples / of those real clips.", ""]
     rows = []
+    unseen = bool(meta.get("cvae_unseen"))
     for p, res in results["primitives"].items():
         for s, r in res["styles"].items():
             zs, cv, real = r["zero_shot"], r["cvae"], r["real"]
-            rows.append([p, s, _pct(zs["recognition"]), _pct(cv["recognition"]), _pct(real["recognition"]),
+            extra = [_pct(r[UNSEEN_ROW]["recognition"])] if unseen else []
+            rows.append([p, s, _pct(zs["recognition"]), _pct(cv["recognition"]), *extra, _pct(real["recognition"]),
                          _pct(r["reconstructed"]["recognition"]), _pct(zs["pose_across_sd"] / real["pose_across_sd"]),
                          _pct(cv["pose_across_sd"] / real["pose_across_sd"])])
-    lines += [_table(["primitive", "left-out style", "zero-shot", "CVAE", "real", "real through the generator's AE",
-                      "zero-shot spread", "CVAE spread"], rows), ""]
+    lines += [_table(["primitive", "left-out style", "zero-shot", "CVAE",
+                      *(["CVAE on the AE without the style"] if unseen else []), "real",
+                      "real through the generator's AE", "zero-shot spread", "CVAE spread"], rows), ""]
     summary = results["summary"]
     nearest = ", ".join(f"{label} {summary[kind]['own_column_is_minimum']}/{summary[kind]['rows']}"
                         for kind, label in (("zero_shot", "zero-shot"), ("cvae", "CVAE"), ("real", "real clips")))

@@ -50,6 +50,19 @@ class FootSkating:
         return asdict(self)
 
 
+def padded_motions(positions: np.ndarray, num_frames: np.ndarray, min_frames: int) -> tuple[np.ndarray, np.ndarray]:
+    """Padded motions ``(n, frames, 21, 3)`` as float64 and their valid frame counts ``(n,)`` as int64, checked: at
+    least one motion, each with ``min_frames`` ≤ ``num_frames`` ≤ the padded length (ValueError otherwise)."""
+    p = np.asarray(positions, dtype=np.float64)
+    lengths = np.asarray(num_frames, dtype=np.int64).reshape(-1)
+    if p.ndim != 4 or p.shape[2:] != (NUM_JOINTS, 3) or len(p) != len(lengths):
+        raise ValueError(f"positions must be (n, frames, {NUM_JOINTS}, 3) with one num_frames each, got {p.shape} "
+                         f"and {lengths.shape}")
+    if len(p) == 0 or lengths.min() < min_frames or lengths.max() > p.shape[1]:
+        raise ValueError(f"need ≥ 1 motion with {min_frames} ≤ num_frames ≤ {p.shape[1]}, got {lengths.tolist()[:8]}")
+    return p, lengths
+
+
 def foot_skating(positions: np.ndarray, num_frames: np.ndarray, fps: float, rest_heights: np.ndarray,
                  stance_foot: int | None = None, skate_speed: float = SKATE_SPEED_MPS) -> FootSkating:
     """Foot-skating ratio: the share of foot-frames in ground contact whose foot slides.
@@ -75,13 +88,7 @@ def foot_skating(positions: np.ndarray, num_frames: np.ndarray, fps: float, rest
     Returns:
         :class:`FootSkating`.
     """
-    p = np.asarray(positions, dtype=np.float64)
-    lengths = np.asarray(num_frames, dtype=np.int64).reshape(-1)
-    if p.ndim != 4 or p.shape[2:] != (NUM_JOINTS, 3) or len(p) != len(lengths):
-        raise ValueError(f"positions must be (n, frames, {NUM_JOINTS}, 3) with one num_frames each, got {p.shape} "
-                         f"and {lengths.shape}")
-    if len(p) == 0 or lengths.min() < 2 or lengths.max() > p.shape[1]:
-        raise ValueError(f"need ≥ 1 motion with 2 ≤ num_frames ≤ {p.shape[1]}, got {lengths.tolist()[:8]}")
+    p, lengths = padded_motions(positions, num_frames, 2)
     contact_frames = skating_frames = valid = no_plant = 0
     mids = []
     for length in np.unique(lengths):  # equal lengths are detected together

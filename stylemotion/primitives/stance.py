@@ -16,7 +16,8 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from stylemotion.skeleton import FOOT_POINTS, NUM_JOINTS
+from stylemotion.primitives.skating import padded_motions
+from stylemotion.skeleton import FOOT_POINTS
 
 
 @dataclass
@@ -61,13 +62,7 @@ def stance_travel(positions: np.ndarray, num_frames: np.ndarray, fps: float, sta
     Returns:
         :class:`StanceTravel`.
     """
-    p = np.asarray(positions, dtype=np.float64)
-    lengths = np.asarray(num_frames, dtype=np.int64).reshape(-1)
-    if p.ndim != 4 or p.shape[2:] != (NUM_JOINTS, 3) or len(p) != len(lengths):
-        raise ValueError(f"positions must be (n, frames, {NUM_JOINTS}, 3) with one num_frames each, got {p.shape} "
-                         f"and {lengths.shape}")
-    if len(p) == 0 or lengths.min() < 4 or lengths.max() > p.shape[1]:
-        raise ValueError(f"need ≥ 1 motion with 4 ≤ num_frames ≤ {p.shape[1]}, got {lengths.tolist()[:8]}")
+    p, lengths = padded_motions(positions, num_frames, 4)
     if stance_foot not in (0, 1):
         raise ValueError(f"stance_foot must be 0 (left) or 1 (right), got {stance_foot!r}")
     rows = np.empty((len(p), 5))

@@ -92,6 +92,11 @@ def test_results_of_real_clips_look_like_real_data(results) -> None:
         assert results["nearest_training"][primitive]["elderly"]["samples_median_m"] > 0.005
     for name, ratio in results["foot_skating"].items():
         assert ratio == pytest.approx(results["foot_skating_real"][name], abs=0.05)
+    for primitive in PRIMITIVES:  # resampled real clips: the root follows the stance leg, as in the real clips
+        for name, travel in results["stance_travel"][primitive].items():
+            assert 0.9 < travel["real"]["travel_ratio"] < 1.1, (primitive, name, travel)
+            assert travel["samples"]["travel_ratio"] == pytest.approx(travel["real"]["travel_ratio"], abs=0.05)
+            assert travel["samples"]["foot_drift_m"] < 0.02 and travel["samples"]["motions"] == 120
     assert 0 < results["autoencoder"]["test_mpjpe_m"] < 0.5
 
 
@@ -102,7 +107,7 @@ def test_report_folder_is_complete_and_never_overwritten_silently(results, tmp_p
         assert {f"table_5_1_{p}.csv", f"table_5_1_{p}.png", f"variance_{p}.csv",
                 f"classifier_confusion_{p}.png"} <= names
     assert {"report.md", "report.json", "variance.png", "style_recognition.csv", "foot_skating.csv",
-            "variation_vs_style.csv"} <= names
+            "stance_travel.csv", "variation_vs_style.csv"} <= names
     saved = json.loads((out / "report.json").read_text())
     t = saved["table_5_1"]["walk_leftStance"]
     assert len(t["distance"]) == len(t["models"]) == len(t["examples"]) == 3

@@ -1,0 +1,185 @@
+"""Suite ``style_method``: which ``method`` of ``stylemotion-style`` serves a style the run never saw, chosen on
+**validation** clips (issue 27 item 3: the zero-shot network as the default if the validation split supports it).
+
+    python scripts/benchmarks.py run style_method --seeds 100 101 --primitives walk_leftStance
+
+A user's new style is one the run's autoencoder never saw. Per training seed ``k`` (not a reported seed) the judge is
+a reproduction evaluated on validation clips (``--judge``, default suite ``contact_template``'s ``off`` run of that
+seed; run here through the library when missing, with ``evaluation.heldout_splits=[val]``), and for each left-out
+style ``s`` :func:`stylemotion.evaluation.zero_shot.leave_one_style_out` (``cvae_unseen=True``) trains an
+autoencoder without any take of ``s`` and on it, for each primitive, the two methods of ``stylemotion-style``:
+
+* ``zero_shot``: the zero-shot network trained without ``s`` (``--epochs``; default the ``zero_shot`` experiment's,
+  as ``stylemotion-style method=zero_shot`` trains it), conditioned on the example clip(s) of the judge's CVAE of s;
+* ``cvae_unseen``: the judge's CVAE stage of ``(p, s)`` (the same settings and example clips) on that autoencoder,
+  as ``stylemotion-style method=cvae`` trains it.
+
+Both are measured in the judge's space (its autoencoder, its style classifier fitted on train clips) against s's
+real clips of the train and val splits but the example (the judge's val protocol: no test clip): recognition, whether
+the Table 5.1 row's minimum is s's own column, and V_SD, step_SD and diversity of the samples as shares of the real
+clips'. The judge's own CVAE of s (its autoencoder saw s) stands beside as ``cvae``, not ruled on.
+
+Rule (:func:`choose`, fixed before any Bandai run), over every (seed, primitive, style) case: ``zero_shot`` becomes
+the default when its own-column rows are no fewer than ``cvae_unseen``'s, its mean recognition is at least min(0.9,
+``cvae_unseen``'s) and its mean capped log variation (the log of each share capped at 1, averaged) exceeds
+``cvae_unseen``'s by more than :data:`TIE`; else ``cvae`` stays the default.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+from pathlib import Path
+from typing import Any
+
+from suites import contact_full
+from suites.common import fmt, md_table, provenance_line, spread
+from suites.style import DATA, reproduce_seed
+
+DESCRIPTION = ("stylemotion-style's method for a style the run never saw (zero-shot network or CVAE, both on an "
+               "autoencoder without the style), chosen on validation clips")
+DEFAULT_SEEDS = (100, 101)
+ROOT = Path(__file__).resolve().parents[2]
+#: The methods compared (rows of leave_one_style_out) and the reference row beside them.
+METHODS = ("zero_shot", "cvae_unseen")
+REFERENCE = "cvae"
+LABELS = {"zero_shot": "zero-shot network (method=zero_shot)",
+          "cvae_unseen": "CVAE on the autoencoder without the style (method=cvae)",
+          "cvae": "the judge's CVAE (its autoencoder saw the style; not ruled on)"}
+#: Variation shares of the samples over the style's real clips.
+VARIATION = ("v_sd", "step_sd", "diversity")
+#: Mean capped log variations this close count as tied (as suite style_channels).
+TIE = 0.05
+AIM_RECOGNITION = 0.9
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--data", choices=sorted(DATA), default="bandai",
+                        help="bandai: dataset-2 walks; synthetic: a smoke run of the suite only")
+    parser.add_argument("--judge", default=str(ROOT / "runs" / "benchmarks" / "contact_template" / "{data}" /
+                                               "seed{seed}" / "off"),
+                        help="the judge reproduction per seed ({data} and {seed} are filled in); made here with "
+                             "evaluation.heldout_splits=[val] when missing")
+    parser.add_argument("--runs", type=Path, default=ROOT / "runs" / "benchmarks" / "style_method",
+                        help="folder of the leave-one-style-out trainings (reused and resumed)")
+    parser.add_argument("--styles", nargs="+", default=None, help="left-out styles (default: the judge's CVAE styles)")
+    parser.add_argument("--primitives", nargs="+", default=None, help="primitives (default: the judge's)")
+    parser.add_argument("--epochs", type=int, default=None,
+                        help="epochs of each zero-shot network (default: the zero_shot experiment's, as "
+                             "stylemotion-style trains it)")
+    parser.add_argument("--samples", type=int, default=1000, help="samples per model and seed")
+    parser.add_argument("--workers", type=int, default=2, help="training stages at once of a judge made here")
+    parser.add_argument("--override", nargs="*", default=[], metavar="KEY=VALUE",
+                        help="more reproduce overrides of a judge made here (e.g. budget.* for a smoke run)")
+
+
+def judge_for(args: argparse.Namespace, seed: int) -> Path:
+    """The judge of ``seed``: the ``--judge`` folder, made (val protocol) when it holds no finished reproduction."""
+    folder = Path(str(args.judge).format(data=args.data, seed=seed)).expanduser()
+    if not (folder / "report" / "report.json").is_file():
+        reproduce_seed(args.data, seed, folder, args.workers, args.primitives, args.styles,
+                       extra=["evaluation.heldout_splits=[val]", *args.override])
+    return folder.resolve()
+
+
+def case_figures(row: dict[str, Any]) -> dict[str, dict[str, Any]]:
+    """Per method row of one left-out (primitive, style): recognition, own column, variation shares of real."""
+    real = row["real"]["variation"]
+    out = {}
+    for kind in (*METHODS, REFERENCE):
+        r = row[kind]
+        shares = {k: (r["variation"][k] / real[k] if real[k] else None) for k in VARIATION}
+        out[kind] = {"recognition": r["recognition"], "own_column": bool(r["own_column_is_minimum"]), **shares}
+    return out
+
+
+def capped_log(case: dict[str, Any]) -> float:
+    values = [case[k] for k in VARIATION]
+    if any(v is None or not v > 0 for v in values):
+        return -math.inf
+    return sum(math.log(min(1.0, v)) for v in values) / len(values)
+
+
+def summary(cases: list[dict[str, Any]]) -> dict[str, Any]:
+    """Over every case of one method."""
+    return {"cases": len(cases), "own_column": sum(c["own_column"] for c in cases),
+            "recognition": spread(c["recognition"] for c in cases),
+            **{k: spread(c[k] for c in cases) for k in VARIATION},
+            "capped_log_variation": sum(capped_log(c) for c in cases) / len(cases) if cases else -math.inf}
+
+
+def choose(summaries: dict[str, dict[str, Any]]) -> dict[str, Any]:
+    """The module doc's rule."""
+    zs, cv = summaries["zero_shot"], summaries["cvae_unseen"]
+    floor = min(AIM_RECOGNITION, cv["recognition"]["mean"])
+    tests = {"own_column": zs["own_column"] >= cv["own_column"],
+             "recognition": zs["recognition"]["mean"] >= floor,
+             "variation": zs["capped_log_variation"] > cv["capped_log_variation"] + TIE}
+    return {"tests": tests, "recognition_floor": floor,
+            "default": "zero_shot" if all(tests.values()) else "cvae"}
+
+
+def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
+    import torch
+
+    from stylemotion.evaluation.zero_shot import ZeroShotRunError, leave_one_style_out, read_run
+
+    torch.set_num_threads(1)
+    per_seed: dict[str, Any] = {}
+    for seed in seeds:
+        judge = judge_for(args, seed)
+        source = read_run(judge)
+        if list(source.settings.heldout_splits) != ["val"]:
+            raise ZeroShotRunError(f"judge {judge} was evaluated on {list(source.settings.heldout_splits)}, not "
+                                   "[val]: the choice must not read test clips")
+        out = args.runs / args.data / (f"seed{seed}" + ("" if args.epochs is None else f"_e{args.epochs}"))
+        result = leave_one_style_out(judge, out, args.styles, args.primitives, args.epochs, args.samples, seed,
+                                     threads=1, resume=True, cvae_unseen=True)
+        cases = {f"{p}/{s}": case_figures(row) for p, res in result["primitives"].items()
+                 for s, row in res["styles"].items()}
+        minutes = {f"{p}/{s}": {
+            "autoencoder": round((row["generator_autoencoder"].get("train_seconds") or 0) / 60, 1),
+            "zero_shot": round((row["zero_shot"].get("train_seconds") or 0) / 60, 1),
+            "cvae_unseen": round((row["cvae_unseen"].get("train_seconds") or 0) / 60, 1)}
+            for p, res in result["primitives"].items() for s, row in res["styles"].items()}
+        per_seed[str(seed)] = {"judge": str(judge.relative_to(ROOT)) if judge.is_relative_to(ROOT) else str(judge),
+                               "out": str(out), "cases": cases, "train_minutes": minutes,
+                               "seconds": round(result["meta"]["seconds"], 1),
+                               "splits": result["splits"]}
+    summaries = {kind: summary([c[kind] for s in per_seed.values() for c in s["cases"].values()])
+                 for kind in (*METHODS, REFERENCE)}
+    return {"data": args.data, "epochs": args.epochs, "samples": args.samples,
+            "narrowed": {"primitives": args.primitives, "styles": args.styles},
+            "splits": {"choose": "the judge's evaluation.heldout_splits=[val]: real clips of the train and val "
+                                 "splits; no test clip", "seeds": "training seeds, not reported seeds"},
+            "per_seed": per_seed, "summary": summaries, "choice": choose(summaries)}
+
+
+def render(record: dict[str, Any]) -> dict[str, str]:
+    r = record["results"]
+    choice = r["choice"]
+    sd = contact_full.sd
+    label = "**Synthetic data: a smoke run of the suite, not evidence.** " if r["data"] == "synthetic" else ""
+    narrowed = {k: v for k, v in r["narrowed"].items() if v}
+    if narrowed:
+        label += "**Narrowed:** " + "; ".join(f"{k} {', '.join(v)}" for k, v in narrowed.items()) + ". "
+    rows = [[LABELS[kind], f"{s['own_column']}/{s['cases']}", sd(s["recognition"], 3),
+             *(sd(s[k]) for k in VARIATION), fmt(s["capped_log_variation"], 3)]
+            for kind, s in r["summary"].items()]
+    verdict = ("**method=zero_shot becomes the default**" if choice["default"] == "zero_shot"
+               else "method=cvae **stays** the default")
+    tests = ", ".join(f"{k}: {'yes' if v else 'no'}" for k, v in choice["tests"].items())
+    return {"headline": (
+        f"{label}A style the run never saw, on **validation** clips ({r['data']}, training seeds "
+        f"{', '.join(r['per_seed'])}: not reported seeds; network epochs: "
+        f"{r['epochs'] if r['epochs'] else 'the zero_shot experiment’s'}): per left-out style an autoencoder without "
+        f"it, and on it the zero-shot network and the CVAE as stylemotion-style trains them, judged by a "
+        f"reproduction evaluated with `evaluation.heldout_splits=[val]`. Recognition: share of samples the judge's "
+        f"classifier gives the style; own column: Table 5.1 rows whose minimum is the style's example; V_SD, step_SD, "
+        f"diversity: samples ÷ the style's train + val clips; mean ± sd (min–max) over (seed, primitive, style). Rule: "
+        f"zero-shot when its own-column rows are no fewer, its mean recognition ≥ "
+        f"{fmt(choice['recognition_floor'], 3)} and its mean capped log variation exceeds the CVAE's by more than "
+        f"{TIE:g}. Tests: {tests}. Verdict: {verdict}.\n\n"
+        + md_table(["method", "own column", "recognition", "V_SD / style", "step_SD / style", "diversity / style",
+                    "mean capped log variation"], rows)
+        + f"\n\n{provenance_line(record)}")}
