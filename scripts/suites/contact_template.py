@@ -228,7 +228,8 @@ def render(record: dict[str, Any]) -> dict[str, str]:
                     "rows on diagonal", "recognition", "V_SD / style", "step_SD / style", "diversity / style",
                     "mean capped log variation", "CVAE minutes per run", "eligible"], rows)
         + f"\n\n{provenance_line(record)}"),
-        **({"stance": f"{render_stance(r)}\n\n{provenance_line(record)}"} if r.get("stance_samples") else {})}
+        **({"stance": f"{render_stance(r)}\n\n{provenance_line(record)}"} if r.get("stance_samples") else {}),
+        "reading": render_reading(r)}
 
 
 #: Columns of the stance block: key of :class:`stylemotion.primitives.stance.StanceTravel`, header, digits.
@@ -263,3 +264,55 @@ def render_stance(r: dict[str, Any]) -> str:
             "Root ÷ leg travel: the root's travel over that of the root relative to the stance foot (median over "
             "motions; 1 when the foot holds the ground); drift: the stance foot's own travel. Not ruled on.\n\n"
             + md_table(["model", "arm", *(h for _, h, _ in STANCE_COLUMNS)], rows))
+
+
+def _span(values: list[float], digits: int, scale: float = 1.0) -> str:
+    """``lo–hi`` of ``values`` × ``scale``."""
+    return f"{fmt(scale * min(values), digits)}–{fmt(scale * max(values), digits)}"
+
+
+def render_reading(r: dict[str, Any]) -> str:
+    """The reading of the blocks, every figure taken from the results: the verdict and what each arm does."""
+    summary, choice = r["summary"], r["choice"]
+    arms_ = list(summary)
+    off = summary["off"]
+    lines = [f"Reading (figures from the blocks above): by the rule **{choice['chosen']}** is the default."]
+    for arm in arms_[1:]:
+        s = summary[arm]
+        missed = []
+        if s["styled"]["rows_on_diagonal"] < off["styled"]["rows_on_diagonal"]:
+            missed.append("Table 5.1 rows")
+        if s["styled"]["recognition"]["mean"] < choice["recognition_floor"]:
+            missed.append("recognition")
+        if s["styled"]["capped_log_variation"] < choice["variation_floor"]:
+            missed.append(f"variation (mean capped log {fmt(s['styled']['capped_log_variation'], 3)} against the "
+                          f"floor {fmt(choice['variation_floor'], 3)})")
+        status = "eligible" if choice["eligible"][arm] else "not eligible: " + ", ".join(missed)
+
+        def change(key: str, digits: int = 2, *path: str, arm_summary: dict[str, Any] = s) -> str:
+            before, after = off, arm_summary
+            for step in path:
+                before, after = before[step], after[step]
+            return f"{fmt(before[key]['mean'], digits)} to {fmt(after[key]['mean'], digits)}"
+
+        lines.append(
+            f"`{arm}` ({status}): the stance foot's mid-stance speed over real falls from {change('mid_excess')} m/s, "
+            f"the share of samples never planted from {change('no_plant_samples')}, the skating share from "
+            f"{change('styled_skating_relative', 1)} times the real clips'; V_SD {change('v_sd', 2, 'styled')}, "
+            f"step_SD {change('step_sd', 2, 'styled')}, diversity {change('diversity', 2, 'styled')} of the style's "
+            f"clips; recognition {fmt(s['styled']['recognition']['mean'], 3)}.")
+    stance = [(arm, [v for seed in r["per_seed"].values() for k, v in seed[arm].get("stance_travel", {}).items()
+                     if not k.endswith("/neutral")]) for arm in arms_]
+    real = [v for seed in r.get("stance_real", {}).values() for k, v in seed.items() if not k.endswith("/neutral")]
+    if real and all(values for _, values in stance):
+        lines.append(
+            "Block `stance`: in the style models' samples the root travels "
+            + "; ".join(f"{_span([v['travel_ratio'] for v in values], 2)} of the leg's sweep with the stance foot "
+                        f"drifting {_span([v['foot_drift_m'] for v in values], 1, 100)} cm (`{arm}`)"
+                        for arm, values in stance)
+            + f"; in the styles' real clips {_span([v['travel_ratio'] for v in real], 2)} and "
+              f"{_span([v['foot_drift_m'] for v in real], 1, 100)} cm. Where the root travels less than the leg "
+              "sweeps, the stance foot slides back by the difference.")
+    lines.append("To train with the template anyway: `model.sample_contact_weight=100 model.sample_contacts=content` "
+                 "(`stylemotion-train experiment=style_cvae`, or a reproduction's `stages.cvae`).")
+    return "\n\n".join(lines)

@@ -97,3 +97,15 @@ def test_the_stance_block_pools_seeds_and_stances_and_shows_the_shared_vae_once(
     assert "|  | VAE samples (every arm's) | 0.90 ± 0.00 (0.90–0.90) |" in text
     assert text.count("VAE samples") == 1
     assert "|  | off | 0.45 ± 0.06 (0.40–0.50) |" in text and "|  | content100 | 0.95 ± 0.06 (0.90–1.00) |" in text
+
+
+def test_the_reading_names_what_keeps_an_arm_out_and_what_it_changes() -> None:
+    per_seed = {"100": {"off": run(report(0.5, no_plant=0.5)), "content100": run(report(0.04, v_sd=0.4))}}
+    summary = {n: contact_template.arm_summary([per_seed["100"][n]]) for n in ("off", "content100")}
+    results = {"data": "bandai", "weight": 100.0, "arms": {"off": [], "content100": []}, "overrides": [],
+               "per_seed": per_seed, "summary": summary, "choice": contact_template.choose(summary)}
+    text = contact_template.render_reading(results)
+    assert "by the rule **off** is the default" in text
+    assert "`content100` (not eligible: variation (mean capped log" in text
+    assert "mid-stance speed over real falls from 0.48 to 0.02 m/s" in text and "V_SD 0.50 to 0.40" in text
+    assert "Block `stance`" not in text  # no stance figures in these results
