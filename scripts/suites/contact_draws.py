@@ -97,10 +97,27 @@ def choose(summaries: dict[str, dict[str, Any]]) -> dict[str, Any]:
             "chosen": chosen}
 
 
+def val_arm(args: argparse.Namespace, seed: int, out: Path, stages: dict[str, list[str]]
+            ) -> tuple[dict[str, Any], list[str], dict[str, Any]]:
+    """One arm's reproduction of ``seed`` into ``out`` evaluated on validation clips (``stages``: stage kind → extra
+    ``train`` overrides); returns its report, its CVAE styles and the arm's record (run folder, held-out splits, CVAE
+    minutes, suite style_channels' case figures)."""
+    from stylemotion.io.jsonfile import read_json_object
+
+    report = style.reproduce_seed(args.data, seed, out, args.workers,
+                                  extra=["evaluation.heldout_splits=[val]", *args.override],
+                                  stages={k: v for k, v in stages.items() if v} or None)
+    styles = read_json_object(out / "data.json", "the reproduction's data summary", "rerun the suite")["cvae_styles"]
+    recorded = read_json_object(out / "reproduce.json", "the reproduction's summary", "rerun the suite")["stages"]
+    return report, styles, {"run": str(out.relative_to(style.ROOT) if out.is_relative_to(style.ROOT) else out),
+                            "heldout_splits": report["meta"]["settings"]["heldout_splits"],
+                            "cvae_minutes": round(style.stage_minutes(recorded, "cvae"), 2),
+                            "cases": style_channels.case_figures(report, styles)}
+
+
 def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
     import torch
 
-    from stylemotion.io.jsonfile import read_json_object
 
     torch.set_num_threads(1)
     base = contact_base(Path(args.base) if args.base else CONTACT_RESULTS)
@@ -115,19 +132,8 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
             copied = style_channels.share_stages(first, out) if beta > 0 else []
             cvae = [*base["stages"].get("cvae", []), *([f"model.sample_contact_weight={beta:g}"] if beta else [])]
             stages = {**base["stages"], "cvae": cvae}
-            report = style.reproduce_seed(args.data, seed, out, args.workers,
-                                          extra=["evaluation.heldout_splits=[val]", *args.override],
-                                          stages={k: v for k, v in stages.items() if v})
-            styles = read_json_object(out / "data.json", "the reproduction's data summary",
-                                      "rerun the suite")["cvae_styles"]
-            recorded = read_json_object(out / "reproduce.json", "the reproduction's summary",
-                                        "rerun the suite")["stages"]
-            per_seed.setdefault(str(seed), {})[name] = {
-                "run": str(out.relative_to(style.ROOT) if out.is_relative_to(style.ROOT) else out),
-                "stages": stages, "shared_from_base": copied,
-                "heldout_splits": report["meta"]["settings"]["heldout_splits"],
-                "cvae_minutes": round(style.stage_minutes(recorded, "cvae"), 2),
-                "cases": style_channels.case_figures(report, styles)}
+            _, _, record = val_arm(args, seed, out, stages)
+            per_seed.setdefault(str(seed), {})[name] = {**record, "stages": stages, "shared_from_base": copied}
     summaries = {weight_label(b): candidate_summary([s[weight_label(b)] for s in per_seed.values()])
                  for b in weights}
     return {"data": args.data, "base": base, "weights": weights, "overrides": args.override,

@@ -158,7 +158,6 @@ def stance_figures(out: Path, report: dict[str, Any], styles: list[str], samples
 def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
     import torch
 
-    from stylemotion.io.jsonfile import read_json_object
 
     torch.set_num_threads(1)
     table = arms(args.weight, list(args.arms))
@@ -170,19 +169,10 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
             out = first.with_name(name)
             out.mkdir(parents=True, exist_ok=True)
             copied = style_channels.share_stages(first, out) if name != "off" else []
-            report = style.reproduce_seed(args.data, seed, out, args.workers,
-                                          extra=["evaluation.heldout_splits=[val]", *args.override],
-                                          stages={"cvae": overrides} if overrides else None)
-            styles = read_json_object(out / "data.json", "the reproduction's data summary",
-                                      "rerun the suite")["cvae_styles"]
-            recorded = read_json_object(out / "reproduce.json", "the reproduction's summary",
-                                        "rerun the suite")["stages"]
-            per_seed.setdefault(str(seed), {})[name] = {
-                "run": str(out.relative_to(style.ROOT) if out.is_relative_to(style.ROOT) else out),
-                "cvae_overrides": overrides, "shared_from_off": copied,
-                "heldout_splits": report["meta"]["settings"]["heldout_splits"],
-                "cvae_minutes": round(style.stage_minutes(recorded, "cvae"), 2),
-                "cases": style_channels.case_figures(report, styles), "stance": case_stance(report, styles)}
+            report, styles, record = contact_draws.val_arm(args, seed, out, {"cvae": overrides})
+            per_seed.setdefault(str(seed), {})[name] = {**record, "cvae_overrides": overrides,
+                                                        "shared_from_off": copied,
+                                                        "stance": case_stance(report, styles)}
             if args.stance_samples > 0:
                 per_seed[str(seed)][name]["stance_travel"] = stance_figures(
                     out, report, styles, args.stance_samples, seed, stance_real.setdefault(str(seed), {}))

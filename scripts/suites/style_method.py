@@ -166,8 +166,12 @@ def render(record: dict[str, Any]) -> dict[str, str]:
     rows = [[LABELS[kind], f"{s['own_column']}/{s['cases']}", sd(s["recognition"], 3),
              *(sd(s[k]) for k in VARIATION), fmt(s["capped_log_variation"], 3)]
             for kind, s in r["summary"].items()]
+    full = not narrowed and not r["epochs"] and len(r["per_seed"]) >= 2
     verdict = ("**method=zero_shot becomes the default**" if choice["default"] == "zero_shot"
                else "method=cvae **stays** the default")
+    if not full:
+        verdict = (f"{'zero-shot' if choice['default'] == 'zero_shot' else 'CVAE'} by the rule, **not applied**: a "
+                   "narrowed run (fewer than 2 seeds, a subset, or shortened networks) changes no default")
     tests = ", ".join(f"{k}: {'yes' if v else 'no'}" for k, v in choice["tests"].items())
     return {"headline": (
         f"{label}A style the run never saw, on **validation** clips ({r['data']}, training seeds "

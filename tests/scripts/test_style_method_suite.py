@@ -61,6 +61,10 @@ def test_the_block_states_the_verdict() -> None:
     record = {"suite": "style_method", "command": "c", "commit": "0" * 40, "started": "2026-12-07T06:00:00",
               "machine": {"cpu": "x", "cores": 2}, "seeds": [100], "seconds": 1.0, "results": results}
     text = style_method.render(record)["headline"]
-    assert "Verdict: **method=zero_shot becomes the default**" in text
+    assert "Verdict: zero-shot by the rule, **not applied**: a narrowed run" in text
     assert "**Narrowed:** primitives walk_leftStance" in text
+    full = {**results, "narrowed": {"primitives": None, "styles": None},
+            "per_seed": {"100": {"cases": cases}, "101": {"cases": cases}}}
+    assert "Verdict: **method=zero_shot becomes the default**" in style_method.render({**record, "results": full})[
+        "headline"]
     assert "| zero-shot network (method=zero_shot) | 1/1 | 0.950 ± 0.000 (0.950–0.950) | 0.75 ± 0.00" in text
