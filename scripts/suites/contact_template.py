@@ -131,27 +131,30 @@ def stance_figures(out: Path, report: dict[str, Any], styles: list[str], samples
     from stylemotion.primitives.stance import stance_travel
 
     meta = report["meta"]
+    neutral_style = meta["settings"]["neutral_style"]
     takeset = None
     figures: dict[str, dict[str, Any]] = {}
     for primitive in report["primitives"]:
+        foot = stance_foot(parse_primitive(primitive)[1])
         folders = {"neutral": out / "vae" / primitive, **{st: out / "cvae" / f"{primitive}_{st}" for st in styles}}
+        data = None  # the primitive's real clips, segmented and split once (only when a style is not cached yet)
         for name, folder in folders.items():
             model = load_generative(folder / "checkpoints" / "best.ckpt")
             motions = model.sample(samples, seed=seed)
-            foot = stance_foot(parse_primitive(primitive)[1])
-            figures[f"{primitive}/{name}"] = stance_travel(motions.positions.numpy(), motions.num_frames.numpy(),
-                                                           motions.fps, foot).as_dict()
             key = f"{primitive}/{name}"
-            if key not in real_cache:
-                if takeset is None:
-                    takeset = build_dataset(meta["data"])
-                data = primitive_data(takeset, primitive, model.timeline_frames, meta["settings"]["neutral_style"],
+            figures[key] = stance_travel(motions.positions.numpy(), motions.num_frames.numpy(), motions.fps,
+                                         foot).as_dict()
+            if key in real_cache:
+                continue
+            if data is None:
+                takeset = takeset or build_dataset(meta["data"])
+                data = primitive_data(takeset, primitive, model.timeline_frames, neutral_style,
                                       meta["settings"]["segment"], meta["data"].get("split"), heldout_splits=("val",))
-                style_name = meta["settings"]["neutral_style"] if name == "neutral" else name
-                real = motions_from_clips(data.split("train", style_name) + data.split("val", style_name),
-                                          model.timeline_frames)
-                real_cache[key] = stance_travel(real.positions.numpy(), real.num_frames.numpy(), real.fps,
-                                                data.stance_foot).as_dict()
+            style_name = neutral_style if name == "neutral" else name
+            real = motions_from_clips(data.split("train", style_name) + data.split("val", style_name),
+                                      model.timeline_frames)
+            real_cache[key] = stance_travel(real.positions.numpy(), real.num_frames.numpy(), real.fps,
+                                            foot).as_dict()
     return figures
 
 
