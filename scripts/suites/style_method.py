@@ -68,7 +68,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="epochs of each zero-shot network (default: the zero_shot experiment's, as "
                              "stylemotion-style trains it)")
     parser.add_argument("--samples", type=int, default=1000, help="samples per model and seed")
-    parser.add_argument("--workers", type=int, default=2, help="training stages at once of a judge made here")
+    parser.add_argument("--workers", type=int, default=2,
+                        help="processes at once: training stages of a judge made here, then seeds (one thread each)")
     parser.add_argument("--override", nargs="*", default=[], metavar="KEY=VALUE",
                         help="more reproduce overrides of a judge made here (e.g. budget.* for a smoke run)")
 
@@ -119,33 +120,42 @@ def choose(summaries: dict[str, dict[str, Any]]) -> dict[str, Any]:
             "default": "zero_shot" if all(tests.values()) else "cvae"}
 
 
-def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
+def seed_record(args: argparse.Namespace, seed: int, judge: Path) -> dict[str, Any]:
+    """One training seed's leave-one-style-out on ``judge`` (one torch thread): its cases, minutes and splits."""
     import torch
 
     from stylemotion.evaluation.zero_shot import ZeroShotRunError, leave_one_style_out, read_run
 
     torch.set_num_threads(1)
-    per_seed: dict[str, Any] = {}
-    for seed in seeds:
-        judge = judge_for(args, seed)
-        source = read_run(judge)
-        if list(source.settings.heldout_splits) != ["val"]:
-            raise ZeroShotRunError(f"judge {judge} was evaluated on {list(source.settings.heldout_splits)}, not "
-                                   "[val]: the choice must not read test clips")
-        out = args.runs / args.data / (f"seed{seed}" + ("" if args.epochs is None else f"_e{args.epochs}"))
-        result = leave_one_style_out(judge, out, args.styles, args.primitives, args.epochs, args.samples, seed,
-                                     threads=1, resume=True, cvae_unseen=True)
-        cases = {f"{p}/{s}": case_figures(row) for p, res in result["primitives"].items()
-                 for s, row in res["styles"].items()}
-        minutes = {f"{p}/{s}": {
-            "autoencoder": round((row["generator_autoencoder"].get("train_seconds") or 0) / 60, 1),
-            "zero_shot": round((row["zero_shot"].get("train_seconds") or 0) / 60, 1),
-            "cvae_unseen": round((row["cvae_unseen"].get("train_seconds") or 0) / 60, 1)}
-            for p, res in result["primitives"].items() for s, row in res["styles"].items()}
-        per_seed[str(seed)] = {"judge": str(judge.relative_to(ROOT)) if judge.is_relative_to(ROOT) else str(judge),
-                               "out": str(out), "cases": cases, "train_minutes": minutes,
-                               "seconds": round(result["meta"]["seconds"], 1),
-                               "splits": result["splits"]}
+    source = read_run(judge)
+    if list(source.settings.heldout_splits) != ["val"]:
+        raise ZeroShotRunError(f"judge {judge} was evaluated on {list(source.settings.heldout_splits)}, not "
+                               "[val]: the choice must not read test clips")
+    out = args.runs / args.data / (f"seed{seed}" + ("" if args.epochs is None else f"_e{args.epochs}"))
+    result = leave_one_style_out(judge, out, args.styles, args.primitives, args.epochs, args.samples, seed,
+                                 threads=1, resume=True, cvae_unseen=True)
+    cases = {f"{p}/{s}": case_figures(row) for p, res in result["primitives"].items()
+             for s, row in res["styles"].items()}
+    minutes = {f"{p}/{s}": {
+        "autoencoder": round((row["generator_autoencoder"].get("train_seconds") or 0) / 60, 1),
+        "zero_shot": round((row["zero_shot"].get("train_seconds") or 0) / 60, 1),
+        "cvae_unseen": round((row["cvae_unseen"].get("train_seconds") or 0) / 60, 1)}
+        for p, res in result["primitives"].items() for s, row in res["styles"].items()}
+    return {"judge": str(judge.relative_to(ROOT)) if judge.is_relative_to(ROOT) else str(judge),
+            "out": str(out), "cases": cases, "train_minutes": minutes,
+            "seconds": round(result["meta"]["seconds"], 1), "splits": result["splits"]}
+
+
+def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
+    from concurrent.futures import ProcessPoolExecutor
+    from multiprocessing import get_context
+
+    judges = {seed: judge_for(args, seed) for seed in seeds}  # made one after another, each with --workers stages
+    # Seeds in parallel, one torch thread each (--workers processes); a seed's figures do not depend on it.
+    processes = max(1, min(args.workers, len(seeds)))
+    with ProcessPoolExecutor(max_workers=processes, mp_context=get_context("spawn")) as pool:
+        futures = {seed: pool.submit(seed_record, args, seed, judge) for seed, judge in judges.items()}
+        per_seed: dict[str, Any] = {str(seed): future.result() for seed, future in futures.items()}
     summaries = {kind: summary([c[kind] for s in per_seed.values() for c in s["cases"].values()])
                  for kind in (*METHODS, REFERENCE)}
     return {"data": args.data, "epochs": args.epochs, "samples": args.samples,
