@@ -65,6 +65,15 @@ def spread(values: Iterable[float | None]) -> dict[str, Any]:
     return out
 
 
+def capped_log(shares: Iterable[float | None]) -> float:
+    """Mean of ``log(min(1, share))`` over ``shares`` (variation as shares of real clips: more than the real clips'
+    counts as no more); −inf when one is missing or not positive."""
+    values = list(shares)
+    if not values or any(v is None or not v > 0 for v in values):
+        return -math.inf
+    return sum(math.log(min(1.0, v)) for v in values) / len(values)
+
+
 def quantiles(values: Sequence[float], qs: Sequence[float] = (50, 95, 100)) -> dict[str, float | None]:
     """Percentiles of ``values`` as ``{"p50": …, "p95": …, "p100": …}`` (None for no values)."""
     arr = np.asarray([v for v in values if v is not None], dtype=float)

@@ -30,6 +30,17 @@ still to within 0.01–0.05 m/s, so a ratio would be ruled by the cases with the
 ``off``, each eligible arm in turn (``own``, then ``content``) replaces the holder when its figure is more than
 :data:`TIE` (5 %) below the holder's. The skating share (samples ÷ real) and the share of samples never planted are
 shown beside.
+
+Second look (:func:`choose_sliding_free`, written on 2026-12-07 after the rule above kept ``off`` on content100's
+variation alone, before any of its figures were computed): V_SD and step_SD read the root, and a stance foot that
+slides lets the root's pace vary without the legs (suite ``contact_template``'s stance block: ``off``'s roots travel
+0.35–1.10 of the leg's sweep), so an arm whose samples slide may show variation that is not in their steps. The
+stance block's samples give, over the middle half of each motion, the spread over motions of the root's travel and
+speed and of the leg's (the root relative to the stance foot: what the root would travel were the foot planted;
+:mod:`stylemotion.primitives.stance`), each as samples ÷ the style's real clips. The second look keeps the rule
+above but for its variation test, which reads the sliding-free shares instead: leg travel SD, leg speed SD and the
+case's diversity (mean capped log over cases no lower than ``off``'s minus the same tie). Root and leg shares are
+shown side by side, so the block also says how much of each arm's step variation is sliding.
 """
 
 from __future__ import annotations
@@ -39,7 +50,7 @@ from pathlib import Path
 from typing import Any
 
 from suites import contact_draws, contact_full, style, style_channels
-from suites.common import fmt, md_table, provenance_line, spread
+from suites.common import capped_log, fmt, md_table, provenance_line, spread
 
 DESCRIPTION = ("where the style CVAE's draws' contact term holds their feet (their own contacts or the content "
                "clips' template), chosen at full budget on Bandai validation clips of every style")
@@ -104,8 +115,15 @@ def arm_summary(runs: list[dict[str, Any]]) -> dict[str, Any]:
 
 def choose(summaries: dict[str, dict[str, Any]]) -> dict[str, Any]:
     """The module doc's rule; the first key is ``off``."""
-    names = list(summaries)
     eligible, floor, variation_floor = contact_draws.eligibility(summaries)
+    return {"eligible": eligible, "recognition_floor": floor, "variation_floor": variation_floor,
+            "chosen": slowest_eligible(summaries, eligible)}
+
+
+def slowest_eligible(summaries: dict[str, dict[str, Any]], eligible: dict[str, bool]) -> str:
+    """Starting from the first arm, each eligible arm in turn replaces the holder when its mean mid-stance speed over
+    real is more than :data:`TIE` below the holder's."""
+    names = list(summaries)
 
     def mid(n: str) -> float:
         mean = summaries[n]["mid_excess"].get("mean")
@@ -115,8 +133,53 @@ def choose(summaries: dict[str, dict[str, Any]]) -> dict[str, Any]:
     for n in names[1:]:  # in order: own before content; a later arm must beat the holder by more than TIE
         if eligible[n] and mid(n) < mid(chosen) * (1 - TIE):
             chosen = n
-    return {"eligible": eligible, "recognition_floor": floor, "variation_floor": variation_floor,
-            "chosen": chosen}
+    return chosen
+
+
+#: The stance block's spreads over motions, shown as samples ÷ the style's real clips (key, header).
+SPREADS = (("root_travel_sd_m", "root travel SD"), ("leg_travel_sd_m", "leg travel SD"),
+           ("root_speed_sd_mps", "root speed SD"), ("leg_speed_sd_mps", "leg speed SD"))
+#: The sliding-free variation shares the second look reads.
+SLIDING_FREE = ("leg_travel_sd_m", "leg_speed_sd_mps", "diversity")
+
+
+def spread_cases(per_seed: dict[str, dict[str, Any]], stance_real: dict[str, dict[str, Any]]
+                 ) -> dict[str, list[dict[str, float | None]]]:
+    """Per arm, per styled (seed, primitive, style) case: the stance spreads of its samples ÷ those of the style's
+    real clips (None where either is missing or the real one is 0) and the case's diversity share."""
+    out: dict[str, list[dict[str, float | None]]] = {}
+    for seed, arms_ in per_seed.items():
+        real = stance_real.get(seed, {})
+        for arm, record in arms_.items():
+            cases = out.setdefault(arm, [])
+            for key, figures in record.get("stance_travel", {}).items():
+                if key.endswith("/neutral"):
+                    continue
+                ref = real.get(key, {})
+                case: dict[str, float | None] = {
+                    k: figures[k] / ref[k] if figures.get(k) is not None and ref.get(k) else None for k, _ in SPREADS}
+                case["diversity"] = record["cases"][key]["diversity"]
+                cases.append(case)
+    return out
+
+
+def choose_sliding_free(per_seed: dict[str, dict[str, Any]], stance_real: dict[str, dict[str, Any]],
+                        summaries: dict[str, dict[str, Any]]) -> dict[str, Any]:
+    """The module doc's second look: :func:`choose` with the variation test on the sliding-free shares."""
+    cases = spread_cases(per_seed, stance_real)
+    names = list(summaries)
+    figure = {n: (sum(capped_log([c[k] for k in SLIDING_FREE]) for c in cases.get(n, [])) / len(cases[n])
+                  if cases.get(n) else -float("inf")) for n in names}
+    eligible_first, floor, _ = contact_draws.eligibility(summaries)
+    first = summaries[names[0]]["styled"]
+    variation_floor = figure[names[0]] - style_channels.TIE
+    eligible = {n: n == names[0] or (summaries[n]["styled"]["rows_on_diagonal"] >= first["rows_on_diagonal"]
+                                     and summaries[n]["styled"]["recognition"]["mean"] >= floor
+                                     and figure[n] >= variation_floor) for n in names}
+    shares = {n: {k: spread(c[k] for c in cases.get(n, [])) for k in (*(k for k, _ in SPREADS), "diversity")}
+              for n in names}
+    return {"capped_log_sliding_free": figure, "variation_floor": variation_floor, "recognition_floor": floor,
+            "eligible": eligible, "chosen": slowest_eligible(summaries, eligible), "shares": shares}
 
 
 def stance_figures(out: Path, report: dict[str, Any], styles: list[str], samples: int, seed: int,
@@ -180,12 +243,13 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
                 per_seed[str(seed)][name]["stance_travel"] = stance_figures(
                     out, report, styles, args.stance_samples, seed, stance_real.setdefault(str(seed), {}))
     summaries = {name: arm_summary([s[name] for s in per_seed.values()]) for name in table}
+    sliding_free = choose_sliding_free(per_seed, stance_real, summaries) if args.stance_samples > 0 else None
     return {"data": args.data, "weight": args.weight, "arms": table, "overrides": args.override,
             "splits": {"choose": "evaluation.heldout_splits=[val], as suites style_channels and contact_draws: no "
                                  "test clip is read by the figures the rule uses",
                        "seeds": "training seeds, not reported seeds"},
             "per_seed": per_seed, "summary": summaries, "choice": choose(summaries),
-            "stance_samples": args.stance_samples, "stance_real": stance_real}
+            "stance_samples": args.stance_samples, "stance_real": stance_real, "sliding_free": sliding_free}
 
 
 def render(record: dict[str, Any]) -> dict[str, str]:
@@ -222,6 +286,7 @@ def render(record: dict[str, Any]) -> dict[str, str]:
                     "mean capped log variation", "CVAE minutes per run", "eligible"], rows)
         + f"\n\n{provenance_line(record)}"),
         **({"stance": f"{render_stance(r)}\n\n{provenance_line(record)}"} if r.get("stance_samples") else {}),
+        **({"sliding": f"{render_sliding(r)}\n\n{provenance_line(record)}"} if r.get("sliding_free") else {}),
         "reading": render_reading(r)}
 
 
@@ -257,6 +322,26 @@ def render_stance(r: dict[str, Any]) -> str:
             "Root ÷ leg travel: the root's travel over that of the root relative to the stance foot (median over "
             "motions; 1 when the foot holds the ground); drift: the stance foot's own travel. Not ruled on.\n\n"
             + md_table(["model", "arm", *(h for _, h, _ in STANCE_COLUMNS)], rows))
+
+
+def render_sliding(r: dict[str, Any]) -> str:
+    """The second look's block: root and leg spread shares side by side, the sliding-free figure and its verdict."""
+    look, sd = r["sliding_free"], contact_full.sd
+    rows = [[f"**{n}**" if n == look["chosen"] else n, *(sd(look["shares"][n][k]) for k, _ in SPREADS),
+             sd(look["shares"][n]["diversity"]), fmt(look["capped_log_sliding_free"][n], 3),
+             "yes" if look["eligible"][n] else "no"] for n in r["summary"]]
+    verdict = ("`off` **stays**" if look["chosen"] == "off" else f"**{look['chosen']}** is chosen")
+    return ("Second look (the module doc's rule, written after the first rule kept `off` and before these figures): "
+            "the first rule with its variation test on sliding-free shares. Spreads over motions of the middle half "
+            "of each stance (the stance block's samples), samples ÷ the style's real clips (train + val), mean ± sd "
+            "(min–max) over (seed, stance, style): root travel and speed as the root moves, leg travel and speed "
+            "as the root moves relative to the stance foot (what it would travel were the foot planted); a root "
+            "share above the leg share is variation a sliding foot makes. Eligible when Table 5.1 rows and "
+            f"recognition hold as in the first rule and the mean capped log of (leg travel SD, leg speed SD, "
+            f"diversity) ≥ {fmt(look['variation_floor'], 3)} (`off`'s minus {style_channels.TIE:g}); then the "
+            f"lowest mid-stance speed over real as before. Verdict: {verdict}.\n\n"
+            + md_table(["arm", *(f"{h} ÷ real" for _, h in SPREADS), "diversity ÷ real",
+                        "mean capped log (leg travel, leg speed, diversity)", "eligible"], rows))
 
 
 def _span(values: list[float], digits: int, scale: float = 1.0) -> str:
@@ -306,6 +391,16 @@ def render_reading(r: dict[str, Any]) -> str:
             + f"; in the styles' real clips {_span([v['travel_ratio'] for v in real], 2)} and "
               f"{_span([v['foot_drift_m'] for v in real], 1, 100)} cm. Where the root travels less than the leg "
               "sweeps, the stance foot slides back by the difference.")
-    lines.append("To train with the template anyway: `model.sample_contact_weight=100 model.sample_contacts=content` "
-                 "(`stylemotion-train experiment=style_cvae`, or a reproduction's `stages.cvae`).")
+    look = r.get("sliding_free")
+    if look:
+        parts = [f"`{n}` root travel SD {fmt(look['shares'][n]['root_travel_sd_m'].get('mean'))} and leg travel SD "
+                 f"{fmt(look['shares'][n]['leg_travel_sd_m'].get('mean'))} of the real clips' (mean capped log "
+                 f"{fmt(look['capped_log_sliding_free'][n], 3)})" for n in arms_]
+        lines.append(f"Second look (block `sliding`): by its rule **{look['chosen']}** is the default. "
+                     + "; ".join(parts) + ".")
+    chosen = look["chosen"] if look else choice["chosen"]
+    if chosen == "off":
+        lines.append("To train with the template anyway: `model.sample_contact_weight=100 "
+                     "model.sample_contacts=content` (`stylemotion-train experiment=style_cvae`, or a reproduction's "
+                     "`stages.cvae`).")
     return "\n\n".join(lines)

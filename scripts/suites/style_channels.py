@@ -32,7 +32,7 @@ from pathlib import Path
 from typing import Any
 
 from suites import style
-from suites.common import fmt, md_table, provenance_line, spread
+from suites.common import capped_log, fmt, md_table, provenance_line, spread
 
 DESCRIPTION = ("the style CVAE's Gram over all channels or pose channels only, chosen on Bandai validation clips at "
                "full budget against issue 27's aims")
@@ -89,19 +89,14 @@ def case_figures(report: dict[str, Any], styles: list[str]) -> dict[str, dict[st
 
 def candidate_summary(cases: list[dict[str, Any]]) -> dict[str, Any]:
     """Over every (seed, stance, style) case of a candidate: the rule's figures and spreads."""
-    def capped_log(c: dict[str, Any]) -> float:
-        values = [c[k] for k in VARIATION]
-        if any(v is None or not v > 0 for v in values):
-            return -math.inf
-        return sum(math.log(min(1.0, v)) for v in values) / len(values)
-
     return {"cases": len(cases), "rows_on_diagonal": sum(c["row_on_diagonal"] for c in cases),
             "meets_aims": sum(c["meets_aims"] for c in cases),
             "recognition": spread(c["recognition"] for c in cases),
             **{k: spread(c[k] for c in cases) for k in VARIATION},
             "skating_samples": spread(c["skating_samples"] for c in cases),
             "skating_real": spread(c["skating_real"] for c in cases),
-            "capped_log_variation": sum(capped_log(c) for c in cases) / len(cases) if cases else -math.inf}
+            "capped_log_variation": (sum(capped_log([c[k] for k in VARIATION]) for c in cases) / len(cases)
+                                     if cases else -math.inf)}
 
 
 def choose(summaries: dict[str, dict[str, Any]]) -> dict[str, Any]:

@@ -33,7 +33,7 @@ from pathlib import Path
 from typing import Any
 
 from suites import contact_full
-from suites.common import fmt, md_table, provenance_line, spread
+from suites.common import capped_log, fmt, md_table, provenance_line, spread
 from suites.style import DATA, reproduce_seed
 
 DESCRIPTION = ("stylemotion-style's method for a style the run never saw (zero-shot network or CVAE, both on an "
@@ -94,19 +94,13 @@ def case_figures(row: dict[str, Any]) -> dict[str, dict[str, Any]]:
     return out
 
 
-def capped_log(case: dict[str, Any]) -> float:
-    values = [case[k] for k in VARIATION]
-    if any(v is None or not v > 0 for v in values):
-        return -math.inf
-    return sum(math.log(min(1.0, v)) for v in values) / len(values)
-
-
 def summary(cases: list[dict[str, Any]]) -> dict[str, Any]:
     """Over every case of one method."""
     return {"cases": len(cases), "own_column": sum(c["own_column"] for c in cases),
             "recognition": spread(c["recognition"] for c in cases),
             **{k: spread(c[k] for c in cases) for k in VARIATION},
-            "capped_log_variation": sum(capped_log(c) for c in cases) / len(cases) if cases else -math.inf}
+            "capped_log_variation": (sum(capped_log([c[k] for k in VARIATION]) for c in cases) / len(cases)
+                                     if cases else -math.inf)}
 
 
 def choose(summaries: dict[str, dict[str, Any]]) -> dict[str, Any]:

@@ -6,6 +6,10 @@ stays put. A model that widens the leg sweep without moving the root faster (or 
 slide, often too fast for the contact detector to call it planted at all, so the skating share
 (:mod:`stylemotion.primitives.skating`) leaves the motion out; these figures show the mismatch itself.
 
+The spreads over motions of the root's travel and of the leg's (the root relative to the stance foot: how far the
+root would travel were the foot planted) tell variation in the steps from variation that only a sliding foot makes:
+a model whose root speed varies while its legs do not has a wide root spread and a narrow leg spread.
+
 Motions are padded ``(n, frames, 21, 3)`` positions in metres with ``num_frames`` valid frames each, as in
 :class:`stylemotion.models.sampling.MotionSamples`.
 """
@@ -34,6 +38,11 @@ class StanceTravel:
         root_speed_mps: root travel over the whole motion ÷ its duration, m/s.
         duration_s: duration, seconds.
         motions: number of motions.
+        root_travel_sd_m: standard deviation over motions of the root travel over the middle half, metres (None
+            for one motion).
+        leg_travel_sd_m: the same of the leg travel, metres (None for one motion).
+        root_speed_sd_mps: the same of the root travel ÷ the middle half's duration, m/s (None for one motion).
+        leg_speed_sd_mps: the same of the leg travel ÷ the middle half's duration, m/s (None for one motion).
     """
 
     root_travel_m: float
@@ -43,6 +52,10 @@ class StanceTravel:
     root_speed_mps: float
     duration_s: float
     motions: int
+    root_travel_sd_m: float | None = None
+    leg_travel_sd_m: float | None = None
+    root_speed_sd_mps: float | None = None
+    leg_speed_sd_mps: float | None = None
 
     def as_dict(self) -> dict[str, float | int]:
         return asdict(self)
@@ -65,7 +78,7 @@ def stance_travel(positions: np.ndarray, num_frames: np.ndarray, fps: float, sta
     p, lengths = padded_motions(positions, num_frames, 4)
     if stance_foot not in (0, 1):
         raise ValueError(f"stance_foot must be 0 (left) or 1 (right), got {stance_foot!r}")
-    rows = np.empty((len(p), 5))
+    rows = np.empty((len(p), 6))
     for i, (motion, m) in enumerate(zip(p, lengths)):
         ground = motion[:m][..., [0, 2]]  # (m, 21, 2) horizontal
         root, foot = ground[:, 0], ground[:, FOOT_POINTS[stance_foot]]  # (m, 2), (m, 2 points, 2)
@@ -73,9 +86,14 @@ def stance_travel(positions: np.ndarray, num_frames: np.ndarray, fps: float, sta
         relative = root[:, None] - foot  # (m, 2 points, 2)
         rows[i] = (np.linalg.norm(root[hi] - root[lo]), np.linalg.norm(relative[hi] - relative[lo], axis=-1).min(),
                    np.linalg.norm(foot[hi] - foot[lo], axis=-1).min(),
-                   np.linalg.norm(root[m - 1] - root[0]) * fps / (m - 1), (m - 1) / fps)
+                   np.linalg.norm(root[m - 1] - root[0]) * fps / (m - 1), (m - 1) / fps, (hi - lo) / fps)
     ratio = rows[:, 0] / np.maximum(rows[:, 1], 1e-6)
+
+    def sd(values: np.ndarray) -> float | None:
+        return float(values.std(ddof=1)) if len(values) > 1 else None
+
     return StanceTravel(root_travel_m=float(rows[:, 0].mean()), leg_travel_m=float(rows[:, 1].mean()),
                         travel_ratio=float(np.median(ratio)), foot_drift_m=float(rows[:, 2].mean()),
                         root_speed_mps=float(rows[:, 3].mean()), duration_s=float(rows[:, 4].mean()),
-                        motions=len(p))
+                        motions=len(p), root_travel_sd_m=sd(rows[:, 0]), leg_travel_sd_m=sd(rows[:, 1]),
+                        root_speed_sd_mps=sd(rows[:, 0] / rows[:, 5]), leg_speed_sd_mps=sd(rows[:, 1] / rows[:, 5]))

@@ -52,3 +52,16 @@ def test_padding_past_num_frames_is_ignored_and_bad_input_is_refused() -> None:
         stance_travel(both, np.array([3, 17]), FPS, 0)
     with pytest.raises(ValueError, match="stance_foot"):
         stance_travel(both, np.array([17, 17]), FPS, 2)
+
+
+def test_a_root_speed_spread_the_legs_do_not_make_shows_in_the_root_spread_only() -> None:
+    # two motions, the same leg sweep (1.2 m/s relative to the stance foot): one planted, one whose foot slides
+    # backwards at 0.3 m/s under a root at 0.9 m/s
+    both = np.stack([walker(17, 1.2, 0.0), walker(17, 0.9, -0.3)])
+    s = stance_travel(both, np.array([17, 17]), FPS, 0)
+    assert s.root_travel_sd_m == pytest.approx(np.std([0.32, 0.24], ddof=1))
+    assert s.leg_travel_sd_m == pytest.approx(0.0, abs=1e-12)
+    assert s.root_speed_sd_mps == pytest.approx(np.std([1.2, 0.9], ddof=1))  # over the middle half's 8 / 30 s
+    assert s.leg_speed_sd_mps == pytest.approx(0.0, abs=1e-12)
+    one = stance_travel(both[:1], np.array([17]), FPS, 0)
+    assert one.root_travel_sd_m is None and one.leg_speed_sd_mps is None

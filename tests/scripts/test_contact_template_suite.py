@@ -4,6 +4,7 @@ over real by more than the tie band) and the block (hand-made reports, no traini
 
 from __future__ import annotations
 
+import math
 import sys
 from pathlib import Path
 
@@ -109,3 +110,50 @@ def test_the_reading_names_what_keeps_an_arm_out_and_what_it_changes() -> None:
     assert "`content100` (not eligible: variation (mean capped log" in text
     assert "mid-stance speed over real falls from 0.48 to 0.02 m/s" in text and "V_SD 0.50 to 0.40" in text
     assert "Block `stance`" not in text  # no stance figures in these results
+
+
+def spreads(root: float, leg: float) -> dict:
+    """Stance spreads of one model: root and leg travel SD (m) and speed SD (m/s, over a middle half of 0.25 s)."""
+    return {"root_travel_sd_m": root, "leg_travel_sd_m": leg, "root_speed_sd_mps": root * 4,
+            "leg_speed_sd_mps": leg * 4}
+
+
+def test_the_second_look_rules_on_leg_spreads_not_on_the_roots_that_sliding_widens() -> None:
+    # off: the root spread is the real clips' but the legs keep half of it (sliding); content100: root and legs
+    # both at 0.6 of the real clips', its first-rule V_SD lower (capped log ≈ 0.074 below off's: not eligible)
+    per_seed = {"100": {"off": {**run(report(0.5)), "stance_travel": {"p/neutral": spreads(1, 1),
+                                                                       "p/a": spreads(0.1, 0.05)}},
+                        "content100": {**run(report(0.04, v_sd=0.4)), "stance_travel": {"p/a": spreads(0.06, 0.06)}}}}
+    real = {"100": {"p/neutral": spreads(1, 1), "p/a": spreads(0.1, 0.1)}}
+    summary = {n: contact_template.arm_summary([per_seed["100"][n]]) for n in ("off", "content100")}
+    assert contact_template.choose(summary)["chosen"] == "off"
+    cases = contact_template.spread_cases(per_seed, real)
+    assert len(cases["off"]) == 1 and len(cases["content100"]) == 1  # the neutral VAE is not a styled case
+    assert cases["off"][0]["root_travel_sd_m"] == 1.0 and cases["off"][0]["leg_travel_sd_m"] == 0.5
+    assert cases["content100"][0]["leg_speed_sd_mps"] == 0.6 and cases["content100"][0]["diversity"] == 0.5
+    look = contact_template.choose_sliding_free(per_seed, real, summary)
+    # sliding-free capped logs: off (log .5 + log .5 + log .5) / 3, content (2 log .6 + log .5) / 3: content higher
+    assert abs(look["capped_log_sliding_free"]["off"] - math.log(0.5)) < 1e-12
+    assert look["eligible"] == {"off": True, "content100": True} and look["chosen"] == "content100"
+    # content's legs at 0.3 of the real clips': below off's minus the tie, not eligible, off stays
+    per_seed["100"]["content100"]["stance_travel"]["p/a"] = spreads(0.03, 0.03)
+    assert contact_template.choose_sliding_free(per_seed, real, summary)["chosen"] == "off"
+
+
+def test_the_sliding_block_and_the_reading_state_the_second_look() -> None:
+    per_seed = {"100": {"off": {**run(report(0.5)), "stance_travel": {"p/a": spreads(0.1, 0.05)}},
+                        "content100": {**run(report(0.04, v_sd=0.4)), "stance_travel": {"p/a": spreads(0.06, 0.06)}}}}
+    real = {"100": {"p/a": spreads(0.1, 0.1)}}
+    summary = {n: contact_template.arm_summary([per_seed["100"][n]]) for n in ("off", "content100")}
+    results = {"data": "bandai", "weight": 100.0, "arms": {"off": [], "content100": []}, "overrides": [],
+               "per_seed": per_seed, "summary": summary, "choice": contact_template.choose(summary),
+               "sliding_free": contact_template.choose_sliding_free(per_seed, real, summary)}
+    text = contact_template.render_sliding(results)
+    assert "Verdict: **content100** is chosen" in text
+    assert "| off | 1.00 ± 0.00 (1.00–1.00) | 0.50 ± 0.00 (0.50–0.50) |" in text
+    assert "| **content100** | 0.60 ± 0.00 (0.60–0.60) | 0.60 ± 0.00 (0.60–0.60) |" in text
+    reading = contact_template.render_reading(results)
+    assert "by the rule **off** is the default" in reading
+    assert "Second look (block `sliding`): by its rule **content100** is the default" in reading
+    assert "`off` root travel SD 1.00 and leg travel SD 0.50 of the real clips'" in reading
+    assert "To train with the template anyway" not in reading

@@ -35,7 +35,8 @@ def test_case_figures_are_shares_of_the_real_clips() -> None:
     assert figures["zero_shot"] == {"recognition": 0.9, "own_column": True, "v_sd": 0.5, "step_sd": 0.5,
                                     "diversity": 0.5}
     assert figures["cvae_unseen"]["v_sd"] == 0.25 and figures["cvae"]["own_column"] is True
-    assert math.isclose(style_method.capped_log(figures["zero_shot"]), math.log(0.5))
+    assert math.isclose(style_method.capped_log([figures["zero_shot"][k] for k in style_method.VARIATION]),
+                        math.log(0.5))
 
 
 def test_zero_shot_wins_only_with_its_rows_its_recognition_and_more_variation() -> None:
