@@ -396,8 +396,13 @@ def render_reading(r: dict[str, Any]) -> str:
         parts = [f"`{n}` root travel SD {fmt(look['shares'][n]['root_travel_sd_m'].get('mean'))} and leg travel SD "
                  f"{fmt(look['shares'][n]['leg_travel_sd_m'].get('mean'))} of the real clips' (mean capped log "
                  f"{fmt(look['capped_log_sliding_free'][n], 3)})" for n in arms_]
+        wider = [n for n in arms_ if (look["shares"][n]["root_travel_sd_m"].get("mean") or 0)
+                 > (look["shares"][n]["leg_travel_sd_m"].get("mean") or 0)]
         lines.append(f"Second look (block `sliding`): by its rule **{look['chosen']}** is the default. "
-                     + "; ".join(parts) + ".")
+                     + "; ".join(parts) + ". "
+                     + (f"Root spread above the legs' (variation a sliding foot makes) in {', '.join(wider)}."
+                        if wider else "In no arm is the root's travel spread above the legs': sliding does not "
+                        "widen the step variation the first rule read."))
     chosen = look["chosen"] if look else choice["chosen"]
     if chosen == "off":
         lines.append("To train with the template anyway: `model.sample_contact_weight=100 "

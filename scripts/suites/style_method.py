@@ -190,4 +190,22 @@ def render(record: dict[str, Any]) -> dict[str, str]:
         f"{TIE:g}. Tests: {tests}. Verdict: {verdict}.\n\n"
         + md_table(["method", "own column", "recognition", "V_SD / style", "step_SD / style", "diversity / style",
                     "mean capped log variation"], rows)
-        + f"\n\n{provenance_line(record)}")}
+        + f"\n\n{provenance_line(record)}"),
+        "styles": f"{render_styles(r)}\n\n{provenance_line(record)}"}
+
+
+def render_styles(r: dict[str, Any]) -> str:
+    """Per left-out style, over seeds and primitives: each method's recognition, own-column rows and diversity."""
+    cases: dict[str, list[dict[str, Any]]] = {}
+    for seed in r["per_seed"].values():
+        for key, case in seed["cases"].items():
+            cases.setdefault(key.split("/", 1)[1], []).append(case)
+    sd = contact_full.sd
+    rows = [[style, *(cell for kind in (*METHODS, REFERENCE) for cell in (
+        sd(spread(c[kind]["recognition"] for c in group), 3),
+        f"{sum(c[kind]['own_column'] for c in group)}/{len(group)}",
+        sd(spread(c[kind]["diversity"] for c in group))))] for style, group in cases.items()]
+    header = [h for kind in ("zero-shot", "CVAE, AE without the style", "judge's CVAE")
+              for h in (f"{kind}: recognition", "own column", "diversity / style")]
+    return ("Per left-out style, mean ± sd (min–max) over training seeds and primitives (same runs as above).\n\n"
+            + md_table(["style", *header], rows))

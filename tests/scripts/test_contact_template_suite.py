@@ -156,4 +156,5 @@ def test_the_sliding_block_and_the_reading_state_the_second_look() -> None:
     assert "by the rule **off** is the default" in reading
     assert "Second look (block `sliding`): by its rule **content100** is the default" in reading
     assert "`off` root travel SD 1.00 and leg travel SD 0.50 of the real clips'" in reading
+    assert "Root spread above the legs' (variation a sliding foot makes) in off." in reading
     assert "To train with the template anyway" not in reading

@@ -69,3 +69,14 @@ def test_the_block_states_the_verdict() -> None:
     assert "Verdict: **method=zero_shot becomes the default**" in style_method.render({**record, "results": full})[
         "headline"]
     assert "| zero-shot network (method=zero_shot) | 1/1 | 0.950 ± 0.000 (0.950–0.950) | 0.75 ± 0.00" in text
+
+
+def test_the_styles_block_pools_seeds_and_primitives_per_left_out_style() -> None:
+    left = style_method.case_figures(row(model(0.6, False, 0.2), model(0.97, True, 0.1)))
+    right = style_method.case_figures(row(model(0.8, True, 0.2), model(0.99, True, 0.1)))
+    per_seed = {"100": {"cases": {"walk_leftStance/exhausted": left, "walk_rightStance/exhausted": right}},
+                "101": {"cases": {"walk_leftStance/exhausted": left, "walk_rightStance/exhausted": right}}}
+    text = style_method.render_styles({"per_seed": per_seed})
+    # zero-shot recognition 0.6, 0.8, 0.6, 0.8: mean 0.7, sd 0.115; own column in the right stance only
+    assert "| exhausted | 0.700 ± 0.115 (0.600–0.800) | 2/4 | 0.50 ± 0.00 (0.50–0.50) | 0.980 ± 0.012" in text
+    assert text.count("| exhausted |") == 1
