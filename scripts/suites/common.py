@@ -74,6 +74,11 @@ def capped_log(shares: Iterable[float | None]) -> float:
     return sum(math.log(min(1.0, v)) for v in values) / len(values)
 
 
+def mean_capped_log(cases: Sequence[Mapping[str, float | None]], keys: Sequence[str]) -> float:
+    """Mean over ``cases`` of :func:`capped_log` of each case's ``keys``; −inf without cases."""
+    return sum(capped_log([c[k] for k in keys]) for c in cases) / len(cases) if cases else -math.inf
+
+
 def quantiles(values: Sequence[float], qs: Sequence[float] = (50, 95, 100)) -> dict[str, float | None]:
     """Percentiles of ``values`` as ``{"p50": …, "p95": …, "p100": …}`` (None for no values)."""
     arr = np.asarray([v for v in values if v is not None], dtype=float)

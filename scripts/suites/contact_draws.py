@@ -68,17 +68,21 @@ def candidate_summary(runs: list[dict[str, Any]]) -> dict[str, Any]:
             "cvae_minutes": sum(run["cvae_minutes"] for run in runs) / len(runs) if runs else None}
 
 
-def eligibility(summaries: dict[str, dict[str, Any]]) -> tuple[dict[str, bool], float, float]:
+def eligibility(summaries: dict[str, dict[str, Any]], variation: dict[str, float] | None = None
+                ) -> tuple[dict[str, bool], float, float]:
     """Which candidates keep the first one's styled rows, recognition (floor min(0.9, its mean)) and capped log
-    variation (its own minus :data:`suites.style_channels.TIE`); returns (eligible, recognition floor, variation
-    floor). The first candidate is always eligible."""
+    variation (its own minus :data:`suites.style_channels.TIE`; ``variation``: another figure per candidate in its
+    place, default each summary's ``capped_log_variation``); returns (eligible, recognition floor, variation floor).
+    The first candidate is always eligible."""
     names = list(summaries)
     first = summaries[names[0]]["styled"]
+    if variation is None:
+        variation = {n: s["styled"]["capped_log_variation"] for n, s in summaries.items()}
     floor = min(style_channels.AIMS["recognition"], first["recognition"]["mean"])
-    variation_floor = first["capped_log_variation"] - style_channels.TIE
+    variation_floor = variation[names[0]] - style_channels.TIE
     eligible = {n: n == names[0] or (s["styled"]["rows_on_diagonal"] >= first["rows_on_diagonal"]
                                      and s["styled"]["recognition"]["mean"] >= floor
-                                     and s["styled"]["capped_log_variation"] >= variation_floor)
+                                     and variation[n] >= variation_floor)
                 for n, s in summaries.items()}
     return eligible, floor, variation_floor
 

@@ -50,7 +50,7 @@ from pathlib import Path
 from typing import Any
 
 from suites import contact_draws, contact_full, style, style_channels
-from suites.common import capped_log, fmt, md_table, provenance_line, spread
+from suites.common import fmt, md_table, mean_capped_log, provenance_line, spread
 
 DESCRIPTION = ("where the style CVAE's draws' contact term holds their feet (their own contacts or the content "
                "clips' template), chosen at full budget on Bandai validation clips of every style")
@@ -168,14 +168,8 @@ def choose_sliding_free(per_seed: dict[str, dict[str, Any]], stance_real: dict[s
     """The module doc's second look: :func:`choose` with the variation test on the sliding-free shares."""
     cases = spread_cases(per_seed, stance_real)
     names = list(summaries)
-    figure = {n: (sum(capped_log([c[k] for k in SLIDING_FREE]) for c in cases.get(n, [])) / len(cases[n])
-                  if cases.get(n) else -float("inf")) for n in names}
-    eligible_first, floor, _ = contact_draws.eligibility(summaries)
-    first = summaries[names[0]]["styled"]
-    variation_floor = figure[names[0]] - style_channels.TIE
-    eligible = {n: n == names[0] or (summaries[n]["styled"]["rows_on_diagonal"] >= first["rows_on_diagonal"]
-                                     and summaries[n]["styled"]["recognition"]["mean"] >= floor
-                                     and figure[n] >= variation_floor) for n in names}
+    figure = {n: mean_capped_log(cases.get(n, []), SLIDING_FREE) for n in names}
+    eligible, floor, variation_floor = contact_draws.eligibility(summaries, figure)
     shares = {n: {k: spread(c[k] for c in cases.get(n, [])) for k in (*(k for k, _ in SPREADS), "diversity")}
               for n in names}
     return {"capped_log_sliding_free": figure, "variation_floor": variation_floor, "recognition_floor": floor,

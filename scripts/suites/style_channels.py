@@ -26,13 +26,12 @@ beside, not ruled on.
 from __future__ import annotations
 
 import argparse
-import math
 import shutil
 from pathlib import Path
 from typing import Any
 
 from suites import style
-from suites.common import capped_log, fmt, md_table, provenance_line, spread
+from suites.common import fmt, md_table, mean_capped_log, provenance_line, spread
 
 DESCRIPTION = ("the style CVAE's Gram over all channels or pose channels only, chosen on Bandai validation clips at "
                "full budget against issue 27's aims")
@@ -95,8 +94,7 @@ def candidate_summary(cases: list[dict[str, Any]]) -> dict[str, Any]:
             **{k: spread(c[k] for c in cases) for k in VARIATION},
             "skating_samples": spread(c["skating_samples"] for c in cases),
             "skating_real": spread(c["skating_real"] for c in cases),
-            "capped_log_variation": (sum(capped_log([c[k] for k in VARIATION]) for c in cases) / len(cases)
-                                     if cases else -math.inf)}
+            "capped_log_variation": mean_capped_log(cases, VARIATION)}
 
 
 def choose(summaries: dict[str, dict[str, Any]]) -> dict[str, Any]:

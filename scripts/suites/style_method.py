@@ -28,12 +28,11 @@ the default when its own-column rows are no fewer than ``cvae_unseen``'s, its me
 from __future__ import annotations
 
 import argparse
-import math
 from pathlib import Path
 from typing import Any
 
 from suites import contact_full
-from suites.common import capped_log, fmt, md_table, provenance_line, spread
+from suites.common import fmt, md_table, mean_capped_log, provenance_line, spread
 from suites.style import DATA, reproduce_seed
 
 DESCRIPTION = ("stylemotion-style's method for a style the run never saw (zero-shot network or CVAE, both on an "
@@ -99,8 +98,7 @@ def summary(cases: list[dict[str, Any]]) -> dict[str, Any]:
     return {"cases": len(cases), "own_column": sum(c["own_column"] for c in cases),
             "recognition": spread(c["recognition"] for c in cases),
             **{k: spread(c[k] for c in cases) for k in VARIATION},
-            "capped_log_variation": (sum(capped_log([c[k] for k in VARIATION]) for c in cases) / len(cases)
-                                     if cases else -math.inf)}
+            "capped_log_variation": mean_capped_log(cases, VARIATION)}
 
 
 def choose(summaries: dict[str, dict[str, Any]]) -> dict[str, Any]:

@@ -12,6 +12,7 @@ ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "scripts"))
 
 from suites import style_method  # noqa: E402
+from suites.common import capped_log  # noqa: E402
 
 
 def model(recognition: float, own: bool, v_sd: float) -> dict:
@@ -35,7 +36,7 @@ def test_case_figures_are_shares_of_the_real_clips() -> None:
     assert figures["zero_shot"] == {"recognition": 0.9, "own_column": True, "v_sd": 0.5, "step_sd": 0.5,
                                     "diversity": 0.5}
     assert figures["cvae_unseen"]["v_sd"] == 0.25 and figures["cvae"]["own_column"] is True
-    assert math.isclose(style_method.capped_log([figures["zero_shot"][k] for k in style_method.VARIATION]),
+    assert math.isclose(capped_log([figures["zero_shot"][k] for k in style_method.VARIATION]),
                         math.log(0.5))
 
 
