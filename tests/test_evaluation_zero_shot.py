@@ -256,6 +256,16 @@ def test_the_cvae_on_the_autoencoder_without_the_style_is_a_row_beside_the_netwo
     assert again["primitives"][PRIMITIVE]["styles"][STYLE]["cvae_unseen"] == {**row["cvae_unseen"],
                                                                               "train_seconds": None}
     assert row["cvae_unseen"]["train_seconds"] > 0
+    # an arm with other networks on the same stages: the autoencoder and the CVAE reused, only the network trained
+    with logged_lines("stylemotion.evaluation.zero_shot") as arm_lines:
+        arm = leave_one_style_out(run, tmp_path / "arm", [STYLE], [PRIMITIVE], epochs=1, samples=SAMPLES, seed=SEED,
+                                  overrides=NETWORK, threads=1, cvae_unseen=True, stages=out)
+    assert sum("reused" in line for line in arm_lines) == 2
+    assert not (tmp_path / "arm" / "autoencoders").exists() and arm["meta"]["stages"] == str(out.resolve())
+    arm_row = arm["primitives"][PRIMITIVE]["styles"][STYLE]
+    assert arm_row["cvae_unseen"] == {**row["cvae_unseen"], "train_seconds": None}
+    assert arm_row["generator_autoencoder"]["path"] == row["generator_autoencoder"]["path"]
+    assert arm_row["zero_shot"]["train_seconds"] > 0
 
 
 def test_the_train_configs_leave_the_style_out_of_the_runs_data(run, tmp_path) -> None:

@@ -10,7 +10,8 @@ style ``s`` :func:`stylemotion.evaluation.zero_shot.leave_one_style_out` (``cvae
 autoencoder without any take of ``s`` and on it, for each primitive, the two methods of ``stylemotion-style``:
 
 * ``zero_shot``: the zero-shot network trained without ``s`` (``--epochs``; default the ``zero_shot`` experiment's,
-  as ``stylemotion-style method=zero_shot`` trains it), conditioned on the example clip(s) of the judge's CVAE of s;
+  as ``stylemotion-style method=zero_shot`` trains it), conditioned on the example clip(s) of the judge's CVAE of s
+  (in ``seed<k>_e<epochs>/`` when ``--epochs`` is given; the autoencoders and CVAEs stay in ``seed<k>/``, shared);
 * ``cvae_unseen``: the judge's CVAE stage of ``(p, s)`` (the same settings and example clips) on that autoencoder,
   as ``stylemotion-style method=cvae`` trains it.
 
@@ -53,6 +54,14 @@ AIM_RECOGNITION = 0.9
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
+    leave_one_out_arguments(parser)
+    parser.add_argument("--epochs", type=int, default=None,
+                        help="epochs of each zero-shot network (default: the zero_shot experiment's, as "
+                             "stylemotion-style trains it)")
+
+
+def leave_one_out_arguments(parser: argparse.ArgumentParser) -> None:
+    """The options of the leave-one-style-out runs but the networks' epochs (suite zero_shot_epochs shares them)."""
     parser.add_argument("--data", choices=sorted(DATA), default="bandai",
                         help="bandai: dataset-2 walks; synthetic: a smoke run of the suite only")
     parser.add_argument("--judge", default=str(ROOT / "runs" / "benchmarks" / "contact_template" / "{data}" /
@@ -63,9 +72,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="folder of the leave-one-style-out trainings (reused and resumed)")
     parser.add_argument("--styles", nargs="+", default=None, help="left-out styles (default: the judge's CVAE styles)")
     parser.add_argument("--primitives", nargs="+", default=None, help="primitives (default: the judge's)")
-    parser.add_argument("--epochs", type=int, default=None,
-                        help="epochs of each zero-shot network (default: the zero_shot experiment's, as "
-                             "stylemotion-style trains it)")
     parser.add_argument("--samples", type=int, default=1000, help="samples per model and seed")
     parser.add_argument("--workers", type=int, default=2,
                         help="processes at once: training stages of a judge made here, then seeds (one thread each)")
@@ -123,9 +129,11 @@ def seed_record(args: argparse.Namespace, seed: int, judge: Path) -> dict[str, A
     if list(source.settings.heldout_splits) != ["val"]:
         raise ZeroShotRunError(f"judge {judge} was evaluated on {list(source.settings.heldout_splits)}, not "
                                "[val]: the choice must not read test clips")
-    out = args.runs / args.data / (f"seed{seed}" + ("" if args.epochs is None else f"_e{args.epochs}"))
+    # Autoencoders and CVAEs in seed<k>/, shared by every epoch count of the networks (seed<k>_e<epochs>/).
+    stages = args.runs / args.data / f"seed{seed}"
+    out = stages if args.epochs is None else stages.with_name(f"seed{seed}_e{args.epochs}")
     result = leave_one_style_out(judge, out, args.styles, args.primitives, args.epochs, args.samples, seed,
-                                 threads=1, resume=True, cvae_unseen=True)
+                                 threads=1, resume=True, cvae_unseen=True, stages=stages)
     cases = {f"{p}/{s}": case_figures(row) for p, res in result["primitives"].items()
              for s, row in res["styles"].items()}
     minutes = {f"{p}/{s}": {

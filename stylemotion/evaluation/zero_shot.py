@@ -36,7 +36,8 @@ For each primitive ``p`` of a finished ``stylemotion-reproduce`` run and each of
 ``shared_autoencoder=True`` keeps the earlier protocol: the network is trained on the run's autoencoder, which
 saw s. Its output is labelled **leaky** (``meta.leaky``) and is no evidence that the network generalizes to an
 unseen style. ``out`` must not exist unless ``force`` (replace it) or ``resume`` (reuse the finished trainings in
-it, resume interrupted ones).
+it, resume interrupted ones). ``stages`` keeps the autoencoders and the ``cvae_unseen`` CVAEs in another folder,
+which arms that differ only in their networks (e.g. the networks' epochs) share.
 """
 
 from __future__ import annotations
@@ -469,7 +470,7 @@ def leave_one_style_out(run: str | Path, out: str | Path, styles: Sequence[str] 
                         primitives: Sequence[str] | None = None, epochs: int | None = None, samples: int = 1000,
                         seed: int | None = None, overrides: Sequence[str] = (), threads: Any = None,
                         force: bool = False, resume: bool = False, shared_autoencoder: bool = False,
-                        cvae_unseen: bool = False) -> dict[str, Any]:
+                        cvae_unseen: bool = False, stages: str | Path | None = None) -> dict[str, Any]:
     """The leave-one-style-out evaluation (see the module doc); returns what ``zero_shot.json`` holds.
 
     Args:
@@ -488,6 +489,9 @@ def leave_one_style_out(run: str | Path, out: str | Path, styles: Sequence[str] 
             the generator's autoencoder (which never saw the style; the same example clips) into
             ``<out>/models/<p>_cvae_on_without_<s>``: row ``cvae_unseen``, what ``stylemotion-style method=cvae``
             gives a user whose style the run's autoencoder never saw.
+        stages: the folder of the autoencoders without each style and of the ``cvae_unseen`` CVAEs (default
+            ``out``; created when missing, its finished trainings reused): arms that differ only in the networks
+            (e.g. their epochs) share them, so every arm is judged on the same generators and CVAEs.
 
     Raises:
         OutputExistsError: ``out`` exists and neither ``force`` nor ``resume`` is on (before any work).
@@ -514,6 +518,8 @@ def leave_one_style_out(run: str | Path, out: str | Path, styles: Sequence[str] 
     if out.exists() and not resume:
         shutil.rmtree(out)
     out.mkdir(parents=True, exist_ok=True)
+    stages = out if stages is None else Path(stages).expanduser()
+    stages.mkdir(parents=True, exist_ok=True)
     judge = load_autoencoder(source.autoencoder_ckpt)
     judge_info = {"path": str(source.autoencoder_ckpt.resolve()), "fingerprint": fingerprint(judge)}
     takeset = build_dataset(source.data_cfg)
@@ -523,7 +529,7 @@ def leave_one_style_out(run: str | Path, out: str | Path, styles: Sequence[str] 
         networks, trained = {}, {}
         for s in wanted:
             if s not in generators:
-                generators[s] = _generator_autoencoder(source, s, out, seed, threads, shared_autoencoder)
+                generators[s] = _generator_autoencoder(source, s, stages, seed, threads, shared_autoencoder)
             gen = generators[s]
             cfg = train_config(source, p, s, model_folder(out, p, s), epochs, overrides, threads, gen["path"], seed)
             path, seconds = train_once(cfg, f"{p} network without {s}")
@@ -533,7 +539,7 @@ def leave_one_style_out(run: str | Path, out: str | Path, styles: Sequence[str] 
             trained[s] = {"checkpoint": str(path), "train_seconds": seconds}
         cvaes = [load_model(source.cvaes[(q, s)], source.settings.neutral_style, judge)
                  for q, s in source.cvaes if q == p]
-        unseen_trained = ({s: _unseen_cvae(source, p, s, out, seed, threads, generators[s], cvaes) for s in wanted}
+        unseen_trained = ({s: _unseen_cvae(source, p, s, stages, seed, threads, generators[s], cvaes) for s in wanted}
                           if cvae_unseen and not shared_autoencoder else {})
         unseen = {s: model for s, (model, _) in unseen_trained.items()} or None
         results[p] = evaluate_primitive(p, networks, cvaes, takeset, judge, source.settings,
@@ -550,6 +556,7 @@ def leave_one_style_out(run: str | Path, out: str | Path, styles: Sequence[str] 
                         "samples": samples, "epochs": epochs, "overrides": list(overrides),
                         "leaky": LEAKY if shared_autoencoder else False, "cvae_unseen": bool(unseen),
                         "autoencoders": "shared (the run's)" if shared_autoencoder else "one per left-out style",
+                        "stages": str(stages.resolve()),
                         "judge_autoencoder": judge_info,
                         "settings": asdict(source.settings), **provenance(),
                         "seconds": time.perf_counter() - started}}
