@@ -53,6 +53,13 @@ TIE = 0.05
 AIM_RECOGNITION = 0.9
 
 
+def experiment_epochs() -> int:
+    """``trainer.max_epochs`` of ``experiment=zero_shot`` (what ``stylemotion-style method=zero_shot`` trains)."""
+    from omegaconf import OmegaConf
+
+    return int(OmegaConf.load(ROOT / "stylemotion" / "configs" / "experiment" / "zero_shot.yaml").trainer.max_epochs)
+
+
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     leave_one_out_arguments(parser)
     parser.add_argument("--epochs", type=int, default=None,
@@ -158,7 +165,7 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
         per_seed: dict[str, Any] = {str(seed): future.result() for seed, future in futures.items()}
     summaries = {kind: summary([c[kind] for s in per_seed.values() for c in s["cases"].values()])
                  for kind in (*METHODS, REFERENCE)}
-    return {"data": args.data, "epochs": args.epochs, "samples": args.samples,
+    return {"data": args.data, "epochs": args.epochs, "experiment_epochs": experiment_epochs(), "samples": args.samples,
             "narrowed": {"primitives": args.primitives, "styles": args.styles},
             "splits": {"choose": "the judge's evaluation.heldout_splits=[val]: real clips of the train and val "
                                  "splits; no test clip", "seeds": "training seeds, not reported seeds"},
@@ -186,7 +193,7 @@ def render(record: dict[str, Any]) -> dict[str, str]:
     return {"headline": (
         f"{label}A style the run never saw, on **validation** clips ({r['data']}, training seeds "
         f"{', '.join(r['per_seed'])}: not reported seeds; network epochs: "
-        f"{r['epochs'] if r['epochs'] else 'the zero_shot experiment’s'}): per left-out style an autoencoder without "
+        f"{network_epochs(r, record)}): per left-out style an autoencoder without "
         f"it, and on it the zero-shot network and the CVAE as stylemotion-style trains them, judged by a "
         f"reproduction evaluated with `evaluation.heldout_splits=[val]`. Recognition: share of samples the judge's "
         f"classifier gives the style; own column: Table 5.1 rows whose minimum is the style's example; V_SD, step_SD, "
@@ -198,6 +205,16 @@ def render(record: dict[str, Any]) -> dict[str, str]:
                     "mean capped log variation"], rows)
         + f"\n\n{provenance_line(record)}"),
         "styles": f"{render_styles(r)}\n\n{provenance_line(record)}"}
+
+
+def network_epochs(r: dict[str, Any], record: dict[str, Any]) -> str:
+    """The networks' epochs as the block states them: ``--epochs``, else the experiment's when the run recorded it,
+    else the experiment's at the run's commit (results from before the record)."""
+    if r["epochs"]:
+        return str(r["epochs"])
+    if r.get("experiment_epochs"):
+        return f"{r['experiment_epochs']}, the zero_shot experiment's"
+    return f"the zero_shot experiment's at commit {record['commit'][:12]}"
 
 
 def render_styles(r: dict[str, Any]) -> str:

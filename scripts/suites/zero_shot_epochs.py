@@ -33,7 +33,6 @@ DESCRIPTION = ("the zero-shot network's training epochs (experiment=zero_shot tr
                "stylemotion-style's method, chosen on validation clips")
 DEFAULT_SEEDS = style_method.DEFAULT_SEEDS
 ROOT = style_method.ROOT
-EXPERIMENT = ROOT / "stylemotion" / "configs" / "experiment" / "zero_shot.yaml"
 DEFAULT_ARMS = (10, 30, 100)
 #: Mean recognitions this close count as tied (fallback of the rule).
 RECOGNITION_TIE = 0.01
@@ -43,13 +42,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     style_method.leave_one_out_arguments(parser)
     parser.add_argument("--epochs", type=int, nargs="+", default=list(DEFAULT_ARMS),
                         help="epoch counts of the zero-shot networks, one arm each")
-
-
-def experiment_epochs() -> int:
-    """``trainer.max_epochs`` of ``experiment=zero_shot`` (what ``stylemotion-style method=zero_shot`` trains)."""
-    from omegaconf import OmegaConf
-
-    return int(OmegaConf.load(EXPERIMENT).trainer.max_epochs)
 
 
 def network_minutes(out: str, cases: dict[str, Any]) -> list[float]:
@@ -101,7 +93,7 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
     from concurrent.futures import ProcessPoolExecutor
     from multiprocessing import get_context
 
-    default = experiment_epochs()
+    default = style_method.experiment_epochs()
     judges = {seed: style_method.judge_for(args, seed) for seed in seeds}
     # The experiment's own count first: it trains the shared autoencoders and CVAEs when they are missing.
     counts = sorted(set(args.epochs), key=lambda e: (e != default, e))
@@ -136,7 +128,7 @@ def render(record: dict[str, Any]) -> dict[str, str]:
         label += "**Narrowed:** " + "; ".join(f"{k} {', '.join(v)}" for k, v in narrowed.items()) + ". "
     full = not narrowed and len(seeds) >= 2
     rows = []
-    for epochs, arm in r["arms"].items():
+    for epochs, arm in sorted(r["arms"].items(), key=lambda item: int(item[0])):
         s = arm["summary"]["zero_shot"]
         tests = arm["choice"]["tests"]
         rows.append([f"zero-shot, {epochs} epochs", f"{s['own_column']}/{s['cases']}", sd(s["recognition"], 3),
@@ -156,7 +148,7 @@ def render(record: dict[str, Any]) -> dict[str, str]:
     headline = (
         f"{label}The zero-shot network's epochs, on **validation** clips ({r['data']}, training seeds "
         f"{', '.join(seeds)}: not reported seeds): suite style_method's leave-one-style-out per arm, the autoencoders "
-        f"without each style and the CVAEs on them shared by every arm ({same}). Figures as in style_method's block; "
+        f"without each style and the CVAEs on them shared by every arm; {same}. Figures as in style_method's block; "
         f"minutes: training of one network (one torch thread, two seeds at once). An arm qualifies when its own "
         f"column and recognition pass style_method's tests. Verdict: {verdict}.\n\n"
         + md_table(["model", "own column", "recognition", "V_SD / style", "step_SD / style", "diversity / style",
@@ -172,7 +164,7 @@ def render_styles(r: dict[str, Any]) -> str:
         for seed in per_seed.values():
             for key, case in seed["cases"].items():
                 styles.setdefault(key.split("/", 1)[1], {}).setdefault(epochs, []).append(case["zero_shot"])
-    arms = list(r["per_arm"])
+    arms = sorted(r["per_arm"], key=int)
     rows = [[style, *(cell for e in arms for cell in (
         contact_full.sd(spread(c["recognition"] for c in by_arm.get(e, [])), 3),
         f"{sum(c['own_column'] for c in by_arm.get(e, []))}/{len(by_arm.get(e, []))}"))]

@@ -65,6 +65,9 @@ def test_the_block_states_the_verdict() -> None:
     text = style_method.render(record)["headline"]
     assert "Verdict: zero-shot by the rule, **not applied**: a narrowed run" in text
     assert "**Narrowed:** primitives walk_leftStance" in text
+    assert "network epochs: the zero_shot experiment's at commit 000000000000)" in text  # results before the record
+    recorded = {**record, "results": {**results, "experiment_epochs": 10}}
+    assert "network epochs: 10, the zero_shot experiment's)" in style_method.render(recorded)["headline"]
     full = {**results, "narrowed": {"primitives": None, "styles": None},
             "per_seed": {"100": {"cases": cases}, "101": {"cases": cases}}}
     assert "Verdict: **method=zero_shot becomes the default**" in style_method.render({**record, "results": full})[
