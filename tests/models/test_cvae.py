@@ -157,12 +157,14 @@ def test_checkpoints_from_before_the_margin_term_and_the_contact_template_still_
     checkpoint = torch.load(tmp_path / "best.ckpt", weights_only=True)
     del checkpoint["state_dict"]["content_spread"]
     del checkpoint["state_dict"]["content_contacts"]
+    del checkpoint["state_dict"]["style_log_duration"]
     for key in ("style_term", "style_margin", "style_centred", "sample_contacts"):
         checkpoint["hyper_parameters"].pop(key)
     torch.save(checkpoint, tmp_path / "old.ckpt")
     loaded = StyleCVAE.load_from_checkpoint(tmp_path / "old.ckpt")
     assert loaded.hparams.style_term == "distance" and torch.isnan(loaded.content_spread)
     assert loaded.content_contacts.shape == (loaded.timeline_frames, 2) and not bool(loaded.content_contacts.any())
+    assert torch.isnan(loaded.style_log_duration)
     assert torch.allclose(loaded.style_gram, cvae.style_gram)
 
 
@@ -281,3 +283,28 @@ def test_the_style_subset_takes_the_mean_over_k_random_decodes(elderly) -> None:
     torch.testing.assert_close(every._extra_losses(y)["style"][0], distances.mean())
     with pytest.raises(ValueError, match="style_subset"):
         StyleCVAE(style_subset=-1)
+
+
+def test_the_styled_duration_term_moves_the_draws_mean_duration_to_the_examples(ae_ckpt) -> None:
+    """Ground truth: the example clips are recorded as lasting 1.3× the content clips' geometric mean; with γ the
+    draws' mean duration moves most of the way there (γ / (γ + w/2) of the gap, module doc), without it it stays."""
+    dm = feature_module(ae_ckpt, style="elderly")
+    content = dm.datasets["train"].duration_s.double().log().mean().exp().item()
+    dm.style_examples = [{**e, "duration_s": 1.3 * content} for e in dm.style_examples]
+    means = {}
+    for gamma in (0.0, 500.0):
+        torch.manual_seed(0)
+        model = StyleCVAE(samples_per_item=4, style_weight=1.0, style_duration_weight=gamma)
+        fit(model, dm, steps=150)
+        assert model.style_log_duration.item() == pytest.approx(np.log(1.3 * content))
+        means[gamma] = model.sample(400, seed=0).duration_s.double().log().mean().exp().item() / content
+    assert abs(means[0.0] - 1.0) < 0.1 and means[500.0] > 1.2, means
+    # the term by hand: (mean standardized log-duration − the standardized target)²
+    mean, sd = model.duration_stats[0].item(), model.duration_stats[1].item()
+    draws = torch.tensor([0.5, -0.5, 1.0])
+    target = (np.log(1.3 * content) - mean) / sd
+    assert model.style_duration_term(draws).item() == pytest.approx((1 / 3 - target) ** 2, rel=1e-5)
+    assert "style_duration" not in StyleCVAE(spec=dm.model_spec())._extra_losses(
+        model.normalize(dm.datasets["train"].features[:2], dm.datasets["train"].duration_s[:2])[None])
+    with pytest.raises(ValueError, match="style_duration_weight"):
+        StyleCVAE(style_duration_weight=-1.0)
