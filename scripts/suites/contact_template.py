@@ -215,6 +215,22 @@ def stance_figures(out: Path, report: dict[str, Any], styles: list[str], samples
     return figures
 
 
+def arm_record(args: argparse.Namespace, seed: int, first: Path, name: str, overrides: list[str],
+               real_cache: dict[str, dict[str, Any]]) -> dict[str, Any]:
+    """Arm ``name`` of ``seed`` in ``first``'s sibling folder ``name`` (``first`` is the ``off`` run, whose
+    autoencoder and VAE stages the others copy), its CVAE stages with ``overrides``, evaluated on validation clips:
+    :func:`contact_draws.val_arm`'s record with the stance figures (``stance_travel`` when ``--stance-samples`` > 0;
+    the style's real clips cached in ``real_cache``)."""
+    out = first.with_name(name)
+    out.mkdir(parents=True, exist_ok=True)
+    copied = style_channels.share_stages(first, out) if out != first else []
+    report, styles, record = contact_draws.val_arm(args, seed, out, {"cvae": overrides})
+    record = {**record, "cvae_overrides": overrides, "shared_from_off": copied, "stance": case_stance(report, styles)}
+    if args.stance_samples > 0:
+        record["stance_travel"] = stance_figures(out, report, styles, args.stance_samples, seed, real_cache)
+    return record
+
+
 def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
     import torch
 
@@ -226,16 +242,8 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
     for seed in seeds:
         first = args.runs / args.data / f"seed{seed}" / "off"
         for name, overrides in table.items():
-            out = first.with_name(name)
-            out.mkdir(parents=True, exist_ok=True)
-            copied = style_channels.share_stages(first, out) if name != "off" else []
-            report, styles, record = contact_draws.val_arm(args, seed, out, {"cvae": overrides})
-            per_seed.setdefault(str(seed), {})[name] = {**record, "cvae_overrides": overrides,
-                                                        "shared_from_off": copied,
-                                                        "stance": case_stance(report, styles)}
-            if args.stance_samples > 0:
-                per_seed[str(seed)][name]["stance_travel"] = stance_figures(
-                    out, report, styles, args.stance_samples, seed, stance_real.setdefault(str(seed), {}))
+            per_seed.setdefault(str(seed), {})[name] = arm_record(args, seed, first, name, overrides,
+                                                                  stance_real.setdefault(str(seed), {}))
     summaries = {name: arm_summary([s[name] for s in per_seed.values()]) for name in table}
     sliding_free = choose_sliding_free(per_seed, stance_real, summaries) if args.stance_samples > 0 else None
     return {"data": args.data, "weight": args.weight, "arms": table, "overrides": args.override,

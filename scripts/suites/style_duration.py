@@ -102,16 +102,9 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
     for seed in seeds:
         first = args.runs / args.data / f"seed{seed}" / "off"
         for name, overrides in table.items():
-            out = first.with_name(name)
-            out.mkdir(parents=True, exist_ok=True)
-            copied = style_channels.share_stages(first, out) if name != "off" else []
-            report, styles, record = contact_draws.val_arm(args, seed, out, {"cvae": overrides})
-            stance = contact_template.stance_figures(out, report, styles, args.stance_samples, seed,
-                                                     real.setdefault(str(seed), {}))
-            per_seed.setdefault(str(seed), {})[name] = {
-                **record, "cvae_overrides": overrides, "shared_from_off": copied,
-                "stance": contact_template.case_stance(report, styles), "stance_travel": stance,
-                "durations": duration_cases(stance, real[str(seed)])}
+            record = contact_template.arm_record(args, seed, first, name, overrides, real.setdefault(str(seed), {}))
+            record["durations"] = duration_cases(record["stance_travel"], real[str(seed)])
+            per_seed.setdefault(str(seed), {})[name] = record
     summaries = {name: arm_summary([s[name] for s in per_seed.values()]) for name in table}
     return {"data": args.data, "arms": table, "overrides": args.override, "stance_samples": args.stance_samples,
             "splits": {"choose": "evaluation.heldout_splits=[val]: no test clip is read by the figures the rule uses",
