@@ -10,9 +10,11 @@ stance block: CVAE draws 0.44–0.50 s in every style, while the style's real st
 (masculine)). A draw with a style's spatial step but a neutral duration walks the step at the wrong pace.
 
 Arms per training seed (not reported seeds), each the user's ``stylemotion-reproduce data=bandai`` (both walk
-stances, every style) with ``evaluation.heldout_splits=[val]``: ``off`` (the configs' defaults; by default suite
-contact_template's ``off`` run of the seed, reused) and ``duration<γ>`` (the CVAE stages with
-``++model.style_duration_weight=γ``), sharing ``off``'s autoencoder and neutral VAE stages (copied). Per (seed, stance,
+stances, every style) with ``evaluation.heldout_splits=[val]``: ``off`` (the CVAE stages with
+``++model.style_duration_weight=0``) and ``duration<γ>`` (with ``++model.style_duration_weight=γ``), sharing ``off``'s
+autoencoder and neutral VAE stages (copied). The run that chose γ = 50 (benchmarks/results/style_duration.json, commit
+d6356a7, before γ was a config key) took suite contact_template's ``off`` runs as its ``off``: the configs' defaults
+then, γ = 0, the same settings. Per (seed, stance,
 style) case, ``--stance-samples`` draws of each CVAE against the style's real clips of the train and val splits
 (suite contact_template's stance figures): the **duration error** ``|log(mean duration of the draws ÷ that of the real
 clips)|``.
@@ -41,9 +43,8 @@ TIE = 0.05
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    style_channels.run_arguments(parser, "folder of the arms' reproduction runs (reused and resumed; default suite "
-                                         "contact_template's, whose off runs are reused)")
-    parser.set_defaults(runs=style.ROOT / "runs" / "benchmarks" / "contact_template")
+    style_channels.run_arguments(parser, "folder of the arms' reproduction runs (reused and resumed)")
+    parser.set_defaults(runs=style.ROOT / "runs" / "benchmarks" / "style_duration")
     parser.add_argument("--weights", type=float, nargs="+", default=list(DEFAULT_WEIGHTS), metavar="GAMMA",
                         help="γ of the duration arms (model.style_duration_weight > 0)")
     parser.add_argument("--stance-samples", type=int, default=300, metavar="N",
@@ -52,7 +53,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def arms(weights: list[float]) -> dict[str, list[str]]:
     """Arm name (``off``, ``duration<γ>`` in order of γ) → the CVAE stages' ``train`` overrides."""
-    return {"off": [], **{f"duration{g:g}": [f"++model.style_duration_weight={g:g}"]
+    return {"off": ["++model.style_duration_weight=0"], **{f"duration{g:g}": [f"++model.style_duration_weight={g:g}"]
                           for g in sorted({float(w) for w in weights if w > 0})}}
 
 

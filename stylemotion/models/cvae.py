@@ -55,13 +55,14 @@ planted on the whole timeline in clips of every style. The PrimitiveVAE's ``cont
 reconstructions of the neutral content clips to the content clips' contacts, which pulls the draws' steps towards
 neutral ones (suite ``contact_loss``).
 
-A styled duration (off by default): the reconstruction term holds the draws' durations to the content (neutral)
-clips', and the style term reads features on the canonical timeline only, so every style's draws last about as long
-as neutral steps, however long the style's steps are (Bandai validation clips: masculine real steps 0.62 s, its
-draws 0.48 s). ``style_duration_weight`` = γ > 0 adds γ · (mean standardized log-duration of the style term's
-decodes − the examples' mean, standardized alike)²: the draws' mean duration moves to the examples', their spread
-around it stays the model's. Against the reconstruction's per-item duration weight w (``duration_weight``), the
-mean moves about γ / (γ + w/2) of the way.
+A styled duration (``StyleCVAE``'s default off; ``configs/model/style_cvae.yaml`` sets γ = 50, chosen on Bandai
+validation clips by suite ``style_duration``): the reconstruction term holds the draws' durations to the content
+(neutral) clips', and the style term reads features on the canonical timeline only, so without it every style's
+draws last about as long as neutral steps, however long the style's steps are (Bandai validation clips: masculine
+real steps 0.62 s, its draws 0.48 s). ``style_duration_weight`` = γ > 0 adds γ · (mean standardized log-duration of
+the style term's decodes − the examples' mean, standardized alike)²: the draws' mean duration moves to the examples',
+their spread around it stays the model's. Against the reconstruction's per-item duration weight w
+(``duration_weight``), the mean moves about γ / (γ + w/2) of the way.
 
 One model per (primitive, style). The style, the example clip(s) (take, frame range, primitive,
 duration) and how they were encoded are recorded in ``hparams.spec``; the target Gram matrix is a

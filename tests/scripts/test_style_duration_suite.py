@@ -42,8 +42,9 @@ def choice(*runs: dict) -> dict:
 
 
 def test_the_arms_are_off_then_each_weight_in_order() -> None:
-    assert style_duration.arms([500.0, 50.0, 0.0]) == {"off": [], "duration50": ["++model.style_duration_weight=50"],
-                                                        "duration500": ["++model.style_duration_weight=500"]}
+    assert style_duration.arms([500.0, 50.0, 0.0]) == {
+        "off": ["++model.style_duration_weight=0"], "duration50": ["++model.style_duration_weight=50"],
+        "duration500": ["++model.style_duration_weight=500"]}
 
 
 def test_duration_cases_are_log_ratios_of_styled_draws_only() -> None:
