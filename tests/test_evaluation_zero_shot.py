@@ -293,3 +293,7 @@ def test_bad_runs_and_styles_are_refused(run, tmp_path) -> None:
     with pytest.raises(ZeroShotRunError, match=r"has no CVAE of walk_leftStance for style\(s\) \['feminine'\]"):
         leave_one_style_out(run, tmp_path / "x", styles=["feminine"])
     assert not (tmp_path / "x").exists()
+    (tmp_path / "stages").write_text("not a folder")
+    with pytest.raises(ZeroShotRunError, match="is a file, not a folder of trainings"):
+        leave_one_style_out(run, tmp_path / "y", stages=tmp_path / "stages")
+    assert not (tmp_path / "y").exists()

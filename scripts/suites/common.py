@@ -44,6 +44,20 @@ def progress_printed(prefix: str, logger: str = "stylemotion") -> Iterator[None]
         target.setLevel(before)
 
 
+def number_above(bound: float, kind: type = int, inclusive: bool = True) -> Callable[[str], Any]:
+    """An argparse ``type``: a ``kind`` number ≥ ``bound`` (> ``bound`` when not ``inclusive``); anything else is
+    refused by argparse in one line naming the option and the value."""
+    def parse(text: str) -> Any:
+        try:
+            value = kind(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{text!r} is not {'an integer' if kind is int else 'a number'}") from None
+        if not (value >= bound if inclusive else value > bound) or not math.isfinite(value):
+            raise argparse.ArgumentTypeError(f"{text} is not {'≥' if inclusive else '>'} {bound:g}")
+        return value
+    return parse
+
+
 def md_table(header: Sequence[str], rows: Sequence[Sequence[str]]) -> str:
     """A Markdown table whose cells may hold ``|`` (escaped, so a cell never splits in two)."""
     def cells(row: Sequence[str]) -> list[str]:

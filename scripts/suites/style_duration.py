@@ -32,7 +32,7 @@ import math
 from typing import Any
 
 from suites import contact_draws, contact_full, contact_template, style, style_channels
-from suites.common import fmt, md_table, provenance_line, spread
+from suites.common import fmt, md_table, number_above, provenance_line, spread
 
 DESCRIPTION = ("whether the style CVAE's draws take the duration of the style's steps (model.style_duration_weight), "
                "chosen at full budget on Bandai validation clips of every style")
@@ -45,9 +45,10 @@ TIE = 0.05
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     style_channels.run_arguments(parser, "folder of the arms' reproduction runs (reused and resumed)")
     parser.set_defaults(runs=style.ROOT / "runs" / "benchmarks" / "style_duration")
-    parser.add_argument("--weights", type=float, nargs="+", default=list(DEFAULT_WEIGHTS), metavar="GAMMA",
+    parser.add_argument("--weights", type=number_above(0, float, inclusive=False), nargs="+",
+                        default=list(DEFAULT_WEIGHTS), metavar="GAMMA",
                         help="γ of the duration arms (model.style_duration_weight > 0)")
-    parser.add_argument("--stance-samples", type=int, default=300, metavar="N",
+    parser.add_argument("--stance-samples", type=number_above(2), default=300, metavar="N",
                         help="draws per model for the durations (≥ 2)")
 
 
@@ -95,8 +96,6 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
     import torch
 
     torch.set_num_threads(1)
-    if args.stance_samples < 2:
-        raise ValueError(f"--stance-samples must be ≥ 2, got {args.stance_samples}")
     table = arms(list(args.weights))
     per_seed: dict[str, dict[str, Any]] = {}
     real: dict[str, dict[str, Any]] = {}

@@ -27,7 +27,7 @@ from pathlib import Path
 from typing import Any
 
 from suites import contact_full, style_method
-from suites.common import fmt, md_table, provenance_line, spread
+from suites.common import fmt, md_table, number_above, provenance_line, spread
 
 DESCRIPTION = ("the zero-shot network's training epochs (experiment=zero_shot trainer.max_epochs) and with them "
                "stylemotion-style's method, chosen on validation clips")
@@ -40,7 +40,7 @@ RECOGNITION_TIE = 0.01
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     style_method.leave_one_out_arguments(parser)
-    parser.add_argument("--epochs", type=int, nargs="+", default=list(DEFAULT_ARMS),
+    parser.add_argument("--epochs", type=number_above(1), nargs="+", default=list(DEFAULT_ARMS),
                         help="epoch counts of the zero-shot networks, one arm each")
 
 

@@ -503,6 +503,9 @@ def leave_one_style_out(run: str | Path, out: str | Path, styles: Sequence[str] 
     out = Path(out).expanduser()
     if not (resume and out.is_dir()):
         out = check_new_output(out, force)
+    stages = out if stages is None else Path(stages).expanduser()
+    if stages.exists() and not stages.is_dir():
+        raise ZeroShotRunError(f"stages={stages} is a file, not a folder of trainings")
     source = read_run(run)
     samples = positive_int(samples, "samples")
     seed = source.seed if seed is None else int(seed)
@@ -518,7 +521,6 @@ def leave_one_style_out(run: str | Path, out: str | Path, styles: Sequence[str] 
     if out.exists() and not resume:
         shutil.rmtree(out)
     out.mkdir(parents=True, exist_ok=True)
-    stages = out if stages is None else Path(stages).expanduser()
     stages.mkdir(parents=True, exist_ok=True)
     judge = load_autoencoder(source.autoencoder_ckpt)
     judge_info = {"path": str(source.autoencoder_ckpt.resolve()), "fingerprint": fingerprint(judge)}

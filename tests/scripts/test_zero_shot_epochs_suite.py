@@ -4,9 +4,12 @@ read from their records, and the blocks (hand-made rows, no training)."""
 
 from __future__ import annotations
 
+import argparse
 import json
 import sys
 from pathlib import Path
+
+import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "scripts"))
@@ -79,3 +82,13 @@ def test_the_blocks_state_the_verdict_and_the_arms() -> None:
     assert "| exhausted | 0.950 ± 0.000 (0.950–0.950) | 2/2 | 0.600 ± 0.000 (0.600–0.600) | 0/2 |" in blocks["styles"]
     narrowed = {**results, "narrowed": {"primitives": ["walk_leftStance"], "styles": None}}
     assert "**not applied**: a narrowed run" in zero_shot_epochs.render({**record, "results": narrowed})["headline"]
+
+
+@pytest.mark.parametrize("value", ["0", "-3", "ten"])
+def test_an_epoch_count_that_is_not_a_positive_integer_is_refused_by_the_parser(value, capsys) -> None:
+    parser = argparse.ArgumentParser(prog="zero_shot_epochs")
+    zero_shot_epochs.add_arguments(parser)
+    assert parser.parse_args(["--epochs", "10", "30"]).epochs == [10, 30]
+    with pytest.raises(SystemExit) as exit_:
+        parser.parse_args(["--epochs", "10", value])
+    assert exit_.value.code == 2 and "argument --epochs" in capsys.readouterr().err
