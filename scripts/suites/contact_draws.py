@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import argparse
 import json
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -147,19 +148,28 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
             "per_seed": per_seed, "summary": summaries, "choice": choose(summaries)}
 
 
+def styled_cells(styled: dict[str, Any]) -> list[str]:
+    """A block's cells of an arm's styled figures: rows on the diagonal, recognition, V_SD, step_SD and diversity
+    over the style's real clips, mean capped log variation."""
+    sd = contact_full.sd
+    return [f"{styled['rows_on_diagonal']}/{styled['cases']}", sd(styled["recognition"], 3), sd(styled["v_sd"]),
+            sd(styled["step_sd"]), sd(styled["diversity"]), fmt(styled["capped_log_variation"], 3)]
+
+
+def arm_rows(r: dict[str, Any], cells: Callable[[dict[str, Any]], list[str]]) -> list[list[str]]:
+    """A block row per arm of ``r["summary"]``: its name (bold when chosen), ``cells(summary)``, its CVAE minutes per
+    run and whether it was eligible."""
+    choice = r["choice"]
+    return [[f"**{name}**" if name == choice["chosen"] else name, *cells(s), fmt(s.get("cvae_minutes"), 1),
+             "yes" if choice["eligible"][name] else "no"] for name, s in r["summary"].items()]
+
+
 def render(record: dict[str, Any]) -> dict[str, str]:
     r = record["results"]
     choice = r["choice"]
     label, sd = contact_full.run_label(r), contact_full.sd
-    rows = []
-    for name, s in r["summary"].items():
-        st = s["styled"]
-        rows.append([f"**{name}**" if name == choice["chosen"] else name,
-                     sd(st["skating_samples"], 1, 100), sd(st["skating_real"], 1, 100),
-                     sd(s["styled_skating_relative"]), f"{st['rows_on_diagonal']}/{st['cases']}",
-                     sd(st["recognition"], 3), sd(st["v_sd"]), sd(st["step_sd"]), sd(st["diversity"]),
-                     fmt(st["capped_log_variation"], 3), fmt(s.get("cvae_minutes"), 1),
-                     "yes" if choice["eligible"][name] else "no"])
+    rows = arm_rows(r, lambda s: [sd(s["styled"]["skating_samples"], 1, 100), sd(s["styled"]["skating_real"], 1, 100),
+                                  sd(s["styled_skating_relative"]), *styled_cells(s["styled"])])
     base = r["base"]
     seeds = ", ".join(r["per_seed"])
     stages = "; ".join(f"{k}: {', '.join(v)}" for k, v in base["stages"].items() if v) or "none"

@@ -258,16 +258,10 @@ def render(record: dict[str, Any]) -> dict[str, str]:
     r = record["results"]
     choice = r["choice"]
     label, sd = contact_full.run_label(r), contact_full.sd
-    rows = []
-    for name, s in r["summary"].items():
-        st = s["styled"]
-        rows.append([f"**{name}**" if name == choice["chosen"] else name,
-                     sd(s["mid_mps_samples"], 2), sd(s["mid_mps_real"], 3), sd(s["mid_excess"], 2),
-                     sd(s["no_plant_samples"], 2), sd(st["skating_samples"], 1, 100), sd(st["skating_real"], 1, 100),
-                     sd(s["styled_skating_relative"]), f"{st['rows_on_diagonal']}/{st['cases']}",
-                     sd(st["recognition"], 3), sd(st["v_sd"]), sd(st["step_sd"]), sd(st["diversity"]),
-                     fmt(st["capped_log_variation"], 3), fmt(s.get("cvae_minutes"), 1),
-                     "yes" if choice["eligible"][name] else "no"])
+    rows = contact_draws.arm_rows(r, lambda s: [
+        sd(s["mid_mps_samples"], 2), sd(s["mid_mps_real"], 3), sd(s["mid_excess"], 2), sd(s["no_plant_samples"], 2),
+        sd(s["styled"]["skating_samples"], 1, 100), sd(s["styled"]["skating_real"], 1, 100),
+        sd(s["styled_skating_relative"]), *contact_draws.styled_cells(s["styled"])])
     seeds = ", ".join(r["per_seed"])
     verdict = ("`off` **stays**" if choice["chosen"] == "off" else f"**{choice['chosen']}** is chosen")
     return {"headline": (

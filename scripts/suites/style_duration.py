@@ -116,14 +116,9 @@ def render(record: dict[str, Any]) -> dict[str, str]:
     r = record["results"]
     choice = r["choice"]
     label, sd = contact_full.run_label(r), contact_full.sd
-    rows = []
-    for name, s in r["summary"].items():
-        st = s["styled"]
-        rows.append([f"**{name}**" if name == choice["chosen"] else name, sd(s["duration_log_ratio"], 3),
-                     sd(s["duration_error"], 3), f"{st['rows_on_diagonal']}/{st['cases']}", sd(st["recognition"], 3),
-                     sd(st["v_sd"]), sd(st["step_sd"]), sd(st["diversity"]), fmt(st["capped_log_variation"], 3),
-                     sd(s["styled_skating_relative"]), sd(s["mid_excess"], 2), fmt(s.get("cvae_minutes"), 1),
-                     "yes" if choice["eligible"][name] else "no"])
+    rows = contact_draws.arm_rows(r, lambda s: [
+        sd(s["duration_log_ratio"], 3), sd(s["duration_error"], 3), *contact_draws.styled_cells(s["styled"]),
+        sd(s["styled_skating_relative"]), sd(s["mid_excess"], 2)])
     verdict = "`off` **stays**" if choice["chosen"] == "off" else f"**{choice['chosen']}** is chosen"
     return {"headline": (
         f"{label}Whether the style CVAE's draws take the duration of the style's steps (`model.style_duration_weight`"

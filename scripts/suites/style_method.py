@@ -114,6 +114,12 @@ def summary(cases: list[dict[str, Any]]) -> dict[str, Any]:
             "capped_log_variation": mean_capped_log(cases, VARIATION)}
 
 
+def method_summaries(per_seed: dict[str, Any]) -> dict[str, dict[str, Any]]:
+    """Per method row (and the reference), :func:`summary` over every case of every seed."""
+    return {kind: summary([c[kind] for s in per_seed.values() for c in s["cases"].values()])
+            for kind in (*METHODS, REFERENCE)}
+
+
 def choose(summaries: dict[str, dict[str, Any]]) -> dict[str, Any]:
     """The module doc's rule."""
     zs, cv = summaries["zero_shot"], summaries["cvae_unseen"]
@@ -163,8 +169,7 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
     with ProcessPoolExecutor(max_workers=processes, mp_context=get_context("spawn")) as pool:
         futures = {seed: pool.submit(seed_record, args, seed, judge) for seed, judge in judges.items()}
         per_seed: dict[str, Any] = {str(seed): future.result() for seed, future in futures.items()}
-    summaries = {kind: summary([c[kind] for s in per_seed.values() for c in s["cases"].values()])
-                 for kind in (*METHODS, REFERENCE)}
+    summaries = method_summaries(per_seed)
     return {"data": args.data, "epochs": args.epochs, "experiment_epochs": experiment_epochs(), "samples": args.samples,
             "narrowed": {"primitives": args.primitives, "styles": args.styles},
             "splits": {"choose": "the judge's evaluation.heldout_splits=[val]: real clips of the train and val "
