@@ -266,6 +266,16 @@ def test_the_cvae_on_the_autoencoder_without_the_style_is_a_row_beside_the_netwo
     assert arm_row["cvae_unseen"] == {**row["cvae_unseen"], "train_seconds": None}
     assert arm_row["generator_autoencoder"]["path"] == row["generator_autoencoder"]["path"]
     assert arm_row["zero_shot"]["train_seconds"] > 0
+    # an arm that samples those networks at another temperature: nothing trained, the network's samples scaled
+    with logged_lines("stylemotion.evaluation.zero_shot") as cool_lines:
+        cool = leave_one_style_out(run, tmp_path / "cool", [STYLE], [PRIMITIVE], epochs=1, samples=SAMPLES,
+                                   seed=SEED, overrides=NETWORK, threads=1, cvae_unseen=True, stages=out,
+                                   networks=tmp_path / "arm", temperature=0.25)
+    assert sum("reused" in line for line in cool_lines) == 3 and not (tmp_path / "cool" / "models").exists()
+    cool_row = cool["primitives"][PRIMITIVE]["styles"][STYLE]
+    assert cool_row["cvae_unseen"] == arm_row["cvae_unseen"] and cool["meta"]["temperature"] == 0.25
+    assert cool_row["zero_shot"]["sample_temperature"] == 0.25 and arm_row["zero_shot"]["sample_temperature"] == 1.0
+    assert cool_row["zero_shot"]["variation"]["diversity"] < arm_row["zero_shot"]["variation"]["diversity"]
 
 
 def test_the_train_configs_leave_the_style_out_of_the_runs_data(run, tmp_path) -> None:
@@ -294,6 +304,10 @@ def test_bad_runs_and_styles_are_refused(run, tmp_path) -> None:
         leave_one_style_out(run, tmp_path / "x", styles=["feminine"])
     assert not (tmp_path / "x").exists()
     (tmp_path / "stages").write_text("not a folder")
-    with pytest.raises(ZeroShotRunError, match="is a file, not a folder of trainings"):
+    with pytest.raises(ZeroShotRunError, match="stages=.* is a file, not a folder of trainings"):
         leave_one_style_out(run, tmp_path / "y", stages=tmp_path / "stages")
+    with pytest.raises(ZeroShotRunError, match="networks=.* is a file, not a folder of trainings"):
+        leave_one_style_out(run, tmp_path / "y", networks=tmp_path / "stages")
+    with pytest.raises(ValueError, match="sample_temperature must be a finite number ≥ 0, got -1"):
+        leave_one_style_out(run, tmp_path / "y", temperature=-1)
     assert not (tmp_path / "y").exists()

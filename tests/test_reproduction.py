@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import shutil
 import subprocess
 from pathlib import Path
@@ -19,7 +20,7 @@ from vae_fixtures import feature_module, fit, tiny_autoencoder_ckpt
 
 import stylemotion
 from stylemotion.cli.schemas import register_schemas
-from stylemotion.config import CONFIG_DIR
+from stylemotion.config import CONFIG_DIR, ConfigError
 from stylemotion.evaluation.run import run_evaluation
 from stylemotion.evaluation.sources import MissingExampleError, MixedAutoencodersError
 from stylemotion.io.outputs import OutputExistsError
@@ -149,6 +150,63 @@ def test_changed_settings_are_refused_not_overwritten(tiny_run, tmp_path: Path) 
     assert (out / "vae" / "walk_leftStance" / "done.json").read_text() == done
 
 
+def test_a_stage_trained_before_a_default_changed_is_refused_not_reused(tiny_run, tmp_path: Path) -> None:
+    """The overrides are the same but a config default differs from what the stage was trained with: as recorded
+    in its done.json, or (records written before they held the config) as its checkpoint's hyperparameters say."""
+    out = copy_run(tiny_run, tmp_path / "run")
+    stage = out / "cvae" / "walk_leftStance_elderly"
+    record = json.loads((stage / "done.json").read_text())
+    assert record["config"]["model.style_duration_weight"] == 50.0  # the experiment's default, not overridden
+    record["config"]["model.style_duration_weight"] = 0.0
+    (stage / "done.json").write_text(json.dumps(record))
+    with pytest.raises(StageConflictError, match=r"model\.style_duration_weight=0\.0 \(now 50\.0\)") as err:
+        reproduce(tiny_overrides(out), [])
+    assert str(stage) in str(err.value)
+
+    del record["config"]  # an older record: the checkpoint says what the model was trained with
+    (stage / "done.json").write_text(json.dumps(record))
+    checkpoint = out / record["checkpoint"]
+    saved = torch.load(checkpoint, weights_only=False)
+    del saved["hyper_parameters"]["style_duration_weight"]  # saved before the option existed: trained at 0
+    torch.save(saved, checkpoint)
+    before = checkpoint.read_bytes()
+    with pytest.raises(StageConflictError, match=r"model\.style_duration_weight=0\.0 \(now 50\.0\)"):
+        reproduce(tiny_overrides(out), [])
+    assert checkpoint.read_bytes() == before and json.loads((stage / "done.json").read_text()) == record
+
+
+def test_another_report_of_the_same_stages_judges_on_test_clips_only(tiny_run, tmp_path: Path) -> None:
+    """``report=report_test`` with test-only evaluation settings: every stage reused, a second report beside the
+    run's (its record in ``evaluation_report_test.json``), the style models judged on fewer clips (their style's
+    test clips only); the run's own report and ``reproduce.json`` untouched; a rerun reuses it."""
+    out = copy_run(tiny_run, tmp_path / "run")
+    kept = {name: (out / name).read_bytes() for name in ("reproduce.json", "evaluation.json", "report/report.json")}
+    test = ["report=report_test", "evaluation.heldout_splits=[test]", "evaluation.style_truth=heldout"]
+    lines: list[str] = []
+    summary = reproduce(tiny_overrides(out) + test, lines)
+    assert {s["status"] for s in summary["stages"]} == {"reused"} and summary["report"] == "report_test"
+    assert {name: (out / name).read_bytes() for name in kept} == kept
+    report = json.loads((out / "report_test" / "report.json").read_text())
+    main = json.loads((out / "report" / "report.json").read_text())
+    assert report["meta"]["settings"]["style_truth"] == "heldout"
+    assert report["meta"]["settings"]["heldout_splits"] == ["test"]
+    clips = [(report["frechet_reference"][p][m]["ground_truth_clips"], ms[m]["ground_truth_clips"])
+             for p, ms in main["frechet_reference"].items() for m in ms if m != "neutral"]
+    assert clips and all(0 < test_count < all_count for test_count, all_count in clips), clips
+    assert (out / "evaluation_report_test.json").is_file()
+    lines.clear()
+    reproduce(tiny_overrides(out) + test, lines)
+    assert any("evaluation: reused" in line for line in lines), lines
+
+
+@pytest.mark.parametrize("name", ["cvae", "a/b", "..", "evaluation.json"])
+def test_a_report_name_that_is_not_a_free_folder_name_is_refused_before_training(tmp_path: Path, name: str) -> None:
+    out = tmp_path / "run"
+    with pytest.raises(ConfigError, match=f"report: '{re.escape(name)}' is not a report folder name"):
+        reproduce(tiny_overrides(out) + [f"report={name}"], [])
+    assert not (out / "autoencoder").exists() and not (out / "data.json").exists()
+
+
 def test_eval_cli_writes_a_report_and_refuses_an_existing_folder(reproduced, tmp_path: Path, capsys,
                                                                  monkeypatch) -> None:
     """``stylemotion-eval`` (in-process) on the run's models of walk_leftStance: folders of checkpoints."""
@@ -271,16 +329,16 @@ def test_a_null_retarget_keeps_the_stage_hashes_of_earlier_runs(tmp_path: Path) 
     the finished stages of earlier runs stay valid; a style name is other data."""
     with initialize_config_dir(config_dir=str(CONFIG_DIR), version_base="1.3"):
         cfg = compose(config_name="reproduce", overrides=[f"out={tmp_path / 'run'}", "primitives=[walk_leftStance]"])
-    repro = Reproduction(cfg)
-    repro.plan([])
-    stage = repro.stages[0]
-    hashes = {}
-    for retarget in ("absent", None, "normal"):
-        repro.data_cfg.pop("retarget", None)
-        if retarget != "absent":
-            repro.data_cfg["retarget"] = retarget
-        repro.prepare_stage(1, stage)
-        hashes[retarget] = stage.settings_hash
+        repro = Reproduction(cfg)
+        repro.plan([])
+        stage = repro.stages[0]
+        hashes = {}
+        for retarget in ("absent", None, "normal"):
+            repro.data_cfg.pop("retarget", None)
+            if retarget != "absent":
+                repro.data_cfg["retarget"] = retarget
+            repro.prepare_stage(1, stage)  # composes the stage's config: Hydra's config search is needed
+            hashes[retarget] = stage.settings_hash
     assert hashes[None] == hashes["absent"] != hashes["normal"]
     assert cfg.data.retarget is None
 

@@ -35,6 +35,10 @@ DATA = {
     "bandai_run_arm": ["data=bandai", f"data.root={DATA_ROOT / 'bandai-namco-motion-2' / 'data.zip'}",
                        "data.contents=[run,raise-up-right-hand]"],
 }
+#: ``--report-on``: the report's folder in the run and the ``reproduce`` overrides that make it.
+REPORTS = {"all": ("report", []),
+           "test": ("report_test", ["report=report_test", "evaluation.heldout_splits=[test]",
+                                    "evaluation.style_truth=heldout"])}
 #: Variation figures of the report (``variance_ratio``: model / training data; ``variation_vs_style``: model /
 #: real clips of its own style).
 RATIOS = ("pose_sd", "v_sd", "step_sd")
@@ -58,6 +62,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--sample-styles", type=int, default=None, metavar="K",
                         help="train CVAEs for K styles only, a seeded choice (numpy default_rng(0)) fixed across seeds "
                              "(default: every style, as the thesis)")
+    parser.add_argument("--report-on", choices=sorted(REPORTS), default="all",
+                        help="all: the run's report (a style model judged against every clip of its style but its "
+                             "example); test: a second report of the same stages (report_test) that reads test-split "
+                             "clips only (classifier held-out accuracy, ground truths)")
     parser.add_argument("--alphas", type=float, nargs="+", default=None, metavar="ALPHA",
                         help="choose the style weight α among these on validation clips first "
                              "(stylemotion/training/style_weight.py), then report every seed with the choice "
@@ -138,7 +146,7 @@ def reproduce_seed(data: str, seed: int, out: Path, workers: int, primitives: li
             reproduce(cfg)
     finally:
         GlobalHydra.instance().clear()
-    return read_json_object(out / "report" / "report.json", "the reproduction's report", "rerun the suite")
+    return read_json_object(out / str(cfg.report) / "report.json", "the reproduction's report", "rerun the suite")
 
 
 def stage_minutes(stages: Sequence[Mapping[str, Any]], kind: str | None = None) -> float:
@@ -342,9 +350,11 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
     alpha_choice = choose_alpha(args, seeds[0], args.primitives, styles) if getattr(args, "alphas", None) else None
     alpha = alpha_choice["chosen"] if alpha_choice else None
     per_seed = {}
+    report_on = getattr(args, "report_on", "all")
     for seed in seeds:
         out = args.runs / args.data / setup_tag(args.primitives, styles) / f"seed{seed}"
-        report = reproduce_seed(args.data, seed, out, args.workers, args.primitives, styles, alpha)
+        report = reproduce_seed(args.data, seed, out, args.workers, args.primitives, styles, alpha,
+                                extra=REPORTS[report_on][1])
         from stylemotion.io.jsonfile import read_json_object
 
         stages = read_json_object(out / "reproduce.json", "the reproduction's summary", "rerun the suite")["stages"]
@@ -362,15 +372,18 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
                  "how": None if not (args.primitives or styles) else
                  "CVAE styles: a seeded choice (numpy default_rng(0)) of the data's styles, the same for every seed"
                  if styles else "primitives narrowed on the command line"}
-    return {"data": args.data, "subsample": subsample,
+    held = "test" if report_on == "test" else "val+test"
+    truth = ("the test-split clips of the model's style" if report_on == "test"
+             else "all real clips of the model's style")
+    return {"data": args.data, "subsample": subsample, "report_on": report_on,
             "splits": {"data": {"kind": "by take", **split, "group_by": ["content", "style"]},
                        "seed_varies": "model initialization, batches and samples (not the data or its split)",
                        "classifier": "fitted on the train-split clips of every style; its accuracy and the samples' "
-                                     "recognition are read against it (held-out accuracy on the val+test clips)",
+                                     f"recognition are read against it (held-out accuracy on the {held} clips)",
                        "table_5_1": "each model's samples against each style's example clip (the CVAE's training "
                                     "example; neutral: the mean of the neutral train clips) — not a held-out figure",
-                       "variation": "model samples against the neutral train clips (variance_ratio) and all real "
-                                    "clips of the model's style (variation_vs_style)",
+                       "variation": "model samples against the neutral train clips (variance_ratio) and "
+                                    f"{truth} (variation_vs_style)",
                        "clips": clips,
                        "chosen_here": (f"α = {alpha:g}, chosen on validation clips (alpha_choice)" if alpha_choice
                                        else "nothing: α (chosen by suite style_alpha) and the style-term "
@@ -434,10 +447,14 @@ def render(record: dict[str, Any]) -> dict[str, str]:
                   + (f"CVAE styles {', '.join(sub['styles'])} (a seeded choice, the same for every seed)"
                      if sub.get("styles") else "every style")
                   + (f", primitives {', '.join(sub['primitives'])}" if sub.get("primitives") else "") + ". ")
+    test_only = r.get("report_on") == "test"
     split_line = (f"Data split by take (seed {split.get('seed')}, val {split.get('val_fraction')}, test "
                   f"{split.get('test_fraction')}); the seed varies training and sampling only. The classifier is "
-                  "fitted on train-split clips and scored on val+test clips; Table 5.1 compares samples with the "
-                  "CVAE's own training example (not a held-out figure).")
+                  f"fitted on train-split clips and scored on {'test' if test_only else 'val+test'} clips; "
+                  + ("every figure against real clips reads the **test split only** (`report=report_test "
+                     "evaluation.heldout_splits=[test] evaluation.style_truth=heldout`: no clip a validation choice "
+                     "read); " if test_only else "")
+                  + "Table 5.1 compares samples with the CVAE's own training example (not a held-out figure).")
     prov = provenance_line(record)
 
     rows = []
@@ -447,7 +464,8 @@ def render(record: dict[str, Any]) -> dict[str, str]:
                      f"{fmt_spread(s['diagonal_columns'], 2)} ({fmt_range(s['diagonal_columns'], 0)})",
                      f"{fmt_spread(s['classifier_heldout_accuracy'], 3)}"])
     o = r["overall"]
-    headline = (f"{label}Style CVAEs ({r['data']}, {seeds} seeds): Table 5.1 diagonal and recognition.\n\n"
+    judged = ", judged on the **test split**" if test_only else ""
+    headline = (f"{label}Style CVAEs ({r['data']}, {seeds} seeds{judged}): Table 5.1 diagonal and recognition.\n\n"
                 + md_table(["primitive", "models", "Table 5.1 rows on diagonal, mean ± sd (min–max)",
                             "columns on diagonal", "classifier held-out accuracy"], rows)
                 + f"\n\nRecognition of the styled models' samples (mean over styles): "
@@ -481,7 +499,8 @@ def render(record: dict[str, Any]) -> dict[str, str]:
                            + md_table(["primitive", "model", "pose_SD ratio", "V_SD ratio", "step_SD ratio"],
                                       ratio_rows)
                            + f"\n\n{split_line} {prov}")
-    blocks["variation_vs_style"] = (f"{label}Variation of each model relative to all real clips of its own style "
+    own = "the test-split clips of its own style" if test_only else "all real clips of its own style"
+    blocks["variation_vs_style"] = (f"{label}Variation of each model relative to {own} "
                                     f"(pose_across_SD, V_SD, step_SD and diversity of the samples / of the real "
                                     f"clips; mean ± sd (min–max) over {seeds} seeds, {r['data']}).\n\n"
                                     + md_table(["primitive", "model", "pose_across_SD", "V_SD", "step_SD",

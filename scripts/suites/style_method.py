@@ -142,11 +142,15 @@ def seed_record(args: argparse.Namespace, seed: int, judge: Path) -> dict[str, A
     if list(source.settings.heldout_splits) != ["val"]:
         raise ZeroShotRunError(f"judge {judge} was evaluated on {list(source.settings.heldout_splits)}, not "
                                "[val]: the choice must not read test clips")
-    # Autoencoders and CVAEs in seed<k>/, shared by every epoch count of the networks (seed<k>_e<epochs>/).
+    # Autoencoders and CVAEs in seed<k>/, shared by every epoch count of the networks (seed<k>_e<epochs>/), and
+    # those networks by every sampling temperature (the evaluation of one in seed<k>[_e<epochs>]_t<τ>/).
     stages = args.runs / args.data / f"seed{seed}"
-    out = stages if args.epochs is None else stages.with_name(f"seed{seed}_e{args.epochs}")
+    networks = stages if args.epochs is None else stages.with_name(f"seed{seed}_e{args.epochs}")
+    temperature = getattr(args, "temperature", None)
+    out = networks if temperature is None else networks.with_name(f"{networks.name}_t{temperature:g}")
     result = leave_one_style_out(judge, out, args.styles, args.primitives, args.epochs, args.samples, seed,
-                                 threads=1, resume=True, cvae_unseen=True, stages=stages)
+                                 threads=1, resume=True, cvae_unseen=True, stages=stages, networks=networks,
+                                 temperature=temperature)
     cases = {f"{p}/{s}": case_figures(row) for p, res in result["primitives"].items()
              for s, row in res["styles"].items()}
     minutes = {f"{p}/{s}": {
@@ -155,7 +159,7 @@ def seed_record(args: argparse.Namespace, seed: int, judge: Path) -> dict[str, A
         "cvae_unseen": round((row["cvae_unseen"].get("train_seconds") or 0) / 60, 1)}
         for p, res in result["primitives"].items() for s, row in res["styles"].items()}
     return {"judge": str(judge.relative_to(ROOT)) if judge.is_relative_to(ROOT) else str(judge),
-            "out": str(out), "cases": cases, "train_minutes": minutes,
+            "out": str(out), "networks": str(networks), "cases": cases, "train_minutes": minutes,
             "seconds": round(result["meta"]["seconds"], 1), "splits": result["splits"]}
 
 

@@ -61,7 +61,7 @@ def network_minutes(out: str, cases: dict[str, Any]) -> list[float]:
 def arm_summary(per_seed: dict[str, Any]) -> dict[str, Any]:
     """Over every (seed, primitive, style) case of one arm: each method's summary and the networks' minutes."""
     summaries = style_method.method_summaries(per_seed)
-    minutes = [m for s in per_seed.values() for m in network_minutes(s["out"], s["cases"])]
+    minutes = [m for s in per_seed.values() for m in network_minutes(s.get("networks", s["out"]), s["cases"])]
     return {"summary": summaries, "network_minutes": spread(minutes), "choice": style_method.choose(summaries)}
 
 

@@ -281,7 +281,7 @@ def real_side(primitive: str, models: Sequence[EvalModel], takeset: TakeSet, set
     length = _canonical_length(primitive, models, takeset, settings, split, segmentation)
     log.info(f"{primitive}: real clips")
     data = primitive_data(takeset, primitive, length, settings.neutral_style, _segment_values(settings), split,
-                          segmentation, settings.heldout_splits)
+                          segmentation, settings.heldout_splits, settings.style_truth)
     for m in models:
         if m.style not in data.styles:
             raise MissingExampleError(f"{m.checkpoint or m.label} models style {m.style!r}, which dataset "

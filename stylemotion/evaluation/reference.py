@@ -10,7 +10,8 @@ time-normalized to the models' canonical length. From them:
 * **classifier clips**: train-split clips of all styles (fitting) and val+test clips (held out);
 * **ground truth of a model** (:meth:`PrimitiveData.ground_truth`): the clips of the model's style
   that the model never saw — every clip of that style except its style example clip(s), and, for
-  the neutral style, except the train split.
+  the neutral style, except the train split; with ``style_truth="heldout"`` a style model's too
+  are the held-out splits' clips only.
 """
 
 from __future__ import annotations
@@ -44,6 +45,8 @@ class PrimitiveData:
             action's train-split takes (the reference of the foot-skating contact test).
         heldout_splits: the splits :meth:`heldout` returns (``val`` and ``test``; ``val`` alone reads no test
             clip).
+        style_truth: ``all`` (a style model's ground truth: every clip of its style but its example) or
+            ``heldout`` (the held-out splits' clips of its style only).
     """
 
     primitive: str
@@ -53,6 +56,7 @@ class PrimitiveData:
     clips: ClipDataModule
     rest_heights: np.ndarray
     heldout_splits: tuple[str, ...] = ("val", "test")
+    style_truth: str = "all"
 
     @property
     def stance_foot(self) -> int | None:
@@ -99,14 +103,15 @@ class PrimitiveData:
     def ground_truth(self, model: EvalModel, examples: Sequence[Clip] = ()) -> list[Clip]:
         """Clips of ``model.style`` the model never saw (see the module doc)."""
         skip = {(c.take, c.start) for c in examples}
-        pool = self.heldout(model.style) if model.style == self.neutral_style else self.style_clips(model.style)
+        neutral_or_heldout = model.style == self.neutral_style or self.style_truth == "heldout"
+        pool = self.heldout(model.style) if neutral_or_heldout else self.style_clips(model.style)
         return [c for c in pool if (c.take, c.start) not in skip]
 
 
 def primitive_data(takeset: TakeSet, primitive: str, length: int, neutral_style: str = "normal",
                    segment: Mapping[str, Any] | None = None, split: Mapping[str, Any] | None = None,
                    segmentation: Segmentation | None = None,
-                   heldout_splits: Sequence[str] = ("val", "test")) -> PrimitiveData:
+                   heldout_splits: Sequence[str] = ("val", "test"), style_truth: str = "all") -> PrimitiveData:
     """Segment, split and time-normalize the real clips of ``primitive`` (see :class:`PrimitiveData`).
 
     Args:
@@ -119,6 +124,7 @@ def primitive_data(takeset: TakeSet, primitive: str, length: int, neutral_style:
         segmentation: the action's takes already segmented with ``segment``
             (:func:`stylemotion.primitives.actions.segment_action`); None segments them here.
         heldout_splits: the splits held out of the models (:attr:`PrimitiveData.heldout_splits`).
+        style_truth: a style model's ground truth (:attr:`PrimitiveData.style_truth`).
     """
     action, name = parse_primitive(primitive)
     module = ClipDataModule(takeset=takeset, action=action, primitives=[name], styles=None, timeline=int(length),
@@ -134,4 +140,4 @@ def primitive_data(takeset: TakeSet, primitive: str, length: int, neutral_style:
         raise ValueError(f"dataset {takeset.name!r} has no {action} take in the train split")
     rest = np.median(np.stack([foot_signals(t.positions, takeset.fps).rest_heights for t in takes]), axis=0)
     return PrimitiveData(primitive, int(length), float(takeset.fps), neutral_style, module, rest,
-                         tuple(heldout_splits))
+                         tuple(heldout_splits), str(style_truth))

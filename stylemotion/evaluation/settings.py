@@ -15,6 +15,9 @@ from stylemotion.primitives.skating import SKATE_SPEED_MPS
 
 #: The data splits that may be held out of the models (the default: both).
 HELDOUT_SPLITS = ("val", "test")
+#: A style model's ground truth (``EvalSettings.style_truth``): every clip of its style but its example, or the
+#: held-out splits' clips only.
+STYLE_TRUTHS = ("all", "heldout")
 
 
 @dataclass
@@ -79,6 +82,9 @@ class EvalSettings:
             neutral model's ground truth and, with the train clips, a style model's ground truth
             (:meth:`stylemotion.evaluation.reference.PrimitiveData.ground_truth`). ``[val]`` reads no test clip
             there: a choice made on the report then reads validation clips only (suite ``style_channels``).
+        style_truth: a style model's ground truth: ``all`` (every clip of its style but its example: the train
+            clips and the held-out splits', the thesis' way) or ``heldout`` (the held-out splits' clips only, so
+            ``heldout_splits=[test]`` reads no clip a choice made on ``[val]`` read).
         seed: sampling seed (every model is sampled with it) and classifier seed; set from the
             command's top-level ``seed``.
     """
@@ -93,6 +99,7 @@ class EvalSettings:
     segment: SegmentSettings = field(default_factory=SegmentSettings)
     shift_baseline: bool = True
     heldout_splits: list[str] = field(default_factory=lambda: list(HELDOUT_SPLITS))
+    style_truth: str = "all"
     seed: int = 0
 
     def __post_init__(self) -> None:
@@ -100,6 +107,8 @@ class EvalSettings:
         if not parts or len(set(parts)) != len(parts) or not set(parts) <= set(HELDOUT_SPLITS):
             raise ConfigError(f"evaluation.heldout_splits must be a non-empty list of distinct splits out of "
                               f"{list(HELDOUT_SPLITS)}, got {parts}")
+        if self.style_truth not in STYLE_TRUTHS:
+            raise ConfigError(f"evaluation.style_truth must be one of {list(STYLE_TRUTHS)}, got {self.style_truth!r}")
         counts = self.samples
         for name in ("table_5_1", "variance", "metrics"):
             value = getattr(counts, name)

@@ -71,7 +71,7 @@ from stylemotion.io.jsonfile import write_json
 from stylemotion.io.outputs import check_new_output, inside, safe_name
 from stylemotion.models.checkpoints import fingerprint, load_autoencoder, read_checkpoint
 from stylemotion.models.loading import NEUTRAL, EvalModel, load_generative, load_model, zero_shot_model
-from stylemotion.models.zero_shot import ZeroShotStyleVAE
+from stylemotion.models.zero_shot import ZeroShotStyleVAE, checked_temperature
 from stylemotion.primitives.segmentation import parse_primitive
 from stylemotion.provenance import provenance
 from stylemotion.training.reproduction import stage_train_config
@@ -218,10 +218,12 @@ def autoencoder_train_config(run: FinishedRun, style: str, folder: Path, seed: i
 
 
 def _settings_hash(cfg: DictConfig) -> str:
-    """A hash of what a training computes from (``threads``, ``ckpt_path`` and the fresh ``run_id`` left out: they
-    change no figure)."""
+    """A hash of what a training computes from (``threads``, ``ckpt_path``, the fresh ``run_id`` and the network's
+    ``model.sample_temperature`` left out: they change no trained weight)."""
     values = {k: v for k, v in OmegaConf.to_container(cfg, resolve=True).items()
               if k not in ("threads", "ckpt_path", "run_id")}
+    if isinstance(values.get("model"), dict):
+        values["model"] = {k: v for k, v in values["model"].items() if k != "sample_temperature"}
     return hashlib.sha256(json.dumps(values, sort_keys=True, default=str).encode()).hexdigest()[:16]
 
 
@@ -470,7 +472,8 @@ def leave_one_style_out(run: str | Path, out: str | Path, styles: Sequence[str] 
                         primitives: Sequence[str] | None = None, epochs: int | None = None, samples: int = 1000,
                         seed: int | None = None, overrides: Sequence[str] = (), threads: Any = None,
                         force: bool = False, resume: bool = False, shared_autoencoder: bool = False,
-                        cvae_unseen: bool = False, stages: str | Path | None = None) -> dict[str, Any]:
+                        cvae_unseen: bool = False, stages: str | Path | None = None,
+                        networks: str | Path | None = None, temperature: float | None = None) -> dict[str, Any]:
     """The leave-one-style-out evaluation (see the module doc); returns what ``zero_shot.json`` holds.
 
     Args:
@@ -492,6 +495,11 @@ def leave_one_style_out(run: str | Path, out: str | Path, styles: Sequence[str] 
         stages: the folder of the autoencoders without each style and of the ``cvae_unseen`` CVAEs (default
             ``out``; created when missing, its finished trainings reused): arms that differ only in the networks
             (e.g. their epochs) share them, so every arm is judged on the same generators and CVAEs.
+        networks: the folder the networks are trained in (default ``out``; its finished trainings reused): arms that
+            differ only in how the networks sample (``temperature``) share them.
+        temperature: sample every network with ``z ~ N(0, τ² I)``
+            (:meth:`~stylemotion.models.zero_shot.ZeroShotStyleVAE.set_sample_temperature`; None: the network's
+            own, ``model.sample_temperature``).
 
     Raises:
         OutputExistsError: ``out`` exists and neither ``force`` nor ``resume`` is on (before any work).
@@ -504,8 +512,12 @@ def leave_one_style_out(run: str | Path, out: str | Path, styles: Sequence[str] 
     if not (resume and out.is_dir()):
         out = check_new_output(out, force)
     stages = out if stages is None else Path(stages).expanduser()
-    if stages.exists() and not stages.is_dir():
-        raise ZeroShotRunError(f"stages={stages} is a file, not a folder of trainings")
+    networks_out = out if networks is None else Path(networks).expanduser()
+    for name, folder in (("stages", stages), ("networks", networks_out)):
+        if folder.exists() and not folder.is_dir():
+            raise ZeroShotRunError(f"{name}={folder} is a file, not a folder of trainings")
+    if temperature is not None:
+        temperature = checked_temperature(temperature)
     source = read_run(run)
     samples = positive_int(samples, "samples")
     seed = source.seed if seed is None else int(seed)
@@ -522,6 +534,7 @@ def leave_one_style_out(run: str | Path, out: str | Path, styles: Sequence[str] 
         shutil.rmtree(out)
     out.mkdir(parents=True, exist_ok=True)
     stages.mkdir(parents=True, exist_ok=True)
+    networks_out.mkdir(parents=True, exist_ok=True)
     judge = load_autoencoder(source.autoencoder_ckpt)
     judge_info = {"path": str(source.autoencoder_ckpt.resolve()), "fingerprint": fingerprint(judge)}
     takeset = build_dataset(source.data_cfg)
@@ -533,12 +546,16 @@ def leave_one_style_out(run: str | Path, out: str | Path, styles: Sequence[str] 
             if s not in generators:
                 generators[s] = _generator_autoencoder(source, s, stages, seed, threads, shared_autoencoder)
             gen = generators[s]
-            cfg = train_config(source, p, s, model_folder(out, p, s), epochs, overrides, threads, gen["path"], seed)
+            cfg = train_config(source, p, s, model_folder(networks_out, p, s), epochs, overrides, threads,
+                               gen["path"], seed)
             path, seconds = train_once(cfg, f"{p} network without {s}")
             networks[s] = load_left_out(path, p, s, gen["fingerprint"])
+            if temperature is not None:
+                networks[s].set_sample_temperature(temperature)
             if shared_autoencoder:
                 networks[s].attach_autoencoder(judge)  # one module for all (the same weights)
-            trained[s] = {"checkpoint": str(path), "train_seconds": seconds}
+            trained[s] = {"checkpoint": str(path), "train_seconds": seconds,
+                          "sample_temperature": networks[s].sample_temperature}
         cvaes = [load_model(source.cvaes[(q, s)], source.settings.neutral_style, judge)
                  for q, s in source.cvaes if q == p]
         unseen_trained = ({s: _unseen_cvae(source, p, s, stages, seed, threads, generators[s], cvaes) for s in wanted}
@@ -549,6 +566,7 @@ def leave_one_style_out(run: str | Path, out: str | Path, styles: Sequence[str] 
         for s, record in trained.items():
             row = results[p]["styles"][s]
             row["zero_shot"]["train_seconds"] = record["train_seconds"]
+            row["zero_shot"]["sample_temperature"] = record["sample_temperature"]
             if s in unseen_trained:
                 row[UNSEEN_ROW]["train_seconds"] = unseen_trained[s][1]
             row["generator_autoencoder"].update({k: v for k, v in generators[s].items() if k != "path"},
@@ -558,7 +576,8 @@ def leave_one_style_out(run: str | Path, out: str | Path, styles: Sequence[str] 
                         "samples": samples, "epochs": epochs, "overrides": list(overrides),
                         "leaky": LEAKY if shared_autoencoder else False, "cvae_unseen": bool(unseen),
                         "autoencoders": "shared (the run's)" if shared_autoencoder else "one per left-out style",
-                        "stages": str(stages.resolve()),
+                        "stages": str(stages.resolve()), "networks": str(networks_out.resolve()),
+                        "temperature": temperature,
                         "judge_autoencoder": judge_info,
                         "settings": asdict(source.settings), **provenance(),
                         "seconds": time.perf_counter() - started}}

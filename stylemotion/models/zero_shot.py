@@ -161,12 +161,16 @@ class ZeroShotStyleVAE(PrimitiveVAE):
             encoder's input): the network models a clip as its example plus a variation (see the module doc).
         style_weight: weight of the Gram style term (0: off).
         style_latents: codes the style term decodes: ``posterior``, ``prior`` or ``both``.
+        sample_temperature: τ of :meth:`sample`'s codes, ``z ~ N(0, τ² I)`` (1: the prior; smaller keeps the
+            samples nearer their example: less variation, more of the style). Sampling only: it changes no
+            training; :meth:`set_sample_temperature` changes it on a trained network.
         spec: what the model knows about its data (filled in at the first ``setup``).
         **kwargs: :class:`PrimitiveVAE` arguments (latent_dim, hidden, samples_per_item, kl_weight, …).
     """
 
     def __init__(self, embedding_dim: int = 32, anchor: bool = True, style_weight: float = 0.0,
-                 style_latents: str = "both", spec: dict[str, Any] | None = None, **kwargs: Any):
+                 style_latents: str = "both", sample_temperature: float = 1.0, spec: dict[str, Any] | None = None,
+                 **kwargs: Any):
         super().__init__(**kwargs)  # built below, once this class' hyperparameters are known
         if isinstance(embedding_dim, bool) or int(embedding_dim) != embedding_dim or embedding_dim < 1:
             raise ValueError(f"embedding_dim must be a whole number ≥ 1, got {embedding_dim!r}")
@@ -176,9 +180,19 @@ class ZeroShotStyleVAE(PrimitiveVAE):
             raise ValueError(f"style_latents must be one of {STYLE_LATENTS}, got {style_latents!r}")
         self.save_hyperparameters({**dict(self.hparams), "embedding_dim": int(embedding_dim), "anchor": bool(anchor),
                                    "style_weight": float(style_weight), "style_latents": str(style_latents),
+                                   "sample_temperature": checked_temperature(sample_temperature),
                                    "spec": None if spec is None else dict(spec)})
         if spec is not None:
             self._build(spec)
+
+    @property
+    def sample_temperature(self) -> float:
+        """τ of :meth:`sample` (1 for a checkpoint saved before the setting existed)."""
+        return float(self.hparams.get("sample_temperature", 1.0))
+
+    def set_sample_temperature(self, temperature: float) -> None:
+        """Sample with ``z ~ N(0, τ² I)`` from now on (also in this network's checkpoints saved later)."""
+        self.hparams["sample_temperature"] = checked_temperature(temperature)
 
     # -- construction from the data
 
@@ -398,11 +412,18 @@ class ZeroShotStyleVAE(PrimitiveVAE):
     @torch.no_grad()
     def sample(self, n: int, seed: int | None = None, chunk_size: int = DEFAULT_CHUNK, *,
                example: Any = None) -> MotionSamples:
-        """``n`` motions in the style of ``example`` (see :meth:`condition`): ``z ~ N(0, I)`` decoded under its
-        condition. ``seed`` seeds a private generator (None: a fresh seed); returns :class:`MotionSamples` as
-        :meth:`PrimitiveVAE.sample`."""
-        z = prior_draws(n, self.hparams.latent_dim, seed)
+        """``n`` motions in the style of ``example`` (see :meth:`condition`): ``z ~ N(0, τ² I)`` (τ:
+        :attr:`sample_temperature`) decoded under its condition. ``seed`` seeds a private generator (None: a fresh
+        seed); returns :class:`MotionSamples` as :meth:`PrimitiveVAE.sample`."""
+        z = prior_draws(n, self.hparams.latent_dim, seed) * self.sample_temperature
         return self.decode_latent(z, chunk_size, example=self.condition(example))
+
+
+def checked_temperature(value: Any) -> float:
+    """A sampling temperature τ as a float; refused unless a finite number ≥ 0 (ValueError naming it)."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value < 0:
+        raise ValueError(f"sample_temperature must be a finite number ≥ 0, got {value!r}")
+    return float(value)
 
 
 @dataclass

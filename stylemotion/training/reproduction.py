@@ -12,7 +12,9 @@ Stages, each in its own folder under ``out`` (default ``runs/reproduce/<data nam
    ``experiment=autoencoder``) on all takes of the data;
 3. ``vae/<primitive>``: the neutral PrimitiveVAE of each primitive (``experiment=primitive_vae``);
 4. ``cvae/<primitive>_<style>``: a StyleCVAE per primitive and style (``experiment=style_cvae``);
-5. ``report``: ``stylemotion-eval`` of all of them (:mod:`stylemotion.evaluation.run`); with
+5. ``report`` (or ``report=<name>``: another report of the same stages, e.g. under other ``evaluation.*``
+   settings, recorded in ``evaluation_<name>.json``): ``stylemotion-eval`` of all of them
+   (:mod:`stylemotion.evaluation.run`); with
    ``morphable=true`` also the Morphable Graph's neutral models (fitted into ``morphable/<primitive>/``,
    :mod:`stylemotion.morphable.rows`) as extra rows of Tables 5.1–5.3.
 
@@ -65,12 +67,15 @@ from stylemotion.io.outputs import check_new_output, inside, safe_name
 from stylemotion.primitives.actions import segment_actions
 from stylemotion.primitives.segmentation import SegmentSettings, parse_primitive
 from stylemotion.provenance import provenance
+from stylemotion.training.stage_settings import changed_settings, changes_line, config_record
 
 log = logging.getLogger(__name__)
 
 
 #: Where the VAE/CVAE stages run (``executor.engine``): this machine's process pool, or submitit jobs.
 ENGINES = ("pool", "local", "slurm")
+#: Names in a run folder that a report (``report=<name>``) may not take.
+RUN_PARTS = ("autoencoder", "vae", "cvae", "morphable", "hydra", "data.json", "reproduce.json", "evaluation.json")
 #: Seconds between looks at running submitit jobs.
 POLL_SECONDS = 2.0
 
@@ -103,6 +108,7 @@ class Stage:
     seconds: float = 0.0
     metrics: dict[str, Any] = field(default_factory=dict)
     settings_hash: str = ""
+    config: dict[str, Any] = field(default_factory=dict)
 
 
 def _hash(payload: Any) -> str:
@@ -235,14 +241,16 @@ class Reproduction:
         last = stage.folder / "checkpoints" / "last.ckpt"
         has_results = done.is_file() or any((stage.folder / "checkpoints").glob("*.ckpt"))
         remedy = f"delete {stage.folder} to train the {stage.name} stage again"
+        stage.config = config = config_record(self.train_config(stage, False))
         for record_path in (done, started):
             if record_path.is_file() and has_results:  # a stage that saved nothing is simply started again
-                recorded = read_json_object(record_path, f"{stage.name} stage's record", remedy).get("settings_hash")
-                if recorded != stage.settings_hash:
+                record = read_json_object(record_path, f"{stage.name} stage's record", remedy)
+                if record.get("settings_hash") != stage.settings_hash:
                     raise StageConflictError(
-                        f"{stage.folder} holds the {stage.name} stage of a run with other settings (hash {recorded}, "
-                        f"now {stage.settings_hash}: overrides, data, seed or an earlier stage changed). Choose "
-                        f"another out=… or delete {stage.folder} to train it again")
+                        f"{stage.folder} holds the {stage.name} stage of a run with other settings (hash "
+                        f"{record.get('settings_hash')}, now {stage.settings_hash}: overrides, data, seed or an "
+                        f"earlier stage changed). Choose another out=… or delete {stage.folder} to train it again")
+                self.check_trained_config(stage, record, config, done if record_path == done else last)
         if done.is_file():
             record = read_json_object(done, f"{stage.name} stage's record", remedy)
             checkpoint, seconds = record.get("checkpoint"), record.get("seconds", 0.0)
@@ -259,9 +267,32 @@ class Reproduction:
                 return None
         resume = last.is_file()
         self._line(index, f"{stage.name}: {'resuming from ' + str(last) if resume else 'training'}")
-        write_json(started, {"settings_hash": stage.settings_hash, "name": stage.name})
+        write_json(started, {"settings_hash": stage.settings_hash, "name": stage.name, "config": config})
         stage.folder.mkdir(parents=True, exist_ok=True)
         return resume
+
+    def check_trained_config(self, stage: Stage, record: dict[str, Any], config: dict[str, Any],
+                             source: Path) -> None:
+        """Refuse ``stage`` (:class:`StageConflictError`) when what it was trained with differs from ``config``, its
+        composed config now (:mod:`stylemotion.training.stage_settings`); ``record``: its ``done.json`` or
+        ``stage.json``, ``source``: that file (for a record without a config, the checkpoint's settings are read)."""
+        from stylemotion.models.checkpoints import checkpoint_hparams
+
+        recorded = record.get("config")
+        hparams = None
+        if recorded is not None and not isinstance(recorded, dict):
+            raise JsonFileError(f"{source}: the {stage.name} stage's recorded config is not an object; delete "
+                                f"{stage.folder} to train it again")
+        if recorded is None:
+            checkpoint = self.located(record.get("checkpoint")) if source.name == "done.json" else str(source)
+            if checkpoint and isinstance(checkpoint, str) and Path(checkpoint).is_file():
+                hparams = checkpoint_hparams(checkpoint)
+        changes = changed_settings(config, recorded, hparams)
+        if changes:
+            raise StageConflictError(
+                f"{stage.folder} holds the {stage.name} stage trained with other settings than the config gives now "
+                f"(a default in the configs changed): {changes_line(changes)}. Choose another out=… or delete "
+                f"{stage.folder} to train it again")
 
     def finish_stage(self, stage: Stage, metrics: dict[str, Any], resume: bool, seconds: float) -> None:
         """Record a trained stage's checkpoint, metrics and time in its ``done.json``."""
@@ -275,7 +306,7 @@ class Reproduction:
         write_json(stage.folder / "done.json", {"settings_hash": stage.settings_hash,
                                                  "checkpoint": self.recorded(stage.checkpoint),
                                                  "seconds": stage.seconds, "metrics": stage.metrics,
-                                                 "name": stage.name})
+                                                 "name": stage.name, "config": stage.config})
         test = stage.metrics.get("test", {})
         shown = ", ".join(f"{k} {v:.4g}" for k, v in test.items() if isinstance(v, float))
         log.info(f"    {stage.name} done in {stage.seconds / 60:.1f} min" + (f": {shown}" if shown else ""))
@@ -335,12 +366,16 @@ class Reproduction:
                                   stage.parent.checkpoint if stage.parent else None)
 
     def evaluation_stage(self) -> dict[str, Any]:
-        """Evaluate every trained model into ``<out>/report`` (or reuse the report of the same stages)."""
-        report, record = self.out / "report", self.out / "evaluation.json"
+        """Evaluate every trained model into ``<out>/<report>`` (or reuse the report of the same stages and
+        evaluation settings)."""
+        report, record = self.report_folder(), self.evaluation_record()
         step = self.total_steps()
         morphable = bool(self.cfg.get("morphable", False))
+        evaluation = OmegaConf.to_container(self.cfg.evaluation, resolve=True)
+        if evaluation.get("style_truth") == "all":
+            del evaluation["style_truth"]  # the default: the hash of reports made before the key existed
         settings_hash = _hash({"stages": [s.settings_hash for s in self.stages], "seed": int(self.cfg.seed),
-                               "evaluation": OmegaConf.to_container(self.cfg.evaluation, resolve=True),
+                               "evaluation": evaluation,
                                **({"morphable": True} if morphable else {})})  # off: the hash of earlier runs
         if report.exists():
             remedy = f"delete {report} to evaluate again"
@@ -363,6 +398,26 @@ class Reproduction:
         write_json(record, {"settings_hash": settings_hash, "report": self.recorded(report)})
         self.evaluated = True
         return results
+
+    def report_folder(self) -> Path:
+        """``<out>/<report>``: where the evaluation writes (``report``, a folder name; default ``report``)."""
+        name = str(self.cfg.get("report") or "report")
+        try:
+            usable = safe_name(name, "report") == name
+        except ValueError:
+            usable = False
+        if not usable or name in RUN_PARTS:
+            raise ConfigError(f"report: {name!r} is not a report folder name (letters, digits and ._+- only, not one "
+                              f"of the run's own {list(RUN_PARTS)}); choose e.g. report=report_test")
+        try:
+            return inside(self.out, name)
+        except ValueError as exc:  # a link out of the run folder
+            raise ConfigError(f"report: {exc}") from None
+
+    def evaluation_record(self) -> Path:
+        """``<out>/evaluation.json`` for the run's report, ``<out>/evaluation_<report>.json`` for another one."""
+        name = self.report_folder().name
+        return self.out / ("evaluation.json" if name == "report" else f"evaluation_{name}.json")
 
     def morphable_rows(self) -> dict[str, dict[str, Any]]:
         """``{primitive: {"morphable": model}}``: the Morphable Graph's neutral models of this run's data."""
@@ -554,6 +609,7 @@ def reproduce(cfg: DictConfig) -> dict[str, Any]:
     log.info(choose_budget(cfg))
     check_out_folder(cfg.out)
     repro = Reproduction(cfg)
+    repro.report_folder()  # a bad report name is named now, not after the training
     repro.out.mkdir(parents=True, exist_ok=True)
     repro.data_stage()
     indexed = list(enumerate(repro.stages, start=2))
@@ -566,16 +622,18 @@ def reproduce(cfg: DictConfig) -> dict[str, Any]:
     if indexed[in_process:]:
         repro.run_stages_in_parallel(indexed[in_process:], workers)
     set_torch_threads(alone, "alone_threads")  # the evaluation runs alone too
+    report = repro.report_folder()
     results = repro.evaluation_stage()
     summary = repro.summary()
-    summary["report"] = repro.recorded(repro.out / "report")
-    # a rerun that reused every stage and the report leaves the finished run's record as it was
-    if repro.evaluated or any(s.status != "reused" for s in repro.stages) \
+    summary["report"] = repro.recorded(report)
+    # a rerun that reused every stage and the report leaves the finished run's record as it was; so does one that
+    # only adds another report (report=<name>) of the same stages
+    if (repro.evaluated and report.name == "report") or any(s.status != "reused" for s in repro.stages) \
             or not (repro.out / "reproduce.json").is_file():
         write_json(repro.out / "reproduce.json", summary)
     log.info(f"done in {summary['seconds'] / 60:.1f} min: "
              + ", ".join(f"{k} {v}" for k, v in Counter(s.status for s in repro.stages).items()) + " training stages")
     for line in summary_lines(results):
         log.info(line)
-    log.info(f"report: {repro.out / 'report' / 'report.md'}")
+    log.info(f"report: {report / 'report.md'}")
     return summary

@@ -233,3 +233,31 @@ def test_heldout_splits_are_checked() -> None:
     for bad in (["train"], [], ["val", "val"]):
         with pytest.raises(ConfigError, match="evaluation.heldout_splits"):
             EvalSettings(heldout_splits=bad)
+
+
+def test_style_truth_heldout_judges_a_style_model_on_held_out_clips_only() -> None:
+    """``style_truth="heldout"`` with ``heldout_splits=[test]``: a style model's ground truth is exactly its style's
+    test-split clips (no train or val clip, which a choice made on ``[val]`` read); the neutral model's is unchanged;
+    the default keeps every clip of the style."""
+    data = dict(split=TINY_DATA["split"], heldout_splits=("test",))
+    everything = primitive_data(tiny_takeset(), "walk_leftStance", 16, **data)
+    test_only = primitive_data(tiny_takeset(), "walk_leftStance", 16, **data, style_truth="heldout")
+    key = lambda clips: {(c.take, c.start) for c in clips}  # noqa: E731
+    for style in everything.styles:
+        model = EvalModel(NEUTRAL if style == "normal" else style, "walk_leftStance", style,
+                          RealClipSource(everything.training_data(), 16), timeline_frames=16)
+        test_clips = key(everything.split("test", style))
+        assert test_clips, f"{style}: the tiny data must have test clips of every style"
+        assert key(test_only.ground_truth(model)) == test_clips
+        if style != "normal":
+            assert key(everything.ground_truth(model)) == key(everything.split("train", style)) | test_clips
+        else:
+            assert key(everything.ground_truth(model)) == test_clips
+
+
+def test_style_truth_is_checked() -> None:
+    from stylemotion.config import ConfigError
+
+    assert EvalSettings(style_truth="heldout").style_truth == "heldout"
+    with pytest.raises(ConfigError, match="evaluation.style_truth must be one of \\['all', 'heldout'\\], got 'test'"):
+        EvalSettings(style_truth="test")

@@ -37,6 +37,7 @@ from stylemotion.models.checkpoints import (
 )
 from stylemotion.models.loading import EvalModel, SampleSource, load_generative, load_model
 from stylemotion.models.style import gram
+from stylemotion.models.vae import prior_draws
 from stylemotion.models.zero_shot import ZeroShotStyleVAE
 
 torch.set_num_threads(1)
@@ -160,6 +161,8 @@ def test_sampling_needs_an_example_and_the_data_must_pair_styles(ae_ckpt, traine
     ({"embedding_dim": 0}, "embedding_dim must be a whole number"),
     ({"style_weight": -1.0}, "style_weight must be ≥ 0"),
     ({"style_latents": "all"}, "style_latents must be one of"),
+    ({"sample_temperature": -0.5}, "sample_temperature must be a finite number ≥ 0"),
+    ({"sample_temperature": float("nan")}, "sample_temperature must be a finite number ≥ 0"),
 ])
 def test_bad_hyperparameters_are_refused(kwargs, message) -> None:
     with pytest.raises(ValueError, match=message):
@@ -238,3 +241,33 @@ def test_per_sample_pooling_conditions_each_sample_on_one_seeded_clip(trained) -
                        model.sample(8, seed=3, example=model.condition(clips)).features)
     with pytest.raises(ValueError, match="pooling must be one of"):
         model.bind_example(clips, pooling="max")
+
+
+def test_the_sampling_temperature_scales_the_codes_and_is_saved_with_the_network(data, trained, tmp_path) -> None:
+    """τ: the samples are the decodes of τ·z for the same draws z; τ = 0 gives every sample the prior's centre; a
+    checkpoint saved before the setting existed samples at τ = 1; a set τ is saved with the network."""
+    model = trained[True]
+    bound = model.bind_example(data.example_clip("elderly"), style="elderly")
+    draws = prior_draws(30, model.hparams.latent_dim, 5)
+    assert model.sample_temperature == 1.0
+    try:
+        model.set_sample_temperature(0.5)
+        cooled = bound.sample(30, seed=5)
+        assert torch.allclose(cooled.latent, 0.5 * draws)
+        assert torch.allclose(cooled.features, bound.decode_latent(0.5 * draws).features, atol=1e-6)
+        model.set_sample_temperature(0)
+        frozen = bound.sample(4, seed=5).features
+        assert torch.allclose(frozen, frozen[:1].expand_as(frozen), atol=1e-6)
+        model.set_sample_temperature(0.7)
+        path = tmp_path / "cooled.ckpt"
+        model.requires_grad_(True)  # an earlier test froze it, as the path-following does
+        fit(model, data, steps=1).save_checkpoint(path, weights_only=False)  # last in the file: it trains
+        assert checkpoint_hparams(path)["sample_temperature"] == 0.7
+        assert load_generative(path).sample_temperature == 0.7
+        with pytest.raises(ValueError, match="sample_temperature must be a finite number ≥ 0, got -1"):
+            model.set_sample_temperature(-1)
+        older = ZeroShotStyleVAE(**TINY_NET)
+        del older.hparams["sample_temperature"]  # as a checkpoint saved before the setting existed
+        assert older.sample_temperature == 1.0
+    finally:
+        model.set_sample_temperature(1.0)

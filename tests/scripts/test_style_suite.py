@@ -93,3 +93,26 @@ def test_a_report_without_skating_figures_renders_no_skating_block():
     record["results"]["summary"] = {PRIMITIVE: summary[PRIMITIVE]}
     record["results"]["primitives"] = [PRIMITIVE]
     assert "skating" not in style.render(record)
+
+
+def test_the_test_report_suite_asks_for_test_clips_only_and_says_so():
+    """Suite ``style_test``: the runs of ``style_bandai`` with a second report that reads test-split clips only; its
+    blocks name the split, the default suite's do not claim it."""
+    import argparse
+
+    from suites import style_test
+
+    parser = argparse.ArgumentParser()
+    style_test.add_arguments(parser)
+    args = parser.parse_args([])
+    assert (args.data, args.report_on) == ("bandai", "test")
+    folder, overrides = style.REPORTS[args.report_on]
+    assert folder == "report_test" and set(overrides) == {
+        "report=report_test", "evaluation.heldout_splits=[test]", "evaluation.style_truth=heldout"}
+    record = json.loads((ROOT / "benchmarks" / "results" / "style_bandai.json").read_text())
+    plain = style.render(record)
+    record["results"]["report_on"] = "test"
+    test = style.render(record)
+    assert "**test split only**" in test["recognition"] and "scored on test clips" in test["recognition"]
+    assert "test-split clips of its own style" in test["variation_vs_style"]
+    assert "test split" not in plain["headline"] and "scored on val+test clips" in plain["recognition"]
