@@ -143,14 +143,15 @@ def seed_record(args: argparse.Namespace, seed: int, judge: Path) -> dict[str, A
         raise ZeroShotRunError(f"judge {judge} was evaluated on {list(source.settings.heldout_splits)}, not "
                                "[val]: the choice must not read test clips")
     # Autoencoders and CVAEs in seed<k>/, shared by every epoch count of the networks (seed<k>_e<epochs>/), and
-    # those networks by every sampling temperature (the evaluation of one in seed<k>[_e<epochs>]_t<τ>/).
+    # those networks by every way of sampling them (the evaluation of one in seed<k>[_e<epochs>]_t<τ>[_centred]/).
     stages = args.runs / args.data / f"seed{seed}"
     networks = stages if args.epochs is None else stages.with_name(f"seed{seed}_e{args.epochs}")
-    temperature = getattr(args, "temperature", None)
-    out = networks if temperature is None else networks.with_name(f"{networks.name}_t{temperature:g}")
+    temperature, centred = getattr(args, "temperature", None), getattr(args, "centred", None) or None
+    out = networks if temperature is None and not centred else networks.with_name(
+        f"{networks.name}_t{1.0 if temperature is None else temperature:g}{'_centred' if centred else ''}")
     result = leave_one_style_out(judge, out, args.styles, args.primitives, args.epochs, args.samples, seed,
                                  threads=1, resume=True, cvae_unseen=True, stages=stages, networks=networks,
-                                 temperature=temperature)
+                                 temperature=temperature, centred=centred)
     cases = {f"{p}/{s}": case_figures(row) for p, res in result["primitives"].items()
              for s, row in res["styles"].items()}
     minutes = {f"{p}/{s}": {

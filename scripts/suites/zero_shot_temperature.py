@@ -16,6 +16,9 @@ changed since: those are the CVAEs ``stylemotion-style method=cvae`` trains toda
 experiment's epoch count (``seed<k>_e<epochs>/``, suite ``zero_shot_epochs``' trainings), sampled at each τ (the
 arm's evaluation in ``seed<k>_e<epochs>_t<τ>/``). Arms differ only in τ.
 
+``--centred`` samples every arm with the variation centred on the example (``model.sample_centred``; suite
+``zero_shot_centred`` is this suite with it on, τ = 1, its results in a file of their own).
+
 Rule (:func:`choose_temperature`, fixed before any run): an arm **qualifies** when ``style_method``'s rule gives
 ``zero_shot`` on it (own-column rows no fewer than the CVAE's, mean recognition ≥ min(0.9, the CVAE's), mean capped
 log variation above the CVAE's by more than ``style_method.TIE``). Among qualifying arms the most variation wins
@@ -42,6 +45,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     style_method.leave_one_out_arguments(parser)
     parser.add_argument("--temperatures", type=number_above(0, kind=float), nargs="+", default=list(DEFAULT_ARMS),
                         help="sampling temperatures τ of the networks, one arm each")
+    parser.add_argument("--centred", action="store_true",
+                        help="sample every arm with the variation centred on the example (model.sample_centred)")
     parser.add_argument("--epochs", type=number_above(1), default=None,
                         help="epochs of the networks (default: the zero_shot experiment's, in seed<k>_e<epochs>/)")
 
@@ -75,6 +80,7 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
     for temperature in sorted(set(args.temperatures), reverse=True):  # τ = 1 first: it trains what is missing
         arm_args = copy.copy(args)
         arm_args.epochs, arm_args.temperature = epochs, temperature
+        arm_args.centred = bool(getattr(args, "centred", False))
         with ProcessPoolExecutor(max_workers=processes, mp_context=get_context("spawn")) as pool:
             futures = {seed: pool.submit(style_method.seed_record, arm_args, seed, judge)
                        for seed, judge in judges.items()}
@@ -82,6 +88,7 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
         arms[arm_key(temperature)] = zero_shot_epochs.arm_summary(per_arm[arm_key(temperature)])
     first = next(iter(arms.values()))["summary"]["cvae_unseen"]
     return {"data": args.data, "epochs": epochs, "samples": args.samples,
+            "centred": bool(getattr(args, "centred", False)),
             "narrowed": {"primitives": args.primitives, "styles": args.styles},
             "splits": {"choose": "the judges' evaluation.heldout_splits=[val]: real clips of the train and val "
                                  "splits; no test clip", "seeds": "training seeds, not reported seeds"},
@@ -104,24 +111,28 @@ def render(record: dict[str, Any]) -> dict[str, str]:
     for t in order:
         arm = r["arms"][t]
         s, tests = arm["summary"]["zero_shot"], arm["choice"]["tests"]
-        rows.append([f"zero-shot, τ = {t}", f"{s['own_column']}/{s['cases']}", sd(s["recognition"], 3),
+        rows.append([f"zero-shot{', centred' if r.get('centred') else ''}, τ = {t}", f"{s['own_column']}/{s['cases']}",
+                     sd(s["recognition"], 3),
                      *(sd(s[k]) for k in style_method.VARIATION), fmt(s["capped_log_variation"], 3),
                      ", ".join(k for k, ok in tests.items() if not ok) or "—",
                      "yes" if arm["choice"]["default"] == "zero_shot" else "no"])
     cv = r["arms"][order[0]]["summary"]["cvae_unseen"]
     rows.append([style_method.LABELS["cvae_unseen"], f"{cv['own_column']}/{cv['cases']}", sd(cv["recognition"], 3),
                  *(sd(cv[k]) for k in style_method.VARIATION), fmt(cv["capped_log_variation"], 3), "", ""])
+    how = " with the variation centred on the example" if r.get("centred") else ""
     if choice["method"] == "zero_shot":
-        verdict = (f"**method=zero_shot becomes the default, sampled at τ = {choice['temperature']:g}** "
+        verdict = (f"**method=zero_shot becomes the default, sampled at τ = {choice['temperature']:g}{how}** "
                    f"({choice['how']})")
     else:
-        verdict = f"method=cvae **stays** the default and τ stays 1 ({choice['how']})"
+        verdict = (f"method=cvae **stays** the default and τ stays 1{', centring off' if r.get('centred') else ''} "
+                   f"({choice['how']})")
     if not full:
         verdict = f"{choice['method']} at τ = {choice['temperature']:g} by the rule, **not applied**: a narrowed run"
     same = ("the CVAE rows are the same in every arm (shared trainings)" if r["cvae_unseen_same_in_every_arm"]
             else "**the CVAE rows differ between arms**")
     headline = (
-        f"{label}The zero-shot network's sampling temperature τ on **validation** clips ({r['data']}, training seeds "
+        f"{label}The zero-shot network's sampling{how}, temperature τ, on **validation** clips ({r['data']}, "
+        f"training seeds "
         f"{', '.join(seeds)}: not reported seeds; networks of {r['epochs']} epochs, the same in every arm): suite "
         f"style_method's leave-one-style-out per arm, the autoencoders without each style, the CVAEs on them "
         f"(today's CVAE defaults) and the networks shared; {same}. Figures as in style_method's block; a qualifying "

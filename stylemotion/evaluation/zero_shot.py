@@ -217,13 +217,17 @@ def autoencoder_train_config(run: FinishedRun, style: str, folder: Path, seed: i
     return _quiet(cfg)
 
 
+#: The networks' ``model.*`` keys that change only how a trained network samples (left out of a training's hash).
+SAMPLING_ONLY = ("sample_temperature", "sample_centred")
+
+
 def _settings_hash(cfg: DictConfig) -> str:
     """A hash of what a training computes from (``threads``, ``ckpt_path``, the fresh ``run_id`` and the network's
-    ``model.sample_temperature`` left out: they change no trained weight)."""
+    :data:`SAMPLING_ONLY` keys left out: they change no trained weight)."""
     values = {k: v for k, v in OmegaConf.to_container(cfg, resolve=True).items()
               if k not in ("threads", "ckpt_path", "run_id")}
     if isinstance(values.get("model"), dict):
-        values["model"] = {k: v for k, v in values["model"].items() if k != "sample_temperature"}
+        values["model"] = {k: v for k, v in values["model"].items() if k not in SAMPLING_ONLY}
     return hashlib.sha256(json.dumps(values, sort_keys=True, default=str).encode()).hexdigest()[:16]
 
 
@@ -473,7 +477,8 @@ def leave_one_style_out(run: str | Path, out: str | Path, styles: Sequence[str] 
                         seed: int | None = None, overrides: Sequence[str] = (), threads: Any = None,
                         force: bool = False, resume: bool = False, shared_autoencoder: bool = False,
                         cvae_unseen: bool = False, stages: str | Path | None = None,
-                        networks: str | Path | None = None, temperature: float | None = None) -> dict[str, Any]:
+                        networks: str | Path | None = None, temperature: float | None = None,
+                        centred: bool | None = None) -> dict[str, Any]:
     """The leave-one-style-out evaluation (see the module doc); returns what ``zero_shot.json`` holds.
 
     Args:
@@ -500,6 +505,8 @@ def leave_one_style_out(run: str | Path, out: str | Path, styles: Sequence[str] 
         temperature: sample every network with ``z ~ N(0, τ² I)``
             (:meth:`~stylemotion.models.zero_shot.ZeroShotStyleVAE.set_sample_temperature`; None: the network's
             own, ``model.sample_temperature``).
+        centred: sample every network with its variation centred on the example
+            (:meth:`~stylemotion.models.zero_shot.ZeroShotStyleVAE.set_sample_centred`; None: the network's own).
 
     Raises:
         OutputExistsError: ``out`` exists and neither ``force`` nor ``resume`` is on (before any work).
@@ -552,10 +559,13 @@ def leave_one_style_out(run: str | Path, out: str | Path, styles: Sequence[str] 
             networks[s] = load_left_out(path, p, s, gen["fingerprint"])
             if temperature is not None:
                 networks[s].set_sample_temperature(temperature)
+            if centred is not None:
+                networks[s].set_sample_centred(centred)
             if shared_autoencoder:
                 networks[s].attach_autoencoder(judge)  # one module for all (the same weights)
             trained[s] = {"checkpoint": str(path), "train_seconds": seconds,
-                          "sample_temperature": networks[s].sample_temperature}
+                          "sample_temperature": networks[s].sample_temperature,
+                          "sample_centred": networks[s].sample_centred}
         cvaes = [load_model(source.cvaes[(q, s)], source.settings.neutral_style, judge)
                  for q, s in source.cvaes if q == p]
         unseen_trained = ({s: _unseen_cvae(source, p, s, stages, seed, threads, generators[s], cvaes) for s in wanted}
@@ -567,6 +577,7 @@ def leave_one_style_out(run: str | Path, out: str | Path, styles: Sequence[str] 
             row = results[p]["styles"][s]
             row["zero_shot"]["train_seconds"] = record["train_seconds"]
             row["zero_shot"]["sample_temperature"] = record["sample_temperature"]
+            row["zero_shot"]["sample_centred"] = record["sample_centred"]
             if s in unseen_trained:
                 row[UNSEEN_ROW]["train_seconds"] = unseen_trained[s][1]
             row["generator_autoencoder"].update({k: v for k, v in generators[s].items() if k != "path"},
@@ -577,7 +588,7 @@ def leave_one_style_out(run: str | Path, out: str | Path, styles: Sequence[str] 
                         "leaky": LEAKY if shared_autoencoder else False, "cvae_unseen": bool(unseen),
                         "autoencoders": "shared (the run's)" if shared_autoencoder else "one per left-out style",
                         "stages": str(stages.resolve()), "networks": str(networks_out.resolve()),
-                        "temperature": temperature,
+                        "temperature": temperature, "centred": centred,
                         "judge_autoencoder": judge_info,
                         "settings": asdict(source.settings), **provenance(),
                         "seconds": time.perf_counter() - started}}

@@ -162,15 +162,19 @@ class ZeroShotStyleVAE(PrimitiveVAE):
         style_weight: weight of the Gram style term (0: off).
         style_latents: codes the style term decodes: ``posterior``, ``prior`` or ``both``.
         sample_temperature: τ of :meth:`sample`'s codes, ``z ~ N(0, τ² I)`` (1: the prior; smaller keeps the
-            samples nearer their example: less variation, more of the style). Sampling only: it changes no
-            training; :meth:`set_sample_temperature` changes it on a trained network.
+            samples nearer the decoder's centre: less variation). Sampling only: it changes no training;
+            :meth:`set_sample_temperature` changes it on a trained network.
+        sample_centred: (anchored networks) decode :meth:`decode_latent`'s codes as the example plus the variation
+            minus its mean over the prior (:meth:`variation_centre`), so the samples centre on their example
+            instead of on where the decoder puts an unseen style. Sampling only, as ``sample_temperature``
+            (:meth:`set_sample_centred`); the path-following synthesis decodes without it.
         spec: what the model knows about its data (filled in at the first ``setup``).
         **kwargs: :class:`PrimitiveVAE` arguments (latent_dim, hidden, samples_per_item, kl_weight, …).
     """
 
     def __init__(self, embedding_dim: int = 32, anchor: bool = True, style_weight: float = 0.0,
-                 style_latents: str = "both", sample_temperature: float = 1.0, spec: dict[str, Any] | None = None,
-                 **kwargs: Any):
+                 style_latents: str = "both", sample_temperature: float = 1.0, sample_centred: bool = False,
+                 spec: dict[str, Any] | None = None, **kwargs: Any):
         super().__init__(**kwargs)  # built below, once this class' hyperparameters are known
         if isinstance(embedding_dim, bool) or int(embedding_dim) != embedding_dim or embedding_dim < 1:
             raise ValueError(f"embedding_dim must be a whole number ≥ 1, got {embedding_dim!r}")
@@ -178,9 +182,12 @@ class ZeroShotStyleVAE(PrimitiveVAE):
             raise ValueError(f"style_weight must be ≥ 0, got {style_weight}")
         if style_latents not in STYLE_LATENTS:
             raise ValueError(f"style_latents must be one of {STYLE_LATENTS}, got {style_latents!r}")
+        if sample_centred and not anchor:
+            raise ValueError("sample_centred needs anchor=true: the samples centre on their example")
         self.save_hyperparameters({**dict(self.hparams), "embedding_dim": int(embedding_dim), "anchor": bool(anchor),
                                    "style_weight": float(style_weight), "style_latents": str(style_latents),
                                    "sample_temperature": checked_temperature(sample_temperature),
+                                   "sample_centred": bool(sample_centred),
                                    "spec": None if spec is None else dict(spec)})
         if spec is not None:
             self._build(spec)
@@ -193,6 +200,27 @@ class ZeroShotStyleVAE(PrimitiveVAE):
     def set_sample_temperature(self, temperature: float) -> None:
         """Sample with ``z ~ N(0, τ² I)`` from now on (also in this network's checkpoints saved later)."""
         self.hparams["sample_temperature"] = checked_temperature(temperature)
+
+    @property
+    def sample_centred(self) -> bool:
+        """Whether :meth:`decode_latent` centres the variation on the example (False for older checkpoints)."""
+        return bool(self.hparams.get("sample_centred", False))
+
+    def set_sample_centred(self, centred: bool) -> None:
+        """Centre the samples' variation on their example from now on, or not (see the class doc)."""
+        if centred and not self.hparams.anchor:
+            raise ValueError("sample_centred needs anchor=true: the samples centre on their example")
+        self.hparams["sample_centred"] = bool(centred)
+
+    @torch.no_grad()
+    def variation_centre(self, condition: StyleCondition) -> torch.Tensor:
+        """The decoder's mean variation under ``condition`` over :data:`CENTRE_DRAWS` prior codes (a fixed seed):
+        ``(D,)`` for one embedding ``(E,)``, ``(n, D)`` for embeddings ``(n, E)`` (each distinct one once)."""
+        z = prior_draws(CENTRE_DRAWS, self.hparams.latent_dim, 0).to(self.device)
+        embeddings = condition.embedding.reshape(-1, condition.embedding.shape[-1])
+        distinct, inverse = torch.unique(embeddings, dim=0, return_inverse=True)
+        centres = torch.stack([self.net.decode(z, e.expand(len(z), -1)).mean(0) for e in distinct])
+        return centres[inverse].reshape(*condition.embedding.shape[:-1], -1)
 
     # -- construction from the data
 
@@ -401,10 +429,14 @@ class ZeroShotStyleVAE(PrimitiveVAE):
 
     @torch.no_grad()
     def decode_latent(self, z: torch.Tensor, chunk_size: int = DEFAULT_CHUNK, *, example: Any = None) -> MotionSamples:
-        """Motions of latent codes ``(n, k)`` in the style of ``example`` (see :meth:`condition`)."""
+        """Motions of latent codes ``(n, k)`` in the style of ``example`` (see :meth:`condition`; with
+        :attr:`sample_centred` the variation centred on the example)."""
         condition = self.condition(example)
         z = torch.as_tensor(z, dtype=torch.float32)
-        features, duration = self.denormalize(self._decode(z.to(self.device), condition))
+        decoded = self._decode(z.to(self.device), condition)
+        if self.sample_centred:
+            decoded = decoded - self.variation_centre(condition)
+        features, duration = self.denormalize(decoded)
         out = decode_features(self.autoencoder, features, duration, self.timeline_frames, self.fps, chunk_size)
         out.latent = z.cpu()
         return out
@@ -417,6 +449,10 @@ class ZeroShotStyleVAE(PrimitiveVAE):
         seed); returns :class:`MotionSamples` as :meth:`PrimitiveVAE.sample`."""
         z = prior_draws(n, self.hparams.latent_dim, seed) * self.sample_temperature
         return self.decode_latent(z, chunk_size, example=self.condition(example))
+
+
+#: Prior codes :meth:`ZeroShotStyleVAE.variation_centre` averages the decoder's variation over.
+CENTRE_DRAWS = 1024
 
 
 def checked_temperature(value: Any) -> float:

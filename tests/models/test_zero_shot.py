@@ -243,6 +243,38 @@ def test_per_sample_pooling_conditions_each_sample_on_one_seeded_clip(trained) -
         model.bind_example(clips, pooling="max")
 
 
+def test_centred_sampling_takes_the_variations_mean_over_the_prior_off_each_clips_samples(data, trained) -> None:
+    """``sample_centred``: the centre is the decoder's mean variation over the fixed prior codes; every sample moves
+    by it (one shift for all samples of one example, one per clip with per-sample pooling); only anchored networks."""
+    from stylemotion.models.zero_shot import CENTRE_DRAWS
+    from stylemotion.style_example.example import cut_examples
+
+    model = trained[True].eval()
+    condition = model.condition(data.example_clip("elderly"))
+    draws = prior_draws(CENTRE_DRAWS, model.hparams.latent_dim, 0)
+    centre = model.variation_centre(condition)
+    assert torch.allclose(centre, model.net.decode(draws, condition.embedding).mean(0), atol=1e-6)
+    assert centre.abs().max() > 0
+    plain = model.sample(20, seed=2, example=condition).features
+    try:
+        model.set_sample_centred(True)
+        centred = model.sample(20, seed=2, example=condition).features
+        shift = centred - plain
+        assert shift.abs().max() > 1e-4 and torch.allclose(shift, shift[:1].expand_as(shift), atol=1e-4)
+        clips = cut_examples(user_examples(2), "tired", "walk", [model.primitive], None).used[model.primitive]
+        per_sample = model.per_sample_condition(clips, 12, seed=3)
+        centres = model.variation_centre(per_sample)
+        singles = torch.stack([model.variation_centre(model.condition([c])) for c in clips])
+        assert centres.shape == (12, centre.shape[-1])
+        assert all(any(torch.allclose(c, one, atol=1e-5) for one in singles) for c in centres)
+    finally:
+        model.set_sample_centred(False)
+    with pytest.raises(ValueError, match="sample_centred needs anchor=true"):
+        trained[False].set_sample_centred(True)
+    with pytest.raises(ValueError, match="sample_centred needs anchor=true"):
+        ZeroShotStyleVAE(anchor=False, sample_centred=True)
+
+
 def test_the_sampling_temperature_scales_the_codes_and_is_saved_with_the_network(data, trained, tmp_path) -> None:
     """τ: the samples are the decodes of τ·z for the same draws z; τ = 0 gives every sample the prior's centre; a
     checkpoint saved before the setting existed samples at τ = 1; a set τ is saved with the network."""

@@ -80,3 +80,23 @@ def test_a_temperature_that_is_not_a_number_at_least_zero_is_refused_by_the_pars
     with pytest.raises(SystemExit) as exit_:
         parser.parse_args(["--temperatures", "1", value])
     assert exit_.value.code == 2 and "argument --temperatures" in capsys.readouterr().err
+
+
+def test_the_centred_suite_samples_centred_at_the_prior_and_says_so() -> None:
+    from suites import zero_shot_centred
+
+    parser = argparse.ArgumentParser(prog="zero_shot_centred")
+    zero_shot_centred.add_arguments(parser)
+    args = parser.parse_args([])
+    assert args.centred and args.temperatures == [1.0]
+    arms = {"1": arm(0.95, True, 0.3)}
+    results = {"data": "bandai", "epochs": 10, "samples": 10, "centred": True,
+               "narrowed": {"primitives": None, "styles": None},
+               "per_arm": {"1": {"100": {"cases": {}}, "101": {"cases": {}}}}, "arms": arms,
+               "cvae_unseen_same_in_every_arm": True,
+               "choice": zero_shot_temperature.choose_temperature(arms)}
+    record = {"suite": "zero_shot_centred", "command": "c", "commit": "0" * 40, "started": "2026-12-07T06:00:00",
+              "machine": {"cpu": "x", "cores": 2}, "seeds": [100, 101], "seconds": 1.0, "results": results}
+    headline = zero_shot_centred.render(record)["headline"]
+    assert "| zero-shot, centred, τ = 1 |" in headline
+    assert "sampled at τ = 1 with the variation centred on the example**" in headline
