@@ -43,7 +43,8 @@ def tiny_style(run: Path) -> tuple[Path, dict]:
 
         folder = run.parent
         with logged_lines("stylemotion.style_example") as lines:
-            results = add_style(str(example_bvh(folder)), run, "tired", folder / "tired", samples=SAMPLES)
+            results = add_style(str(example_bvh(folder)), run, "tired", folder / "tired", method="cvae",
+                                samples=SAMPLES)
         _CACHE["style"], _CACHE["results"], _CACHE["lines"] = folder / "tired", results, lines
     return _CACHE["style"], {"results": _CACHE["results"], "lines": _CACHE["lines"]}
 

@@ -28,7 +28,8 @@ class StyleSettings(MotionFileKeys):
     style of the run's data nor one of its models. ``out``: a new folder (an existing one is refused); nothing is
     left there on failure. ``method``: how the style's primitive models come about: ``cvae`` = the run's StyleCVAE
     training with the example's clips as the style example; ``zero_shot`` = one zero-shot network per primitive
-    bound to the example's clips (no training for the style). ``network``: ``method=zero_shot``: the networks, a
+    bound to the example's clips (no training for the style; the default, chosen on validation clips by suite
+    ``zero_shot_centred``: docs/style.md). ``network``: ``method=zero_shot``: the networks, a
     folder with ``<primitive>/checkpoints/best.ckpt`` (``out/network`` of an earlier zero_shot call) or
     ``{primitive: checkpoint}``; None = train them on all the run's styles into ``out/network`` (reusable).
     ``network_epochs``: ``method=zero_shot``, ``network=None``: epochs per network; None =
@@ -43,7 +44,7 @@ class StyleSettings(MotionFileKeys):
     run: str = "runs/reproduce/synthetic"
     name: str = MISSING
     out: str = "runs/style/${name}"
-    method: str = "cvae"
+    method: str = "zero_shot"
     network: Any = None
     network_epochs: int | None = None
     action: str | None = None

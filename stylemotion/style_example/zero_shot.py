@@ -12,6 +12,10 @@ from the key ``network``:
 * a folder holding ``<primitive>/checkpoints/best.ckpt`` (such a ``network`` folder), or a mapping
   ``{primitive: checkpoint}``.
 
+Every network samples as ``configs/model/zero_shot.yaml`` says today (:func:`sampling_defaults`:
+``sample_temperature``, ``sample_centred``; chosen on validation clips, docs/style.md), also one trained before those
+keys changed or existed; the report records how (``network.sampling``).
+
 Each network is checked before any work (:func:`check_network`): a zero-shot network, of the primitive,
 trained on the run's autoencoder (weight fingerprint) and on the run's canonical timeline.
 
@@ -218,6 +222,9 @@ class ZeroShotMethod(Method):
     def load(self, checkpoint: Path, primitive: str, clips: Sequence[Clip], records: Sequence[Mapping[str, Any]],
              name: str, neutral_style: str, autoencoder) -> EvalModel:
         network = load_generative(checkpoint, autoencoder)
+        defaults = sampling_defaults()
+        network.set_sample_temperature(defaults["sample_temperature"])
+        network.set_sample_centred(defaults["sample_centred"])
         described = [{**describe_clip(c), "encoded_frames": network.timeline_frames, **dict(r)}
                      for c, r in zip(clips, records)]
         bound = network.bind_example(list(clips), name, described)
@@ -233,6 +240,8 @@ class ZeroShotMethod(Method):
             "epochs": trained_epochs(folder, list(models)) if here else None,
             "checkpoints": {p: recorded_path(m.checkpoint, folder) for p, m in models.items()},
             "trained_styles": {p: n.styles for p, n in networks.items()},
+            "sampling": {p: {"temperature": n.sample_temperature, "centred": n.sample_centred}
+                         for p, n in networks.items()},
             "excluded_styles": {p: n.excluded_styles for p, n in networks.items()}}}
 
     def entry(self, primitive: str, clips: Sequence[Clip], origin: Sequence[int] = (), examples: int = 1
@@ -242,3 +251,13 @@ class ZeroShotMethod(Method):
                     "clips": [[int(c.start), int(c.stop)] for c in clips]}
         return {"method": "zero_shot", "example": [example_file(i) for i in range(examples)],
                 "clips": [[int(c.start), int(c.stop), int(i)] for c, i in zip(clips, origin)]}
+
+
+def sampling_defaults() -> dict[str, Any]:
+    """``sample_temperature`` and ``sample_centred`` of ``configs/model/zero_shot.yaml``: how every network of
+    ``method=zero_shot`` samples."""
+    from stylemotion.config import config_dir
+
+    cfg = OmegaConf.load(Path(config_dir()) / "model" / "zero_shot.yaml")
+    return {"sample_temperature": float(cfg.get("sample_temperature", 1.0)),
+            "sample_centred": bool(cfg.get("sample_centred", False))}

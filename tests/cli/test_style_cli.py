@@ -89,7 +89,7 @@ def test_the_config_names_a_missing_key(tmp_path: Path, missing: str, message: s
                       + [f"out={tmp_path / 'out'}"])
     with pytest.raises(ConfigError, match=re.escape(message)):
         add_style_from_config(cfg)
-    assert cfg.method == "cvae" and cfg.samples == 1000 and not (tmp_path / "out").exists()
+    assert cfg.method == "zero_shot" and cfg.samples == 1000 and not (tmp_path / "out").exists()
     assert cfg.network is None and cfg.network_epochs is None
 
 

@@ -90,7 +90,9 @@ def test_the_networks_are_trained_in_the_command_on_every_style_and_the_report_i
         assert cfg["trainer"]["enable_progress_bar"] is False  # as the run's stages show their training
     assert report["network"] | {"trained_styles": None, "checkpoints": None} == {
         "trained_here": True, "given": None, "epochs": NETWORK_EPOCHS, "trained_styles": None, "checkpoints": None,
-        "excluded_styles": {p: [] for p in PRIMITIVES}}
+        "excluded_styles": {p: [] for p in PRIMITIVES},
+        # as configs/model/zero_shot.yaml samples today (chosen on validation clips)
+        "sampling": {p: {"temperature": 1.0, "centred": True} for p in PRIMITIVES}}
     steps = [line for line in made["lines"] if line.startswith("[")]
     assert [s[:5] for s in steps] == [f"[{k}/5]" for k in range(1, 6)]
     assert steps[2].startswith(f"[3/5] network walk_leftStance: training ({NETWORK_EPOCHS} epochs) on the clips of "
@@ -162,7 +164,8 @@ def test_a_folder_without_networks_and_keys_of_the_other_method_are_refused(zero
     _refused(tmp_path, StyleExampleError, rf"its networks are in {zero_shot[0] / 'network'}", run, method="zero_shot",
              network=str(zero_shot[0]))
     _refused(tmp_path, StyleExampleError, "is no folder", run, method="zero_shot", network=str(tmp_path / "nowhere"))
-    _refused(tmp_path, ConfigError, "network=x is a key of method=zero_shot, not of method=cvae", run, network="x")
+    _refused(tmp_path, ConfigError, "network=x is a key of method=zero_shot, not of method=cvae", run, method="cvae",
+             network="x")
     _refused(tmp_path, ConfigError, "network_epochs=3 sets the training of a network made here", run,
              method="zero_shot", network=str(zero_shot[0] / "network"), network_epochs=3)
     _refused(tmp_path, ConfigError, "network_epochs must be a whole number", run, method="zero_shot",
