@@ -164,9 +164,9 @@ class ZeroShotStyleVAE(PrimitiveVAE):
         sample_temperature: τ of :meth:`sample`'s codes, ``z ~ N(0, τ² I)`` (1: the prior; smaller keeps the
             samples nearer the decoder's centre: less variation). Sampling only: it changes no training;
             :meth:`set_sample_temperature` changes it on a trained network.
-        sample_centred: (anchored networks) decode :meth:`decode_latent`'s codes as the example plus the variation
-            minus its mean over the prior (:meth:`variation_centre`), so the samples centre on their example
-            instead of on where the decoder puts an unseen style. Sampling only, as ``sample_temperature``
+        sample_centred: (anchored networks; false otherwise) decode :meth:`decode_latent`'s codes as the example plus
+            the variation minus its mean over the prior (:meth:`variation_centre`), so the samples centre on their
+            example instead of on where the decoder puts an unseen style. Sampling only, as ``sample_temperature``
             (:meth:`set_sample_centred`); the path-following synthesis decodes without it.
         spec: what the model knows about its data (filled in at the first ``setup``).
         **kwargs: :class:`PrimitiveVAE` arguments (latent_dim, hidden, samples_per_item, kl_weight, …).
@@ -182,12 +182,10 @@ class ZeroShotStyleVAE(PrimitiveVAE):
             raise ValueError(f"style_weight must be ≥ 0, got {style_weight}")
         if style_latents not in STYLE_LATENTS:
             raise ValueError(f"style_latents must be one of {STYLE_LATENTS}, got {style_latents!r}")
-        if sample_centred and not anchor:
-            raise ValueError("sample_centred needs anchor=true: the samples centre on their example")
         self.save_hyperparameters({**dict(self.hparams), "embedding_dim": int(embedding_dim), "anchor": bool(anchor),
                                    "style_weight": float(style_weight), "style_latents": str(style_latents),
                                    "sample_temperature": checked_temperature(sample_temperature),
-                                   "sample_centred": bool(sample_centred),
+                                   "sample_centred": bool(sample_centred) and bool(anchor),  # needs the example
                                    "spec": None if spec is None else dict(spec)})
         if spec is not None:
             self._build(spec)

@@ -224,7 +224,7 @@ class ZeroShotMethod(Method):
         network = load_generative(checkpoint, autoencoder)
         defaults = sampling_defaults()
         network.set_sample_temperature(defaults["sample_temperature"])
-        network.set_sample_centred(defaults["sample_centred"])
+        network.set_sample_centred(defaults["sample_centred"] and bool(network.hparams.anchor))
         described = [{**describe_clip(c), "encoded_frames": network.timeline_frames, **dict(r)}
                      for c, r in zip(clips, records)]
         bound = network.bind_example(list(clips), name, described)
