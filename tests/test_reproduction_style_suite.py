@@ -38,7 +38,8 @@ def test_spreads_are_over_seeds(tiny_run, monkeypatch: pytest.MonkeyPatch, tmp_p
     primitive = next(iter(report["table_5_1"]))
     shares = {0: 0.2, 1: 0.5, 2: 0.8}
 
-    def fake(data, seed, out, workers, primitives=None, styles=None, alpha=None):
+    def fake(data, seed, out, workers, primitives=None, styles=None, alpha=None, extra=()):
+        assert list(extra) == []  # the run's own report (--report-on all)
         out.mkdir(parents=True, exist_ok=True)  # what the reproduction leaves beside its report
         (out / "reproduce.json").write_text(json.dumps({"stages": [{"seconds": 30.0 * (seed + 1), "status": "done"}]}))
         copy = json.loads(json.dumps(report))
@@ -67,7 +68,7 @@ def test_a_chosen_alpha_reaches_every_seed_and_its_table(tiny_run, monkeypatch: 
     report = json.loads((tiny_run.folder / "report" / "report.json").read_text())
     passed = []
 
-    def fake(data, seed, out, workers, primitives=None, styles=None, alpha=None):
+    def fake(data, seed, out, workers, primitives=None, styles=None, alpha=None, extra=()):
         passed.append(alpha)
         out.mkdir(parents=True, exist_ok=True)
         (out / "reproduce.json").write_text(json.dumps({"stages": [{"seconds": 1.0, "status": "done"}]}))
