@@ -107,25 +107,37 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
                        for seed, judge in judges.items()}
             per_arm[str(epochs)] = {str(seed): future.result() for seed, future in futures.items()}
         arms[str(epochs)] = arm_summary(per_arm[str(epochs)])
-    first = arms[str(counts[0])]["summary"]["cvae_unseen"]
-    return {"data": args.data, "experiment_epochs": default, "samples": args.samples,
+    return {"experiment_epochs": default, **arms_record(args, per_arm, arms), "choice": choose_epochs(arms)}
+
+
+def arms_record(args: argparse.Namespace, per_arm: dict[str, Any], arms: dict[str, Any]) -> dict[str, Any]:
+    """What every arm suite on style_method's leave-one-style-out records beside its arms and its choice."""
+    first = next(iter(arms.values()))["summary"]["cvae_unseen"]
+    return {"data": args.data, "samples": args.samples,
             "narrowed": {"primitives": args.primitives, "styles": args.styles},
             "splits": {"choose": "the judges' evaluation.heldout_splits=[val]: real clips of the train and val "
                                  "splits; no test clip", "seeds": "training seeds, not reported seeds"},
             "per_arm": per_arm, "arms": arms,
-            "cvae_unseen_same_in_every_arm": all(a["summary"]["cvae_unseen"] == first for a in arms.values()),
-            "choice": choose_epochs(arms)}
+            "cvae_unseen_same_in_every_arm": all(a["summary"]["cvae_unseen"] == first for a in arms.values())}
 
 
-def render(record: dict[str, Any]) -> dict[str, str]:
-    r = record["results"]
-    choice, sd = r["choice"], contact_full.sd
+def arms_frame(r: dict[str, Any]) -> tuple[str, list[str], bool, str]:
+    """The label of an arm suite's blocks (synthetic, narrowed), its training seeds, whether it is full (not
+    narrowed, two seeds or more: its verdict applies) and what it says of the CVAE rows across arms."""
     label = "**Synthetic data: a smoke run of the suite, not evidence.** " if r["data"] == "synthetic" else ""
     narrowed = {k: v for k, v in r["narrowed"].items() if v}
     seeds = sorted({s for arm in r["per_arm"].values() for s in arm})
     if narrowed:
         label += "**Narrowed:** " + "; ".join(f"{k} {', '.join(v)}" for k, v in narrowed.items()) + ". "
-    full = not narrowed and len(seeds) >= 2
+    same = ("the CVAE rows are the same in every arm (shared trainings)" if r["cvae_unseen_same_in_every_arm"]
+            else "**the CVAE rows differ between arms**")
+    return label, seeds, not narrowed and len(seeds) >= 2, same
+
+
+def render(record: dict[str, Any]) -> dict[str, str]:
+    r = record["results"]
+    choice, sd = r["choice"], contact_full.sd
+    label, seeds, full, same = arms_frame(r)
     rows = []
     for epochs, arm in sorted(r["arms"].items(), key=lambda item: int(item[0])):
         s = arm["summary"]["zero_shot"]
@@ -142,8 +154,6 @@ def render(record: dict[str, Any]) -> dict[str, str]:
                f"{r['experiment_epochs']}), and at that count style_method's rule gives **method={method}**")
     if not full:
         verdict = f"{choice['epochs']} epochs and method={method} by the rule, **not applied**: a narrowed run"
-    same = ("the CVAE rows are the same in every arm (shared trainings)" if r["cvae_unseen_same_in_every_arm"]
-            else "**the CVAE rows differ between arms**")
     headline = (
         f"{label}The zero-shot network's epochs, on **validation** clips ({r['data']}, training seeds "
         f"{', '.join(seeds)}: not reported seeds): suite style_method's leave-one-style-out per arm, the autoencoders "

@@ -86,26 +86,14 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
                        for seed, judge in judges.items()}
             per_arm[arm_key(temperature)] = {str(seed): future.result() for seed, future in futures.items()}
         arms[arm_key(temperature)] = zero_shot_epochs.arm_summary(per_arm[arm_key(temperature)])
-    first = next(iter(arms.values()))["summary"]["cvae_unseen"]
-    return {"data": args.data, "epochs": epochs, "samples": args.samples,
-            "centred": bool(getattr(args, "centred", False)),
-            "narrowed": {"primitives": args.primitives, "styles": args.styles},
-            "splits": {"choose": "the judges' evaluation.heldout_splits=[val]: real clips of the train and val "
-                                 "splits; no test clip", "seeds": "training seeds, not reported seeds"},
-            "per_arm": per_arm, "arms": arms,
-            "cvae_unseen_same_in_every_arm": all(a["summary"]["cvae_unseen"] == first for a in arms.values()),
-            "choice": choose_temperature(arms)}
+    return {"epochs": epochs, "centred": bool(getattr(args, "centred", False)),
+            **zero_shot_epochs.arms_record(args, per_arm, arms), "choice": choose_temperature(arms)}
 
 
 def render(record: dict[str, Any]) -> dict[str, str]:
     r = record["results"]
     choice, sd = r["choice"], contact_full.sd
-    label = "**Synthetic data: a smoke run of the suite, not evidence.** " if r["data"] == "synthetic" else ""
-    narrowed = {k: v for k, v in r["narrowed"].items() if v}
-    seeds = sorted({s for arm in r["per_arm"].values() for s in arm})
-    if narrowed:
-        label += "**Narrowed:** " + "; ".join(f"{k} {', '.join(v)}" for k, v in narrowed.items()) + ". "
-    full = not narrowed and len(seeds) >= 2
+    label, seeds, full, same = zero_shot_epochs.arms_frame(r)
     order = sorted(r["arms"], key=float, reverse=True)
     rows = []
     for t in order:
@@ -128,8 +116,6 @@ def render(record: dict[str, Any]) -> dict[str, str]:
                    f"({choice['how']})")
     if not full:
         verdict = f"{choice['method']} at τ = {choice['temperature']:g} by the rule, **not applied**: a narrowed run"
-    same = ("the CVAE rows are the same in every arm (shared trainings)" if r["cvae_unseen_same_in_every_arm"]
-            else "**the CVAE rows differ between arms**")
     headline = (
         f"{label}The zero-shot network's sampling{how}, temperature τ, on **validation** clips ({r['data']}, "
         f"training seeds "
