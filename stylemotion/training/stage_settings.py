@@ -88,27 +88,31 @@ def changed_settings(now: Mapping[str, Any], recorded: Mapping[str, Any] | None,
     target = str(now.get("model._target_", ""))
     changes: list[str] = []
     for key, value in now.items():
-        if recorded is not None and key in recorded:
-            trained: tuple[bool, Any] = (True, recorded[key])
-        elif recorded is None and isinstance(value, str) and "${" in value:
-            continue  # an interpolation (e.g. ${data.fps}): its source is in the settings hash
-        elif key.startswith("model.") and key != "model._target_" and "." not in key[len("model."):]:
-            name = key[len("model."):]
-            if recorded is None and trained_hparams is not None and name in trained_hparams:
-                trained = (True, trained_hparams[name])
-            else:
-                trained = constructor_default(target, name)
-                if not trained[0] and recorded is None:
-                    continue  # not a constructor argument: the checkpoint cannot say
-        elif recorded is None:
-            continue  # an old record: only the model's keys can be checked
-        else:
-            trained = (False, None)
+        trained = _trained_value(key, value, recorded, trained_hparams, target)
+        if trained is None:
+            continue
         if not trained[0]:
             changes.append(f"{key} absent (now {_shown(value)})")
         elif not _same(trained[1], value):
             changes.append(f"{key}={_shown(trained[1])} (now {_shown(value)})")
     return changes
+
+
+def _trained_value(key: str, value: Any, recorded: Mapping[str, Any] | None,
+                   trained_hparams: Mapping[str, Any] | None, target: str) -> tuple[bool, Any] | None:
+    """What ``key`` was trained with, as ``(known, value)`` (see :func:`changed_settings`); None when nothing can
+    say (an old record: a key outside the model, an interpolation, or one the model class does not take)."""
+    if recorded is not None and key in recorded:
+        return True, recorded[key]
+    if recorded is None and isinstance(value, str) and "${" in value:
+        return None  # an interpolation (e.g. ${data.fps}): its source is in the settings hash
+    name = key[len("model."):]
+    if not (key.startswith("model.") and key != "model._target_" and "." not in name):
+        return None if recorded is None else (False, None)  # outside the model nothing says how it was trained
+    if recorded is None and trained_hparams is not None and name in trained_hparams:
+        return True, trained_hparams[name]
+    default = constructor_default(target, name)
+    return None if recorded is None and not default[0] else default
 
 
 def changes_line(changes: list[str]) -> str:
