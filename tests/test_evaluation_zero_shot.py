@@ -17,9 +17,11 @@ import torch
 from log_lines import logged_lines
 from omegaconf import OmegaConf
 from recognition_reference import example_gram, hand_share
+from reproduce_fixtures import copy_run, reproduce, tiny_overrides
 
 from stylemotion.cli.schemas import register_schemas
 from stylemotion.datasets import build_dataset
+from stylemotion.evaluation.metrics import foot_skating
 from stylemotion.evaluation.reference import primitive_data
 from stylemotion.evaluation.sources import MixedAutoencodersError
 from stylemotion.evaluation.zero_shot import (
@@ -286,6 +288,42 @@ def test_the_cvae_on_the_autoencoder_without_the_style_is_a_row_beside_the_netwo
     assert plain_row["table_5_1_row"] != arm_row["zero_shot"]["table_5_1_row"]
 
 
+@pytest.mark.slow  # a second report of the tiny run (every stage reused), two evaluations of one network
+def test_a_test_report_judges_against_the_styles_test_clips_and_every_row_measures_raw_skating(
+        tiny_run, leaky, tmp_path) -> None:
+    """``read_run(run, "report_test")``: the judge takes that report's settings (``heldout_splits=[test]``,
+    ``style_truth=heldout``), so the ``real`` row holds the style's test clips only; every row's raw foot skating is
+    the report's measure (:func:`foot_skating`) of exactly its motions: the samples drawn, the real clips (as the
+    test report measured them)."""
+    folder, _ = leaky
+    copy = copy_run(tiny_run, tmp_path / "run")
+    reproduce(tiny_overrides(copy) + ["report=report_test", "evaluation.heldout_splits=[test]",
+                                      "evaluation.style_truth=heldout"], [])
+    source, every = read_run(copy, "report_test"), read_run(copy)
+    assert source.report_name == "report_test" and list(source.settings.heldout_splits) == ["test"]
+    network = load_generative(model_folder(folder, PRIMITIVE, STYLE) / "checkpoints" / "best.ckpt")
+    row, all_clips = _evaluate(source, network), _evaluate(every, network)
+    length = load_generative(source.cvaes[(PRIMITIVE, STYLE)]).timeline_frames
+    data = primitive_data(build_dataset(source.data_cfg), PRIMITIVE, length, source.settings.neutral_style,
+                          asdict(source.settings.segment), source.data_cfg.get("split"))
+    skip = {(e["take"], e["start"]) for e in row["example"]}
+    test = [c for c in data.split("test", STYLE) if (c.take, c.start) not in skip]
+    assert 0 < row["real"]["clips"] == len(test) < all_clips["real"]["clips"]
+    # the style's real clips skate as the test report measured them for the CVAE of the style (the same clips)
+    report = json.loads((copy / "report_test" / "report.json").read_text())
+    assert row["real"]["foot_skating"] == report["foot_skating_detail"][PRIMITIVE][STYLE]["real"]
+    assert row["real"]["foot_skating"]["motions"] == len(test)
+    for kind in ("zero_shot", "cvae", "real"):
+        skating = row[kind]["foot_skating"]
+        assert 0 <= skating["skating_frames"] <= skating["contact_frames"] <= skating["foot_frames"], kind
+        assert skating["ratio"] == pytest.approx(skating["skating_frames"] / skating["contact_frames"]), kind
+    drawn = network.bind_example([data.find_example(e) for e in row["example"]]).sample(SAMPLES, seed=SEED)
+    hand = foot_skating(drawn.positions.numpy(), drawn.num_frames.numpy(), drawn.fps, data.rest_heights,
+                        data.stance_foot, source.settings.skate_speed_mps)
+    assert row["zero_shot"]["foot_skating"] == hand.as_dict() == all_clips["zero_shot"]["foot_skating"]
+    assert row["zero_shot"]["foot_skating"]["motions"] == SAMPLES
+
+
 def test_the_train_configs_leave_the_style_out_of_the_runs_data(run, tmp_path) -> None:
     source = read_run(run)
     cfg = train_config(source, PRIMITIVE, STYLE, tmp_path / "m", epochs=7, overrides=["model.style_weight=5"],
@@ -308,6 +346,10 @@ def test_the_train_configs_leave_the_style_out_of_the_runs_data(run, tmp_path) -
 def test_bad_runs_and_styles_are_refused(run, tmp_path) -> None:
     with pytest.raises(ZeroShotRunError, match="it has no reproduce.json"):
         read_run(tmp_path)
+    with pytest.raises(ZeroShotRunError, match=r"it has no report \(report_test/report.json\)"):
+        read_run(run, "report_test")
+    with pytest.raises(ZeroShotRunError, match=r"report='../report' is not the name of a report folder"):
+        read_run(run, "../report")
     with pytest.raises(ZeroShotRunError, match=r"has no CVAE of walk_leftStance for style\(s\) \['feminine'\]"):
         leave_one_style_out(run, tmp_path / "x", styles=["feminine"])
     assert not (tmp_path / "x").exists()

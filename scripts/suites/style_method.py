@@ -48,6 +48,10 @@ LABELS = {"zero_shot": "zero-shot network (method=zero_shot)",
           "cvae": "the judge's CVAE (its autoencoder saw the style; not ruled on)"}
 #: Variation shares of the samples over the style's real clips.
 VARIATION = ("v_sd", "step_sd", "diversity")
+#: Which report of the judge a leave-one-style-out reads (``report_on``): its folder, and the evaluation settings
+#: (``heldout_splits``, ``style_truth``) it must have been made with. ``val``: choices, reading no test clip; ``test``:
+#: figures reported after the choices, against each style's test clips only.
+JUDGE_REPORTS = {"val": ("report", ["val"], "all"), "test": ("report_test", ["test"], "heldout")}
 #: Mean capped log variations this close count as tied (as suite style_channels).
 TIE = 0.05
 AIM_RECOGNITION = 0.9
@@ -67,14 +71,18 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "stylemotion-style trains it)")
 
 
-def leave_one_out_arguments(parser: argparse.ArgumentParser) -> None:
-    """The options of the leave-one-style-out runs but the networks' epochs (suite zero_shot_epochs shares them)."""
+#: The default judge of each training seed: suite ``contact_template``'s ``off`` run of that seed.
+VAL_JUDGE = str(ROOT / "runs" / "benchmarks" / "contact_template" / "{data}" / "seed{seed}" / "off")
+
+
+def leave_one_out_arguments(parser: argparse.ArgumentParser, judge: str = VAL_JUDGE,
+                            judge_help: str = "the judge reproduction per seed ({data} and {seed} are filled in); "
+                                              "made here with evaluation.heldout_splits=[val] when missing") -> None:
+    """The options of the leave-one-style-out runs but the networks' epochs (suite zero_shot_epochs shares them);
+    ``judge``/``judge_help``: ``--judge``'s default and help."""
     parser.add_argument("--data", choices=sorted(DATA), default="bandai",
                         help="bandai: dataset-2 walks; synthetic: a smoke run of the suite only")
-    parser.add_argument("--judge", default=str(ROOT / "runs" / "benchmarks" / "contact_template" / "{data}" /
-                                               "seed{seed}" / "off"),
-                        help="the judge reproduction per seed ({data} and {seed} are filled in); made here with "
-                             "evaluation.heldout_splits=[val] when missing")
+    parser.add_argument("--judge", default=judge, help=judge_help)
     parser.add_argument("--runs", type=Path, default=ROOT / "runs" / "benchmarks" / "style_method",
                         help="folder of the leave-one-style-out trainings (reused and resumed)")
     parser.add_argument("--styles", nargs="+", default=None, help="left-out styles (default: the judge's CVAE styles)")
@@ -96,22 +104,33 @@ def judge_for(args: argparse.Namespace, seed: int) -> Path:
 
 
 def case_figures(row: dict[str, Any]) -> dict[str, dict[str, Any]]:
-    """Per method row of one left-out (primitive, style): recognition, own column, variation shares of real."""
+    """Per method row of one left-out (primitive, style): recognition, own column, variation shares of real, and
+    (rows that measured it) the samples' raw foot skating and its multiple of the style's real clips'."""
     real = row["real"]["variation"]
+    real_skating = (row["real"].get("foot_skating") or {}).get("ratio")
     out = {}
     for kind in (*METHODS, REFERENCE):
         r = row[kind]
         shares = {k: (r["variation"][k] / real[k] if real[k] else None) for k in VARIATION}
         out[kind] = {"recognition": r["recognition"], "own_column": bool(r["own_column_is_minimum"]), **shares}
+        if "foot_skating" in r:
+            skating = r["foot_skating"]["ratio"]
+            out[kind].update(skating=skating, skating_vs_real=skating / real_skating if real_skating else None)
+    if real_skating is not None:
+        out["real_skating"] = real_skating
     return out
 
 
 def summary(cases: list[dict[str, Any]]) -> dict[str, Any]:
-    """Over every case of one method."""
-    return {"cases": len(cases), "own_column": sum(c["own_column"] for c in cases),
-            "recognition": spread(c["recognition"] for c in cases),
-            **{k: spread(c[k] for c in cases) for k in VARIATION},
-            "capped_log_variation": mean_capped_log(cases, VARIATION)}
+    """Over every case of one method (the skating figures when every case has them)."""
+    out = {"cases": len(cases), "own_column": sum(c["own_column"] for c in cases),
+           "recognition": spread(c["recognition"] for c in cases),
+           **{k: spread(c[k] for c in cases) for k in VARIATION},
+           "capped_log_variation": mean_capped_log(cases, VARIATION)}
+    if cases and all("skating" in c for c in cases):
+        out.update(skating=spread(c["skating"] for c in cases),
+                   skating_vs_real=spread(c["skating_vs_real"] for c in cases))
+    return out
 
 
 def method_summaries(per_seed: dict[str, Any]) -> dict[str, dict[str, Any]]:
@@ -138,20 +157,27 @@ def seed_record(args: argparse.Namespace, seed: int, judge: Path) -> dict[str, A
     from stylemotion.evaluation.zero_shot import ZeroShotRunError, leave_one_style_out, read_run
 
     torch.set_num_threads(1)
-    source = read_run(judge)
-    if list(source.settings.heldout_splits) != ["val"]:
-        raise ZeroShotRunError(f"judge {judge} was evaluated on {list(source.settings.heldout_splits)}, not "
-                               "[val]: the choice must not read test clips")
+    report_on = getattr(args, "report_on", "val")
+    report, splits, truth = JUDGE_REPORTS[report_on]
+    source = read_run(judge, report)
+    if list(source.settings.heldout_splits) != splits or source.settings.style_truth != truth:
+        raise ZeroShotRunError(f"judge {judge}'s {report} was evaluated on {list(source.settings.heldout_splits)} "
+                               f"with style_truth={source.settings.style_truth}, not {splits} with {truth}: "
+                               + ("the choice must not read test clips" if report_on == "val" else
+                                  "test figures must read test clips only"))
     # Autoencoders and CVAEs in seed<k>/, shared by every epoch count of the networks (seed<k>_e<epochs>/), and
-    # those networks by every way of sampling them (the evaluation of one in seed<k>[_e<epochs>]_t<τ>[_centred]/).
+    # those networks by every way of sampling them (the evaluation of one in seed<k>[_e<epochs>]_t<τ>[_centred]/,
+    # with ``_test`` appended when it is judged on test clips).
     stages = args.runs / args.data / f"seed{seed}"
     networks = stages if args.epochs is None else stages.with_name(f"seed{seed}_e{args.epochs}")
     temperature, centred = getattr(args, "temperature", None), getattr(args, "centred", None) or None
     out = networks if temperature is None and not centred else networks.with_name(
         f"{networks.name}_t{1.0 if temperature is None else temperature:g}{'_centred' if centred else ''}")
+    if report_on != "val":
+        out = out.with_name(f"{out.name}_{report_on}")
     result = leave_one_style_out(judge, out, args.styles, args.primitives, args.epochs, args.samples, seed,
                                  threads=1, resume=True, cvae_unseen=True, stages=stages, networks=networks,
-                                 temperature=temperature, centred=centred)
+                                 temperature=temperature, centred=centred, report=report)
     cases = {f"{p}/{s}": case_figures(row) for p, res in result["primitives"].items()
              for s, row in res["styles"].items()}
     minutes = {f"{p}/{s}": {

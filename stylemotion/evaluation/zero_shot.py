@@ -50,7 +50,7 @@ import shutil
 import time
 from collections.abc import Iterator, Mapping, Sequence
 from contextlib import contextmanager
-from dataclasses import asdict
+from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
 
@@ -59,7 +59,7 @@ from omegaconf import DictConfig, OmegaConf, open_dict
 
 from stylemotion.config import config_dir, positive_int, set_torch_threads
 from stylemotion.datasets import TakeSet, build_dataset
-from stylemotion.evaluation.metrics import diversity
+from stylemotion.evaluation.metrics import diversity, foot_skating
 from stylemotion.evaluation.pipeline import example_column_gram, real_side, recognition
 from stylemotion.evaluation.settings import EvalSettings
 from stylemotion.evaluation.sources import MixedAutoencodersError, check_one_autoencoder
@@ -97,9 +97,13 @@ class ZeroShotRunError(UserInputError, ValueError):
 # -- the reproduce run
 
 
+@dataclass
 class ReproduceRun(FinishedRun):
     """What the evaluation reads of a finished ``stylemotion-reproduce`` run (see :func:`read_run` and
-    :class:`stylemotion.training.run_folder.FinishedRun`): its CVAEs by primitive and style."""
+    :class:`stylemotion.training.run_folder.FinishedRun`): its CVAEs by primitive and style, and the name of the
+    report whose settings it carries (``report_name``)."""
+
+    report_name: str = "report"
 
     @property
     def cvaes(self) -> dict[tuple[str, str], Path]:
@@ -117,20 +121,26 @@ class ReproduceRun(FinishedRun):
         return [s for p, s in self.cvaes if p == primitive]
 
 
-def read_run(folder: str | Path) -> ReproduceRun:
-    """The finished reproduce run in ``folder``.
+def read_run(folder: str | Path, report: str = "report") -> ReproduceRun:
+    """The finished reproduce run in ``folder``, with the evaluation settings of its report ``report`` (the run's
+    own, or a second report ``stylemotion-reproduce ... report=<name>`` made, e.g. ``report_test``: the
+    leave-one-style-out then reads the held-out splits and ground truth that report was made with).
 
     Raises:
         ZeroShotRunError: no such folder, no ``reproduce.json`` or report, no autoencoder or CVAE stage, or
             a stage checkpoint that is gone (each message says which).
     """
     folder = Path(folder).expanduser()
-    summary_path, report_path = folder / "reproduce.json", folder / "report" / "report.json"
-    for path, what in ((summary_path, "reproduce.json"), (report_path, "report (report/report.json)")):
+    name = str(report)
+    if not name or name != safe_name(name, "report"):
+        raise ZeroShotRunError(f"report={report!r} is not the name of a report folder in the run (e.g. report, "
+                               "report_test)")
+    summary_path, report_path = folder / "reproduce.json", folder / name / "report.json"
+    for path, what in ((summary_path, "reproduce.json"), (report_path, f"report ({name}/report.json)")):
         if not path.is_file():
             raise ZeroShotRunError(f"run={folder} is not a finished stylemotion-reproduce run: it has no {what}")
     run = ReproduceRun(folder, read_json_object(summary_path, "summary", ZeroShotRunError),
-                       read_json_object(report_path, "report", ZeroShotRunError))
+                       read_json_object(report_path, "report", ZeroShotRunError), name)
     if not run.meta.get("data"):
         raise ZeroShotRunError(f"run={folder}: {report_path} records no data config (meta.data)")
     if not run.stages("autoencoder") or not run.stages("cvae"):
@@ -316,6 +326,14 @@ def _table_row(autoencoder, frames, style: str, columns: list[str], grams: torch
             "pose_across_sd": across_sample_sd(frames.numpy())}
 
 
+def _skating(real, motions, settings: EvalSettings) -> dict[str, float | int]:
+    """Raw foot skating of motions (:func:`~stylemotion.primitives.skating.foot_skating`: the share of contact
+    foot-frames whose planted point moves faster than ``settings.skate_speed_mps``), as the report measures it."""
+    data = real.data
+    return foot_skating(motions.positions.numpy(), motions.num_frames.numpy(), motions.fps, data.rest_heights,
+                        data.stance_foot, settings.skate_speed_mps).as_dict()
+
+
 def _variation(real, motions, settings: EvalSettings) -> dict[str, float]:
     """pose_SD (cm), V_SD, step_SD (cm) (:func:`~stylemotion.evaluation.tables.variance_stats`) and diversity (mean
     pairwise distance in the classifier's features, :func:`~stylemotion.evaluation.metrics.diversity`) of motions."""
@@ -331,7 +349,8 @@ def _model_row(real, autoencoder, model: EvalModel, columns: list[str], grams: t
     judged = recognition(real, model, real.features(drawn), real.features(real.truth[model.style]))
     return {"checkpoint": model.checkpoint, "recognition": judged.share, "predicted": judged.predicted,
             **_table_row(autoencoder, drawn.normalized_frames, model.style, columns, grams, settings),
-            "variation": _variation(real, drawn, settings), "samples": int(samples)}
+            "variation": _variation(real, drawn, settings), "foot_skating": _skating(real, drawn, settings),
+            "samples": int(samples)}
 
 
 def _real_row(real, autoencoder, style: str, columns: list[str], grams: torch.Tensor,
@@ -341,7 +360,8 @@ def _real_row(real, autoencoder, style: str, columns: list[str], grams: torch.Te
     predicted = real.classifier.predict_features(real.features(truth))
     return {"recognition": float((predicted == style).mean()),
             **_table_row(autoencoder, truth.normalized_frames, style, columns, grams, settings),
-            "variation": _variation(real, truth, settings), "clips": len(truth)}
+            "variation": _variation(real, truth, settings), "foot_skating": _skating(real, truth, settings),
+            "clips": len(truth)}
 
 
 @torch.no_grad()
@@ -468,8 +488,17 @@ def splits_record(source: ReproduceRun, shared_autoencoder: bool) -> dict[str, A
         "condition": "the example clip(s) of the run's CVAE of the left-out style",
         "cvae": "the run's CVAE of the style: its neutral train clips plus the style's example clip (supervised "
                 "baseline; the run's autoencoder)",
-        "real": "the left-out style's clips of every split but its example",
+        "real": real_clips(source.settings),
+        "report": source.report_name,
     }
+
+
+def real_clips(settings: EvalSettings) -> str:
+    """Which clips of a left-out style its ``real`` row (the variation's and skating's reference) holds."""
+    if settings.style_truth == "heldout":
+        return (f"the left-out style's clips of the {' and '.join(settings.heldout_splits)} split(s) only, but its "
+                "example")
+    return "the left-out style's clips of every split but its example"
 
 
 def leave_one_style_out(run: str | Path, out: str | Path, styles: Sequence[str] | None = None,
@@ -478,11 +507,14 @@ def leave_one_style_out(run: str | Path, out: str | Path, styles: Sequence[str] 
                         force: bool = False, resume: bool = False, shared_autoencoder: bool = False,
                         cvae_unseen: bool = False, stages: str | Path | None = None,
                         networks: str | Path | None = None, temperature: float | None = None,
-                        centred: bool | None = None) -> dict[str, Any]:
+                        centred: bool | None = None, report: str = "report") -> dict[str, Any]:
     """The leave-one-style-out evaluation (see the module doc); returns what ``zero_shot.json`` holds.
 
     Args:
         run: a finished ``stylemotion-reproduce`` run folder (the judge and the CVAE baseline).
+        report: the run's report whose evaluation settings the judge takes (:func:`read_run`): ``report``, or a
+            second report such as ``report_test`` (``evaluation.heldout_splits=[test]
+            evaluation.style_truth=heldout``: the real clips and the classifier's held-out clips are test clips).
         out: the output folder (must not exist unless ``force``, which replaces it, or ``resume``).
         styles: left-out styles (default: every CVAE style of the run).
         primitives: default every primitive with CVAEs.
@@ -525,7 +557,7 @@ def leave_one_style_out(run: str | Path, out: str | Path, styles: Sequence[str] 
             raise ZeroShotRunError(f"{name}={folder} is a file, not a folder of trainings")
     if temperature is not None:
         temperature = checked_temperature(temperature)
-    source = read_run(run)
+    source = read_run(run, report)
     samples = positive_int(samples, "samples")
     seed = source.seed if seed is None else int(seed)
     set_torch_threads(threads)
@@ -588,7 +620,7 @@ def leave_one_style_out(run: str | Path, out: str | Path, styles: Sequence[str] 
                         "leaky": LEAKY if shared_autoencoder else False, "cvae_unseen": bool(unseen),
                         "autoencoders": "shared (the run's)" if shared_autoencoder else "one per left-out style",
                         "stages": str(stages.resolve()), "networks": str(networks_out.resolve()),
-                        "temperature": temperature, "centred": centred,
+                        "temperature": temperature, "centred": centred, "report": source.report_name,
                         "judge_autoencoder": judge_info,
                         "settings": asdict(source.settings), **provenance(),
                         "seconds": time.perf_counter() - started}}
