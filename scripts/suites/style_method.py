@@ -165,19 +165,23 @@ def seed_record(args: argparse.Namespace, seed: int, judge: Path) -> dict[str, A
                                f"with style_truth={source.settings.style_truth}, not {splits} with {truth}: "
                                + ("the choice must not read test clips" if report_on == "val" else
                                   "test figures must read test clips only"))
-    # Autoencoders and CVAEs in seed<k>/, shared by every epoch count of the networks (seed<k>_e<epochs>/), and
-    # those networks by every way of sampling them (the evaluation of one in seed<k>[_e<epochs>]_t<τ>[_centred]/,
-    # with ``_test`` appended when it is judged on test clips).
+    # Autoencoders and CVAEs in seed<k>/, shared by every epoch count and training override of the networks
+    # (seed<k>_e<epochs>[<networks_tag>]/), and those networks by every way of sampling them (the evaluation of one in
+    # seed<k>[_e<epochs>][<networks_tag>]_t<τ>[_centred]/, with ``_test`` appended when it is judged on test clips).
+    network_overrides, tag = list(getattr(args, "network_overrides", None) or []), getattr(args, "networks_tag", "")
+    if bool(network_overrides) != bool(tag):
+        raise ValueError("network_overrides and networks_tag go together: other networks need a folder of their own")
     stages = args.runs / args.data / f"seed{seed}"
-    networks = stages if args.epochs is None else stages.with_name(f"seed{seed}_e{args.epochs}")
+    networks = stages if args.epochs is None and not tag else stages.with_name(
+        f"seed{seed}{f'_e{args.epochs}' if args.epochs is not None else ''}{tag}")
     temperature, centred = getattr(args, "temperature", None), getattr(args, "centred", None) or None
     out = networks if temperature is None and not centred else networks.with_name(
         f"{networks.name}_t{1.0 if temperature is None else temperature:g}{'_centred' if centred else ''}")
     if report_on != "val":
         out = out.with_name(f"{out.name}_{report_on}")
     result = leave_one_style_out(judge, out, args.styles, args.primitives, args.epochs, args.samples, seed,
-                                 threads=1, resume=True, cvae_unseen=True, stages=stages, networks=networks,
-                                 temperature=temperature, centred=centred, report=report)
+                                 overrides=network_overrides, threads=1, resume=True, cvae_unseen=True, stages=stages,
+                                 networks=networks, temperature=temperature, centred=centred, report=report)
     cases = {f"{p}/{s}": case_figures(row) for p, res in result["primitives"].items()
              for s, row in res["styles"].items()}
     minutes = {f"{p}/{s}": {
