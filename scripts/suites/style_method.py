@@ -150,6 +150,13 @@ def choose(summaries: dict[str, dict[str, Any]]) -> dict[str, Any]:
             "default": "zero_shot" if all(tests.values()) else "cvae"}
 
 
+def contact_networks(weight: float) -> tuple[list[str], str]:
+    """The networks' training override for foot-contact loss weight ``weight`` and their folder's tag (``""`` for 0:
+    the networks every earlier suite trained, in ``seed<k>_e<epochs>/``; ``_contact<w>`` else), so one folder always
+    holds networks of one weight, whatever the configs' default."""
+    return [f"model.contact_weight={weight:g}"], (f"_contact{weight:g}" if weight else "")
+
+
 def seed_record(args: argparse.Namespace, seed: int, judge: Path) -> dict[str, Any]:
     """One training seed's leave-one-style-out on ``judge`` (one torch thread): its cases, minutes and splits."""
     import torch
@@ -169,8 +176,6 @@ def seed_record(args: argparse.Namespace, seed: int, judge: Path) -> dict[str, A
     # (seed<k>_e<epochs>[<networks_tag>]/), and those networks by every way of sampling them (the evaluation of one in
     # seed<k>[_e<epochs>][<networks_tag>]_t<τ>[_centred]/, with ``_test`` appended when it is judged on test clips).
     network_overrides, tag = list(getattr(args, "network_overrides", None) or []), getattr(args, "networks_tag", "")
-    if bool(network_overrides) != bool(tag):
-        raise ValueError("network_overrides and networks_tag go together: other networks need a folder of their own")
     stages = args.runs / args.data / f"seed{seed}"
     networks = stages if args.epochs is None and not tag else stages.with_name(
         f"seed{seed}{f'_e{args.epochs}' if args.epochs is not None else ''}{tag}")

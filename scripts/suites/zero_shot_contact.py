@@ -57,8 +57,7 @@ def arm_args(args: argparse.Namespace, weight: float, epochs: int) -> argparse.N
     sample = zero_shot_test.sampling()
     out = copy.copy(args)
     out.epochs, out.temperature, out.centred = epochs, sample["sample_temperature"], sample["sample_centred"]
-    out.network_overrides = [f"model.contact_weight={weight:g}"] if weight else []
-    out.networks_tag = f"_contact{weight:g}" if weight else ""
+    out.network_overrides, out.networks_tag = style_method.contact_networks(weight)
     return out
 
 

@@ -8,9 +8,10 @@ The defaults were chosen on validation clips (suites ``style_method``, ``zero_sh
 ``zero_shot_temperature``, ``zero_shot_centred``: training seeds 100 and 101). This suite chooses nothing. Per
 training seed ``k`` it runs ``style_method``'s leave-one-style-out (:func:`suites.style_method.seed_record`) with the
 same trainings where they exist (``runs/benchmarks/style_method/<data>/seed<k>/``: the autoencoders without each
-style and the CVAEs on them, today's CVAE defaults; ``seed<k>_e<epochs>/``: the networks of the experiment's epoch
-count) and trains them where they do not (seed 102), and samples each network as ``stylemotion-style`` does today
-(``sampling_defaults``). Its evaluation goes to ``seed<k>_e<epochs>_t<τ>[_centred]_test/``.
+style and the CVAEs on them, today's CVAE defaults; ``seed<k>_e<epochs>[_contact<w>]/``: the networks of the
+experiment's epoch count and today's foot-contact loss weight ``w``) and trains them where they do not (seed 102), and
+samples each network as ``stylemotion-style`` does today (``sampling_defaults``). Its evaluation goes to
+``seed<k>_e<epochs>[_contact<w>]_t<τ>[_centred]_test/``.
 
 The judge of training seed ``k`` is a finished reproduction with a test report (``--judge``, default suite
 ``style_bandai``'s run of judge seed ``j``, paired in order with the training seeds by ``--judge-seeds``; its test
@@ -83,6 +84,15 @@ def sampling() -> dict[str, Any]:
     return sampling_defaults()
 
 
+def contact_weight() -> float:
+    """The networks' foot-contact loss weight today (``contact_weight`` of configs/model/zero_shot.yaml)."""
+    from omegaconf import OmegaConf
+
+    from stylemotion.config import config_dir
+
+    return float(OmegaConf.load(Path(config_dir()) / "model" / "zero_shot.yaml").contact_weight)
+
+
 def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
     from concurrent.futures import ProcessPoolExecutor
     from multiprocessing import get_context
@@ -93,8 +103,10 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
     seed_args.epochs = args.epochs or style_method.experiment_epochs()
     seed_args.temperature, seed_args.centred = sample["sample_temperature"], sample["sample_centred"]
     seed_args.report_on = "test"
+    seed_args.network_overrides, seed_args.networks_tag = style_method.contact_networks(contact_weight())
     # Seeds in parallel, one torch thread each; seeds without trained networks first (they take longest).
-    trained = {seed: (args.runs / args.data / f"seed{seed}_e{seed_args.epochs}").is_dir() for seed in seeds}
+    trained = {seed: (args.runs / args.data / f"seed{seed}_e{seed_args.epochs}{seed_args.networks_tag}").is_dir()
+               for seed in seeds}
     processes = max(1, min(args.workers, len(seeds)))
     with ProcessPoolExecutor(max_workers=processes, mp_context=get_context("spawn")) as pool:
         futures = {seed: pool.submit(style_method.seed_record, seed_args, seed, by_seed[seed])
@@ -102,7 +114,8 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
         done = {seed: future.result() for seed, future in futures.items()}
     per_seed: dict[str, Any] = {str(seed): done[seed] for seed in seeds}
     summaries = style_method.method_summaries(per_seed)
-    return {"data": args.data, "epochs": seed_args.epochs, "sampling": sample, "samples": args.samples,
+    return {"data": args.data, "epochs": seed_args.epochs, "sampling": sample,
+            "contact_weight": contact_weight(), "samples": args.samples,
             "narrowed": {"primitives": args.primitives, "styles": args.styles},
             "judges": {str(seed): str(judge.relative_to(ROOT)) if judge.is_relative_to(ROOT) else str(judge)
                        for seed, judge in by_seed.items()},
@@ -169,6 +182,8 @@ def render(record: dict[str, Any]) -> dict[str, str]:
                      f"{a['recognition_styles']}/{a['styles']}", *(sd(s[k]) for k in style_method.VARIATION),
                      sd(s.get("skating", {}), 3), sd(s.get("skating_vs_real", {}), 1),
                      f"{a['skating']}/{a['cases']}"])
+    contact = ("" if r.get("contact_weight") is None else
+               f" trained with foot-contact loss weight {r['contact_weight']:g}")
     rule = r["rule_on_test"]
     failed = ", ".join(k for k, ok in rule["tests"].items() if not ok) or "none"
     check = (f"On these test figures style_method's rule would give **{rule['default']}** (tests failed: {failed}); "
@@ -176,7 +191,7 @@ def render(record: dict[str, Any]) -> dict[str, str]:
     judges = ", ".join(f"seed {k} → `{v}`" for k, v in r["judges"].items())
     headline = (
         f"{label}A style the autoencoder never saw, judged on **test** clips only ({r['data']}, training seeds "
-        f"{', '.join(seeds)}; networks of {r['epochs']} epochs, {how}; {r['samples']:,} samples per model and seed): "
+        f"{', '.join(seeds)}; networks of {r['epochs']} epochs{contact}, {how}; {r['samples']:,} samples per model and seed): "
         f"per left-out style an autoencoder without it and on it the zero-shot network and the CVAE as "
         f"stylemotion-style trains them; each training seed judged by a reproduction's test report ({judges}). "
         f"Recognition: share of samples the judge's classifier (fitted on train clips) gives the style; own column: "

@@ -9,8 +9,6 @@ import argparse
 import sys
 from pathlib import Path
 
-import pytest
-
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "scripts"))
 
@@ -48,22 +46,12 @@ def test_the_arm_with_the_lowest_skating_that_keeps_style_and_variation_wins() -
     assert chosen["why"] == {"10": "fails skating", "100": "fails recognition", "1000": "fails variation"}
 
 
-def test_each_arm_trains_its_networks_in_a_folder_of_its_own_and_samples_as_today(monkeypatch) -> None:
-    from types import SimpleNamespace
-
-    from stylemotion.evaluation import zero_shot as library
-
+def test_each_arm_trains_its_networks_in_a_folder_of_its_own_and_samples_as_today() -> None:
     args = argparse.Namespace(data="bandai", runs=Path("r"))
     off, on = zero_shot_contact.arm_args(args, 0.0, 10), zero_shot_contact.arm_args(args, 100.0, 10)
-    assert off.network_overrides == [] and off.networks_tag == "" and off.epochs == 10 and off.centred
+    assert off.networks_tag == "" and off.epochs == 10 and off.centred
     assert on.network_overrides == ["model.contact_weight=100"] and on.networks_tag == "_contact100"
-    # networks trained with an override never go into the configs' networks' folder (refused before any work)
-    source = SimpleNamespace(settings=SimpleNamespace(heldout_splits=["val"], style_truth="all"))
-    monkeypatch.setattr(library, "read_run", lambda folder, report: source)
-    untagged = argparse.Namespace(network_overrides=["model.contact_weight=100"], runs=Path("r"), data="bandai",
-                                  epochs=10)
-    with pytest.raises(ValueError, match="go together"):
-        style_method.seed_record(untagged, 100, Path("judge"))
+    assert off.network_overrides == ["model.contact_weight=0"]  # the folder holds weight 0 whatever the default
 
 
 def test_the_blocks_state_the_verdict_the_skating_and_why_each_arm_failed() -> None:

@@ -68,7 +68,7 @@ def test_the_aims_count_styles_by_their_mean_recognition_and_unmeasured_cases_as
 def record(seeds: dict) -> dict:
     summaries = style_method.method_summaries(seeds)
     results = {"data": "bandai", "epochs": 10, "samples": 100,
-               "sampling": {"sample_temperature": 1.0, "sample_centred": True},
+               "sampling": {"sample_temperature": 1.0, "sample_centred": True}, "contact_weight": 100.0,
                "narrowed": {"primitives": None, "styles": None},
                "judges": {k: f"runs/benchmarks/style/bandai/full/seed{i}" for i, k in enumerate(seeds)},
                "per_seed": seeds, "summary": summaries, "aims": zero_shot_test.aims(seeds),
@@ -82,7 +82,8 @@ def test_the_blocks_state_test_clips_the_aims_and_what_the_rule_would_give_witho
     blocks = zero_shot_test.render(record(per_seed()))
     headline = blocks["headline"]
     assert "judged on **test** clips only" in headline and "**2 training seeds only (fewer than 3).**" in headline
-    assert "sampled at τ = 1 with the variation centred on the example" in headline
+    assert "networks of 10 epochs trained with foot-contact loss weight 100, sampled at τ = 1 with the variation " \
+           "centred on the example" in headline
     assert "seed 100 → `runs/benchmarks/style/bandai/full/seed0`" in headline
     assert "it chooses nothing here" in headline
     line = next(x for x in headline.splitlines() if x.startswith("| zero-shot network"))
