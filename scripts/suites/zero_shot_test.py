@@ -191,7 +191,8 @@ def render(record: dict[str, Any]) -> dict[str, str]:
     judges = ", ".join(f"seed {k} → `{v}`" for k, v in r["judges"].items())
     headline = (
         f"{label}A style the autoencoder never saw, judged on **test** clips only ({r['data']}, training seeds "
-        f"{', '.join(seeds)}; networks of {r['epochs']} epochs{contact}, {how}; {r['samples']:,} samples per model and seed): "
+        f"{', '.join(seeds)}; networks of {r['epochs']} epochs{contact}, {how}; {r['samples']:,} samples per model "
+        f"and seed): "
         f"per left-out style an autoencoder without it and on it the zero-shot network and the CVAE as "
         f"stylemotion-style trains them; each training seed judged by a reproduction's test report ({judges}). "
         f"Recognition: share of samples the judge's classifier (fitted on train clips) gives the style; own column: "
