@@ -40,6 +40,7 @@ from stylemotion.evaluation.zero_shot import (
 from stylemotion.io.outputs import OutputExistsError
 from stylemotion.models.checkpoints import fingerprint, load_autoencoder
 from stylemotion.models.loading import load_generative, load_model
+from stylemotion.models.sampling import decode_features
 from stylemotion.primitives.segmentation import time_normalize
 
 register_schemas()  # the configs composed here take structured schemas (stylemotion.cli.schemas)
@@ -322,6 +323,13 @@ def test_a_test_report_judges_against_the_styles_test_clips_and_every_row_measur
                         data.stance_foot, source.settings.skate_speed_mps)
     assert row["zero_shot"]["foot_skating"] == hand.as_dict() == all_clips["zero_shot"]["foot_skating"]
     assert row["zero_shot"]["foot_skating"]["motions"] == SAMPLES
+    # the real clips through the generator's autoencoder (the leaky network's: the run's), at their durations
+    features = network.autoencoder.encode(torch.from_numpy(np.stack([time_normalize(c.frames, length) for c in test])))
+    rebuilt = decode_features(network.autoencoder, features, torch.tensor([c.duration_s for c in test]), length,
+                              data.fps)
+    hand = foot_skating(rebuilt.positions.numpy(), rebuilt.num_frames.numpy(), data.fps, data.rest_heights,
+                        data.stance_foot, source.settings.skate_speed_mps)
+    assert row["reconstructed"]["foot_skating"] == hand.as_dict()
 
 
 def test_the_train_configs_leave_the_style_out_of_the_runs_data(run, tmp_path) -> None:

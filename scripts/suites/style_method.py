@@ -118,7 +118,20 @@ def case_figures(row: dict[str, Any]) -> dict[str, dict[str, Any]]:
             out[kind].update(skating=skating, skating_vs_real=skating / real_skating if real_skating else None)
     if real_skating is not None:
         out["real_skating"] = real_skating
+    rebuilt = (row.get("reconstructed") or {}).get("foot_skating")
+    if rebuilt is not None and real_skating:
+        out["reconstructed_skating_vs_real"] = rebuilt["ratio"] / real_skating
     return out
+
+
+def reconstruction_skating(cases: list[dict[str, Any]]) -> str:
+    """A sentence on the raw skating of the style's real clips encoded and decoded by the autoencoder without the
+    style (what any model decoding through it starts from), × the real clips'; empty when no case measured it."""
+    rebuilt = spread(c.get("reconstructed_skating_vs_real") for c in cases)
+    if not rebuilt.get("n"):
+        return ""
+    return (f" The style's real clips encoded and decoded by the autoencoder without the style (no model; their own "
+            f"durations) skate {contact_full.sd(rebuilt, 1)}× the real clips' (over {rebuilt['n']} cases).")
 
 
 def summary(cases: list[dict[str, Any]]) -> dict[str, Any]:

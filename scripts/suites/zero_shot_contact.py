@@ -126,13 +126,15 @@ def render(record: dict[str, Any]) -> dict[str, str]:
     sample = r["sampling"]
     real = spread(c["real_skating"] for seed in r["per_arm"][order[0]].values() for c in seed["cases"].values()
                   if c.get("real_skating") is not None)
+    rebuilt = style_method.reconstruction_skating(
+        [c for seed in r["per_arm"][order[0]].values() for c in seed["cases"].values()])
     headline = (
         f"{label}The zero-shot network's foot-contact velocity loss on **validation** clips ({r['data']}, training "
         f"seeds {', '.join(seeds)}: not reported seeds; networks of {r['epochs']} epochs, sampled at τ = "
         f"{sample['sample_temperature']:g}{', centred' if sample['sample_centred'] else ''}): suite style_method's "
         f"leave-one-style-out per arm, the autoencoders without each style and the CVAEs on them shared; {same}. "
         f"Skating: share of contact foot-frames sliding > 0.2 m/s in raw samples, and its multiple of the style's "
-        f"real clips' (train + val clips but the example; they skate {sd(real, 3)}). Other figures as in "
+        f"real clips' (train + val clips but the example; they skate {sd(real, 3)}).{rebuilt} Other figures as in "
         f"style_method's block. Rule: skating ÷ real ≥ {GAIN:g} below weight 0's, style_method's own-column and "
         f"recognition tests, variation within {style_method.TIE:g} of weight 0's. Verdict: {verdict}.\n\n"
         + md_table(["model", "own column", "recognition", "V_SD / style", "step_SD / style", "diversity / style",

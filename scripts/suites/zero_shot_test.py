@@ -225,5 +225,6 @@ def render_styles(r: dict[str, Any]) -> str:
     real = spread(c["real_skating"] for group in per_style(r["per_seed"]).values() for c in group
                   if c.get("real_skating") is not None)
     note = (f" The style's test clips skate {sd(real, 3)} of contact foot-frames." if real.get("n") else "")
+    note += style_method.reconstruction_skating([c for group in per_style(r["per_seed"]).values() for c in group])
     return ("Per left-out style, mean ± sd (min–max) over training seeds and primitives (same runs as above; test "
             f"clips only).{note}\n\n" + md_table(["style", *header], rows))

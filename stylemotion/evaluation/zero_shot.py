@@ -71,6 +71,7 @@ from stylemotion.io.jsonfile import write_json
 from stylemotion.io.outputs import check_new_output, inside, safe_name
 from stylemotion.models.checkpoints import fingerprint, load_autoencoder, read_checkpoint
 from stylemotion.models.loading import NEUTRAL, EvalModel, load_generative, load_model, zero_shot_model
+from stylemotion.models.sampling import decode_features
 from stylemotion.models.zero_shot import ZeroShotStyleVAE, checked_temperature
 from stylemotion.primitives.segmentation import parse_primitive
 from stylemotion.provenance import provenance
@@ -368,12 +369,16 @@ def _real_row(real, autoencoder, style: str, columns: list[str], grams: torch.Te
 def _reconstructed_row(real, autoencoder, generator_ae, style: str, columns: list[str], grams: torch.Tensor,
                        settings: EvalSettings) -> dict[str, Any]:
     """The figures of the style's real clips (those of :func:`_real_row`) encoded and decoded by the generator's
-    autoencoder ``generator_ae``, measured by the judge: what its feature space keeps of the style."""
+    autoencoder ``generator_ae``, measured by the judge: what its feature space keeps of the style, and their raw
+    foot skating at their recorded durations (what a model decoding through it starts from)."""
     truth = real.truth[style]
-    frames = generator_ae(truth.normalized_frames.float())  # (n, T, 66) frames on the canonical timeline
+    features = generator_ae.encode(truth.normalized_frames.float())
+    rebuilt = decode_features(generator_ae, features, truth.duration_s, real.length, truth.fps)
+    frames = rebuilt.normalized_frames  # (n, T, 66) frames on the canonical timeline
     predicted = real.classifier.predict(frames.numpy(), truth.duration_s.numpy())
     return {"recognition": float((predicted == style).mean()),
-            **_table_row(autoencoder, frames, style, columns, grams, settings), "clips": len(truth)}
+            **_table_row(autoencoder, frames, style, columns, grams, settings),
+            "foot_skating": _skating(real, rebuilt, settings), "clips": len(truth)}
 
 
 def generator_autoencoder(network: ZeroShotStyleVAE) -> dict[str, Any]:
