@@ -332,6 +332,42 @@ def test_a_test_report_judges_against_the_styles_test_clips_and_every_row_measur
     assert row["reconstructed"]["foot_skating"] == hand.as_dict()
 
 
+@pytest.mark.slow  # an autoencoder and a network trained without elderly and youthful, one evaluation: ~20 s
+def test_a_group_left_out_together_trains_one_generator_that_never_saw_any_of_its_styles(run, tmp_path) -> None:
+    """``groups`` (e.g. an actor's styles): one autoencoder and one network per primitive without every style of the
+    group, serving each of its styles; each row judged against its own style's clips and example."""
+    group = ["youthful", "elderly"]
+    out = tmp_path / "loso"
+    with logged_lines("stylemotion.evaluation.zero_shot") as lines:
+        results = leave_one_style_out(run, out, group, [PRIMITIVE], epochs=2, samples=SAMPLES, seed=SEED,
+                                      overrides=NETWORK, threads=1, groups={s: group for s in group})
+    assert sum(line.endswith(": training") for line in lines) == 2  # one autoencoder, one network
+    rows = results["primitives"][PRIMITIVE]["styles"]
+    assert set(rows) == {"elderly", "youthful"} and results["meta"]["left_out_groups"] == {
+        "elderly": ["elderly", "youthful"], "youthful": ["elderly", "youthful"]}
+    ae_ckpt = Path(rows["elderly"]["generator_autoencoder"]["path"])
+    assert ae_ckpt.is_relative_to(autoencoder_folder(out, group)) and autoencoder_folder(out, group).name == \
+        "without_elderly+youthful"
+    assert sorted(autoencoder_excluded_styles(ae_ckpt)) == ["elderly", "youthful"]
+    assert rows["youthful"]["generator_autoencoder"]["path"] == str(ae_ckpt)
+    network = load_generative(model_folder(out, PRIMITIVE, group) / "checkpoints" / "best.ckpt")
+    assert sorted(network.excluded_styles) == ["elderly", "youthful"]
+    for style, row in rows.items():
+        assert row["left_out"] == ["elderly", "youthful"] and not set(row["trained_styles"]) & {"elderly", "youthful"}
+        assert row["zero_shot"]["table_5_1_row"].keys() == row["real"]["table_5_1_row"].keys()
+        assert row["example"] == [dict(e) for e in load_model(read_run(run).cvaes[(PRIMITIVE, style)]).examples]
+    assert rows["elderly"]["zero_shot"]["checkpoint"] == rows["youthful"]["zero_shot"]["checkpoint"]
+    assert rows["elderly"]["zero_shot"]["table_5_1_row"] != rows["youthful"]["zero_shot"]["table_5_1_row"]
+
+
+def test_groups_without_their_style_or_with_the_neutral_style_are_refused_before_any_work(run, tmp_path) -> None:
+    with pytest.raises(ZeroShotRunError, match="the group of left-out style 'elderly' is \\['youthful'\\]"):
+        leave_one_style_out(run, tmp_path / "x", [STYLE], [PRIMITIVE], groups={STYLE: ["youthful"]})
+    with pytest.raises(ZeroShotRunError, match="holds the neutral style 'normal'"):
+        leave_one_style_out(run, tmp_path / "x", [STYLE], [PRIMITIVE], groups={STYLE: [STYLE, "normal"]})
+    assert not (tmp_path / "x").exists()
+
+
 def test_the_train_configs_leave_the_style_out_of_the_runs_data(run, tmp_path) -> None:
     source = read_run(run)
     cfg = train_config(source, PRIMITIVE, STYLE, tmp_path / "m", epochs=7, overrides=["model.style_weight=5"],

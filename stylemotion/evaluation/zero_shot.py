@@ -204,27 +204,33 @@ def network_train_config(run: FinishedRun, primitive: str, folder: Path, epochs:
     return cfg
 
 
-def train_config(run: ReproduceRun, primitive: str, style: str, folder: Path, epochs: int | None = None,
-                 overrides: Sequence[str] = (), threads: Any = None, autoencoder_ckpt: str | Path | None = None,
-                 seed: int | None = None) -> DictConfig:
-    """The ``train`` config of the zero-shot network of ``primitive`` without ``style``
-    (:func:`network_train_config`: on ``autoencoder_ckpt``, None the run's), without a progress bar."""
-    return _quiet(network_train_config(run, primitive, folder, epochs, overrides, threads, exclude=[style],
+def left_out(style: str | Sequence[str]) -> list[str]:
+    """The styles a leave-out removes: one style, or a group (e.g. an actor's styles), sorted."""
+    return [style] if isinstance(style, str) else sorted(style)
+
+
+def train_config(run: ReproduceRun, primitive: str, style: str | Sequence[str], folder: Path,
+                 epochs: int | None = None, overrides: Sequence[str] = (), threads: Any = None,
+                 autoencoder_ckpt: str | Path | None = None, seed: int | None = None) -> DictConfig:
+    """The ``train`` config of the zero-shot network of ``primitive`` without ``style`` (a style or a group of
+    styles, :func:`left_out`; :func:`network_train_config`: on ``autoencoder_ckpt``, None the run's), without a
+    progress bar."""
+    return _quiet(network_train_config(run, primitive, folder, epochs, overrides, threads, exclude=left_out(style),
                                        autoencoder_ckpt=autoencoder_ckpt, seed=seed))
 
 
-def autoencoder_train_config(run: FinishedRun, style: str, folder: Path, seed: int | None = None,
+def autoencoder_train_config(run: FinishedRun, style: str | Sequence[str], folder: Path, seed: int | None = None,
                              threads: Any = None) -> DictConfig:
-    """The ``train`` config of an autoencoder that never sees ``style``: the run's autoencoder stage (its Hydra
-    overrides as ``reproduce.json`` records them, its data and split), ``seed`` (None: the run's) and
-    ``datamodule.exclude_styles=[style]`` (every take of the style left out of every split, after splitting: the
-    other takes keep their parts), into ``folder``, without a progress bar."""
+    """The ``train`` config of an autoencoder that never sees ``style`` (a style or a group, :func:`left_out`): the
+    run's autoencoder stage (its Hydra overrides as ``reproduce.json`` records them, its data and split), ``seed``
+    (None: the run's) and ``datamodule.exclude_styles`` (every take of those styles left out of every split, after
+    splitting: the other takes keep their parts), into ``folder``, without a progress bar."""
     stage = run.stages("autoencoder")[0]
     with hydra_configs():
         cfg = stage_train_config(list(stage.get("overrides") or []), dict(stage.get("values") or {}), run.data_cfg,
                                  folder, run.seed if seed is None else int(seed), threads)
     with open_dict(cfg):
-        cfg.datamodule.exclude_styles = [style]
+        cfg.datamodule.exclude_styles = left_out(style)
     return _quiet(cfg)
 
 
@@ -284,19 +290,26 @@ def autoencoder_excluded_styles(path: str | Path) -> list[str]:
     return [str(s) for s in saved.get("exclude_styles") or []]
 
 
-def model_folder(out: Path, primitive: str, style: str) -> Path:
-    """Where the network of ``primitive`` without ``style`` is trained: ``<out>/models/<p>_without_<s>``."""
-    return inside(out, "models", f"{primitive}_without_{safe_name(style, 'style label')}")
+def _without(style: str | Sequence[str]) -> str:
+    """``without_<s>``, or ``without_<s1>+<s2>…`` for a group (:func:`left_out`)."""
+    return "without_" + "+".join(safe_name(s, "style label") for s in left_out(style))
 
 
-def autoencoder_folder(out: Path, style: str) -> Path:
-    """Where the autoencoder without ``style`` is trained: ``<out>/autoencoders/without_<s>``."""
-    return inside(out, "autoencoders", f"without_{safe_name(style, 'style label')}")
+def model_folder(out: Path, primitive: str, style: str | Sequence[str]) -> Path:
+    """Where the network of ``primitive`` without ``style`` (a style or a group) is trained:
+    ``<out>/models/<p>_without_<s>`` (``<p>_without_<s1>+<s2>…``)."""
+    return inside(out, "models", f"{primitive}_{_without(style)}")
 
 
-def load_left_out(path: Path, primitive: str, style: str, fingerprint: str) -> ZeroShotStyleVAE:
-    """A zero-shot checkpoint, checked to be of ``primitive``, trained without ``style`` and on the autoencoder
-    of weights ``fingerprint``.
+def autoencoder_folder(out: Path, style: str | Sequence[str]) -> Path:
+    """Where the autoencoder without ``style`` (a style or a group) is trained: ``<out>/autoencoders/without_<s>``
+    (``without_<s1>+<s2>…``)."""
+    return inside(out, "autoencoders", _without(style))
+
+
+def load_left_out(path: Path, primitive: str, style: str | Sequence[str], fingerprint: str) -> ZeroShotStyleVAE:
+    """A zero-shot checkpoint, checked to be of ``primitive``, trained without ``style`` (a style or a group) and on
+    the autoencoder of weights ``fingerprint``.
 
     Raises:
         ZeroShotRunError: another kind of model, primitive, exclusion or autoencoder.
@@ -306,10 +319,12 @@ def load_left_out(path: Path, primitive: str, style: str, fingerprint: str) -> Z
         raise ZeroShotRunError(f"{path} is a {type(model).__name__}, not a ZeroShotStyleVAE")
     spec = model.spec
     bad = [f"{key} {got!r} (want {want!r})" for key, got, want in (
-        ("primitive", spec["primitive"], primitive), ("excluded_styles", model.excluded_styles, [style]),
+        ("primitive", spec["primitive"], primitive), ("excluded_styles", sorted(model.excluded_styles),
+                                                      left_out(style)),
         ("autoencoder", spec["autoencoder"]["fingerprint"], fingerprint)) if got != want]
     if bad:
-        raise ZeroShotRunError(f"{path} is not the leave-{style}-out network of {primitive} on this autoencoder: "
+        raise ZeroShotRunError(f"{path} is not the leave-{'+'.join(left_out(style))}-out network of {primitive} on "
+                               "this autoencoder: "
                                + "; ".join(bad))
     return model
 
@@ -479,6 +494,25 @@ def _summary(per_primitive: Mapping[str, Any]) -> dict[str, Any]:
     return out
 
 
+def left_out_groups(groups: Mapping[str, Sequence[str]] | None, styles: Sequence[str],
+                    neutral_style: str) -> dict[str, list[str]]:
+    """Each left-out style → the sorted styles left out with it (:func:`leave_one_style_out`'s ``groups``).
+
+    Raises:
+        ZeroShotRunError: a group without its own style, or one holding the neutral style.
+    """
+    out = {}
+    for s in styles:
+        group = left_out(list((groups or {}).get(s) or [s]))
+        if s not in group:
+            raise ZeroShotRunError(f"groups: the group of left-out style {s!r} is {group}, which does not hold it")
+        if neutral_style in group:
+            raise ZeroShotRunError(f"groups: the group of {s!r} holds the neutral style {neutral_style!r}, which every "
+                                   "network needs: leave that style out alone")
+        out[s] = group
+    return out
+
+
 def splits_record(source: ReproduceRun, shared_autoencoder: bool) -> dict[str, Any]:
     """What each model and the judge saw (the ``splits`` entry of ``zero_shot.json``)."""
     return {
@@ -487,9 +521,10 @@ def splits_record(source: ReproduceRun, shared_autoencoder: bool) -> dict[str, A
                  "of every style, the left-out one included): a fixed measuring instrument that never generates",
         "generator_autoencoder": (LEAKY if shared_autoencoder else
                                   "the run's autoencoder stage settings on the run's split minus every take of the "
-                                  "left-out style (train, val and test): it never saw the style"),
-        "network": "the train-split clips of every style but the left-out one (val: its val-split clips), features "
-                   "of the generator's autoencoder",
+                                  "left-out style, or of every style of its group (meta.left_out_groups; train, val "
+                                  "and test): it never saw the style"),
+        "network": "the train-split clips of every style but the left-out one(s) (val: its val-split clips), "
+                   "features of the generator's autoencoder",
         "condition": "the example clip(s) of the run's CVAE of the left-out style",
         "cvae": "the run's CVAE of the style: its neutral train clips plus the style's example clip (supervised "
                 "baseline; the run's autoencoder)",
@@ -512,11 +547,15 @@ def leave_one_style_out(run: str | Path, out: str | Path, styles: Sequence[str] 
                         force: bool = False, resume: bool = False, shared_autoencoder: bool = False,
                         cvae_unseen: bool = False, stages: str | Path | None = None,
                         networks: str | Path | None = None, temperature: float | None = None,
-                        centred: bool | None = None, report: str = "report") -> dict[str, Any]:
+                        centred: bool | None = None, report: str = "report",
+                        groups: Mapping[str, Sequence[str]] | None = None) -> dict[str, Any]:
     """The leave-one-style-out evaluation (see the module doc); returns what ``zero_shot.json`` holds.
 
     Args:
         run: a finished ``stylemotion-reproduce`` run folder (the judge and the CVAE baseline).
+        groups: left-out style → the styles left out with it (it included), e.g. every style of its actor: the
+            autoencoder and the network then never saw that actor (one of each per group serves each of its
+            styles); None or a style not in it: the style alone. The neutral style cannot be left out.
         report: the run's report whose evaluation settings the judge takes (:func:`read_run`): ``report``, or a
             second report such as ``report_test`` (``evaluation.heldout_splits=[test]
             evaluation.style_truth=heldout``: the real clips and the classifier's held-out clips are test clips).
@@ -574,6 +613,8 @@ def leave_one_style_out(run: str | Path, out: str | Path, styles: Sequence[str] 
         if absent:
             raise ZeroShotRunError(f"run={source.folder} has no CVAE of {p} for style(s) {absent} (its CVAEs: "
                                    f"{sorted(f'{a}/{b}' for a, b in source.cvaes)})")
+    excluded = left_out_groups(groups, [s for wanted in plan.values() for s in wanted],
+                               source.settings.neutral_style)
     if out.exists() and not resume:
         shutil.rmtree(out)
     out.mkdir(parents=True, exist_ok=True)
@@ -582,30 +623,36 @@ def leave_one_style_out(run: str | Path, out: str | Path, styles: Sequence[str] 
     judge = load_autoencoder(source.autoencoder_ckpt)
     judge_info = {"path": str(source.autoencoder_ckpt.resolve()), "fingerprint": fingerprint(judge)}
     takeset = build_dataset(source.data_cfg)
-    generators: dict[str, dict[str, Any]] = {}  # left-out style → its autoencoder
+    generators: dict[tuple[str, ...], dict[str, Any]] = {}  # left-out styles → their autoencoder
     results: dict[str, Any] = {}
     for p, wanted in plan.items():
-        networks, trained = {}, {}
+        networks, trained, by_group = {}, {}, {}
         for s in wanted:
-            if s not in generators:
-                generators[s] = _generator_autoencoder(source, s, stages, seed, threads, shared_autoencoder)
-            gen = generators[s]
-            cfg = train_config(source, p, s, model_folder(networks_out, p, s), epochs, overrides, threads,
-                               gen["path"], seed)
-            path, seconds = train_once(cfg, f"{p} network without {s}")
-            networks[s] = load_left_out(path, p, s, gen["fingerprint"])
-            if temperature is not None:
-                networks[s].set_sample_temperature(temperature)
-            if centred is not None:
-                networks[s].set_sample_centred(centred)
-            if shared_autoencoder:
-                networks[s].attach_autoencoder(judge)  # one module for all (the same weights)
+            group = tuple(excluded[s])
+            if group not in generators:
+                generators[group] = _generator_autoencoder(source, group, stages, seed, threads, shared_autoencoder)
+            gen = generators[group]
+            if group not in by_group:  # one network per left-out group serves each of its styles
+                cfg = train_config(source, p, group, model_folder(networks_out, p, group), epochs, overrides,
+                                   threads, gen["path"], seed)
+                path, seconds = train_once(cfg, f"{p} network without {'+'.join(group)}")
+                network = load_left_out(path, p, group, gen["fingerprint"])
+                if temperature is not None:
+                    network.set_sample_temperature(temperature)
+                if centred is not None:
+                    network.set_sample_centred(centred)
+                if shared_autoencoder:
+                    network.attach_autoencoder(judge)  # one module for all (the same weights)
+                by_group[group] = (network, path, seconds)
+            network, path, seconds = by_group[group]
+            networks[s] = network
             trained[s] = {"checkpoint": str(path), "train_seconds": seconds,
-                          "sample_temperature": networks[s].sample_temperature,
-                          "sample_centred": networks[s].sample_centred}
+                          "sample_temperature": network.sample_temperature,
+                          "sample_centred": network.sample_centred, "left_out": list(group)}
         cvaes = [load_model(source.cvaes[(q, s)], source.settings.neutral_style, judge)
                  for q, s in source.cvaes if q == p]
-        unseen_trained = ({s: _unseen_cvae(source, p, s, stages, seed, threads, generators[s], cvaes) for s in wanted}
+        unseen_trained = ({s: _unseen_cvae(source, p, s, stages, seed, threads, generators[tuple(excluded[s])], cvaes,
+                                           excluded[s]) for s in wanted}
                           if cvae_unseen and not shared_autoencoder else {})
         unseen = {s: model for s, (model, _) in unseen_trained.items()} or None
         results[p] = evaluate_primitive(p, networks, cvaes, takeset, judge, source.settings,
@@ -615,10 +662,12 @@ def leave_one_style_out(run: str | Path, out: str | Path, styles: Sequence[str] 
             row["zero_shot"]["train_seconds"] = record["train_seconds"]
             row["zero_shot"]["sample_temperature"] = record["sample_temperature"]
             row["zero_shot"]["sample_centred"] = record["sample_centred"]
+            row["left_out"] = record["left_out"]
             if s in unseen_trained:
                 row[UNSEEN_ROW]["train_seconds"] = unseen_trained[s][1]
-            row["generator_autoencoder"].update({k: v for k, v in generators[s].items() if k != "path"},
-                                                path=str(generators[s]["path"]))
+            generator = generators[tuple(excluded[s])]
+            row["generator_autoencoder"].update({k: v for k, v in generator.items() if k != "path"},
+                                                path=str(generator["path"]))
     payload = {"primitives": results, "summary": _summary(results), "splits": splits_record(source, shared_autoencoder),
                "meta": {"run": str(source.folder.resolve()), "data": source.data_cfg, "seed": seed,
                         "samples": samples, "epochs": epochs, "overrides": list(overrides),
@@ -626,6 +675,7 @@ def leave_one_style_out(run: str | Path, out: str | Path, styles: Sequence[str] 
                         "autoencoders": "shared (the run's)" if shared_autoencoder else "one per left-out style",
                         "stages": str(stages.resolve()), "networks": str(networks_out.resolve()),
                         "temperature": temperature, "centred": centred, "report": source.report_name,
+                        "left_out_groups": {s: list(g) for s, g in excluded.items()},
                         "judge_autoencoder": judge_info,
                         "settings": asdict(source.settings), **provenance(),
                         "seconds": time.perf_counter() - started}}
@@ -634,14 +684,17 @@ def leave_one_style_out(run: str | Path, out: str | Path, styles: Sequence[str] 
     return payload
 
 
-def unseen_cvae_folder(out: Path, primitive: str, style: str) -> Path:
-    """Where the CVAE of ``style`` on the autoencoder without it is trained:
-    ``<out>/models/<p>_cvae_on_without_<s>``."""
-    return inside(out, "models", f"{primitive}_cvae_on_without_{safe_name(style, 'style label')}")
+def unseen_cvae_folder(out: Path, primitive: str, style: str, group: Sequence[str] | None = None) -> Path:
+    """Where the CVAE of ``style`` on the autoencoder without it is trained: ``<out>/models/<p>_cvae_on_without_<s>``
+    (on the autoencoder without a ``group`` holding more styles: ``<p>_cvae_<s>_on_without_<s1>+<s2>…``)."""
+    if group is None or left_out(group) == [style]:
+        return inside(out, "models", f"{primitive}_cvae_on_{_without(style)}")
+    return inside(out, "models", f"{primitive}_cvae_{safe_name(style, 'style label')}_on_{_without(group)}")
 
 
 def _unseen_cvae(source: ReproduceRun, primitive: str, style: str, out: Path, seed: int, threads: Any,
-                 generator: Mapping[str, Any], run_cvaes: Sequence[EvalModel]) -> tuple[EvalModel, float | None]:
+                 generator: Mapping[str, Any], run_cvaes: Sequence[EvalModel],
+                 group: Sequence[str] | None = None) -> tuple[EvalModel, float | None]:
     """The CVAE of ``style`` trained as the run's CVAE stage of ``(primitive, style)`` (its overrides and values) but
     on the ``generator`` autoencoder (trained without the style), loaded with that autoencoder, and its training
     seconds (None when reused).
@@ -651,7 +704,7 @@ def _unseen_cvae(source: ReproduceRun, primitive: str, style: str, out: Path, se
     """
     stage = next(st for st in source.stages("cvae")
                  if (st["values"]["primitive"], st["values"]["style"]) == (primitive, style))
-    folder = unseen_cvae_folder(out, primitive, style)
+    folder = unseen_cvae_folder(out, primitive, style, group)
     with hydra_configs():
         cfg = stage_train_config(list(stage.get("overrides") or []), dict(stage.get("values") or {}), source.data_cfg,
                                  folder, seed, threads, autoencoder_ckpt=str(generator["path"]))
@@ -665,10 +718,11 @@ def _unseen_cvae(source: ReproduceRun, primitive: str, style: str, out: Path, se
     return model, seconds
 
 
-def _generator_autoencoder(source: ReproduceRun, style: str, out: Path, seed: int, threads: Any,
+def _generator_autoencoder(source: ReproduceRun, style: str | Sequence[str], out: Path, seed: int, threads: Any,
                            shared: bool) -> dict[str, Any]:
-    """The autoencoder the networks without ``style`` are trained on: trained here without the style (or, when
-    ``shared``, the run's); its ``path``, ``fingerprint``, ``excluded_styles`` and ``train_seconds``.
+    """The autoencoder the networks without ``style`` (a style or a group) are trained on: trained here without
+    those styles (or, when ``shared``, the run's); its ``path``, ``fingerprint``, ``excluded_styles`` and
+    ``train_seconds``.
 
     Raises:
         ZeroShotRunError: the trained checkpoint records data that did not leave the style out.
@@ -677,10 +731,11 @@ def _generator_autoencoder(source: ReproduceRun, style: str, out: Path, seed: in
         path, seconds = source.autoencoder_ckpt, None
     else:
         cfg = autoencoder_train_config(source, style, autoencoder_folder(out, style), seed, threads)
-        path, seconds = train_once(cfg, f"autoencoder without {style}")
+        path, seconds = train_once(cfg, f"autoencoder without {'+'.join(left_out(style))}")
     excluded = autoencoder_excluded_styles(path)
-    if not shared and style not in excluded:
-        raise ZeroShotRunError(f"{path} was trained on data with style {style!r} (its excluded styles: {excluded}); "
+    seen = [s for s in left_out(style) if s not in excluded]
+    if not shared and seen:
+        raise ZeroShotRunError(f"{path} was trained on data with style(s) {seen} (its excluded styles: {excluded}); "
                                f"delete {autoencoder_folder(out, style)} and run again")
     return {"path": Path(path), "fingerprint": fingerprint(load_autoencoder(path)), "excluded_styles": excluded,
             "train_seconds": seconds}
