@@ -110,6 +110,8 @@ def case_figures(row: dict[str, Any]) -> dict[str, dict[str, Any]]:
     real_skating = (row["real"].get("foot_skating") or {}).get("ratio")
     out = {}
     for kind in (*METHODS, REFERENCE):
+        if kind not in row:  # a run without the CVAE on the autoencoder without the style
+            continue
         r = row[kind]
         shares = {k: (r["variation"][k] / real[k] if real[k] else None) for k in VARIATION}
         out[kind] = {"recognition": r["recognition"], "own_column": bool(r["own_column_is_minimum"]), **shares}
@@ -148,8 +150,9 @@ def summary(cases: list[dict[str, Any]]) -> dict[str, Any]:
 
 def method_summaries(per_seed: dict[str, Any]) -> dict[str, dict[str, Any]]:
     """Per method row (and the reference), :func:`summary` over every case of every seed."""
-    return {kind: summary([c[kind] for s in per_seed.values() for c in s["cases"].values()])
-            for kind in (*METHODS, REFERENCE)}
+    cases = [c for s in per_seed.values() for c in s["cases"].values()]
+    return {kind: summary([c[kind] for c in cases]) for kind in (*METHODS, REFERENCE)
+            if all(kind in c for c in cases)}
 
 
 def choose(summaries: dict[str, dict[str, Any]]) -> dict[str, Any]:
@@ -197,15 +200,18 @@ def seed_record(args: argparse.Namespace, seed: int, judge: Path) -> dict[str, A
         f"{networks.name}_t{1.0 if temperature is None else temperature:g}{'_centred' if centred else ''}")
     if report_on != "val":
         out = out.with_name(f"{out.name}_{report_on}")
+    out = out.with_name(out.name + getattr(args, "out_tag", ""))  # e.g. another leave-out protocol's evaluation
     result = leave_one_style_out(judge, out, args.styles, args.primitives, args.epochs, args.samples, seed,
-                                 overrides=network_overrides, threads=1, resume=True, cvae_unseen=True, stages=stages,
-                                 networks=networks, temperature=temperature, centred=centred, report=report)
+                                 overrides=network_overrides, threads=1, resume=True,
+                                 cvae_unseen=getattr(args, "cvae_unseen", True), stages=stages, networks=networks,
+                                 temperature=temperature, centred=centred, report=report,
+                                 groups=getattr(args, "groups", None))
     cases = {f"{p}/{s}": case_figures(row) for p, res in result["primitives"].items()
              for s, row in res["styles"].items()}
     minutes = {f"{p}/{s}": {
         "autoencoder": round((row["generator_autoencoder"].get("train_seconds") or 0) / 60, 1),
         "zero_shot": round((row["zero_shot"].get("train_seconds") or 0) / 60, 1),
-        "cvae_unseen": round((row["cvae_unseen"].get("train_seconds") or 0) / 60, 1)}
+        "cvae_unseen": round(((row.get("cvae_unseen") or {}).get("train_seconds") or 0) / 60, 1)}
         for p, res in result["primitives"].items() for s, row in res["styles"].items()}
     return {"judge": str(judge.relative_to(ROOT)) if judge.is_relative_to(ROOT) else str(judge),
             "out": str(out), "networks": str(networks), "cases": cases, "train_minutes": minutes,

@@ -93,17 +93,31 @@ def contact_weight() -> float:
     return float(OmegaConf.load(Path(config_dir()) / "model" / "zero_shot.yaml").contact_weight)
 
 
+def seed_options(args: argparse.Namespace) -> argparse.Namespace:
+    """``style_method.seed_record``'s options: the judges' test report, the networks as ``stylemotion-style``
+    trains and samples them today (the experiment's epochs unless ``--epochs``, the yaml's sampling and foot-contact
+    weight, its networks' folder)."""
+    sample = sampling()
+    out = copy.copy(args)
+    out.epochs = args.epochs or style_method.experiment_epochs()
+    out.temperature, out.centred = sample["sample_temperature"], sample["sample_centred"]
+    out.report_on = "test"
+    out.network_overrides, out.networks_tag = style_method.contact_networks(contact_weight())
+    return out
+
+
+def relative(path: Path) -> str:
+    """``path`` relative to the repository when inside it."""
+    return str(path.relative_to(ROOT)) if path.is_relative_to(ROOT) else str(path)
+
+
 def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
     from concurrent.futures import ProcessPoolExecutor
     from multiprocessing import get_context
 
     by_seed = judges(args, seeds)
     sample = sampling()
-    seed_args = copy.copy(args)
-    seed_args.epochs = args.epochs or style_method.experiment_epochs()
-    seed_args.temperature, seed_args.centred = sample["sample_temperature"], sample["sample_centred"]
-    seed_args.report_on = "test"
-    seed_args.network_overrides, seed_args.networks_tag = style_method.contact_networks(contact_weight())
+    seed_args = seed_options(args)
     # Seeds in parallel, one torch thread each; seeds without trained networks first (they take longest).
     trained = {seed: (args.runs / args.data / f"seed{seed}_e{seed_args.epochs}{seed_args.networks_tag}").is_dir()
                for seed in seeds}
@@ -117,8 +131,7 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
     return {"data": args.data, "epochs": seed_args.epochs, "sampling": sample,
             "contact_weight": contact_weight(), "samples": args.samples,
             "narrowed": {"primitives": args.primitives, "styles": args.styles},
-            "judges": {str(seed): str(judge.relative_to(ROOT)) if judge.is_relative_to(ROOT) else str(judge)
-                       for seed, judge in by_seed.items()},
+            "judges": {str(seed): relative(judge) for seed, judge in by_seed.items()},
             "splits": {"report": "the judges' report_test (evaluation.heldout_splits=[test] "
                                  "evaluation.style_truth=heldout): each left-out style's test clips but its example",
                        "seeds": "training seeds of the autoencoders without each style, the networks, the CVAEs on "
@@ -143,6 +156,8 @@ def aims(per_seed: dict[str, Any]) -> dict[str, dict[str, Any]]:
     styles = per_style(per_seed)
     out = {}
     for kind in (*style_method.METHODS, style_method.REFERENCE):
+        if not all(kind in c for group in styles.values() for c in group):  # a row the run did not make
+            continue
         cases = [c[kind] for group in styles.values() for c in group]
         recognized = {s: spread(c[kind]["recognition"] for c in group)["mean"] for s, group in styles.items()}
         out[kind] = {"cases": len(cases), "styles": len(styles),
@@ -163,16 +178,7 @@ def _count(cases: list[dict[str, Any]], key: str, meets: Callable[[float], bool]
 def render(record: dict[str, Any]) -> dict[str, str]:
     r = record["results"]
     sd = contact_full.sd
-    label = "**Synthetic data: a smoke run of the suite, not evidence.** " if r["data"] == "synthetic" else ""
-    narrowed = {k: v for k, v in r["narrowed"].items() if v}
-    if narrowed:
-        label += "**Narrowed:** " + "; ".join(f"{k} {', '.join(v)}" for k, v in narrowed.items()) + ". "
-    seeds = list(r["per_seed"])
-    if len(seeds) < 3:
-        label += f"**{len(seeds)} training seed{'s' if len(seeds) != 1 else ''} only (fewer than 3).** "
-    sample = r["sampling"]
-    how = (f"sampled at τ = {sample['sample_temperature']:g}"
-           + (" with the variation centred on the example" if sample["sample_centred"] else ""))
+    label, seeds, how = block_label(r), list(r["per_seed"]), sampled(r)
     names = {"zero_shot": f"zero-shot network (method=zero_shot, {how})", **{
         k: v for k, v in style_method.LABELS.items() if k != "zero_shot"}}
     rows = []
@@ -182,19 +188,15 @@ def render(record: dict[str, Any]) -> dict[str, str]:
                      f"{a['recognition_styles']}/{a['styles']}", *(sd(s[k]) for k in style_method.VARIATION),
                      sd(s.get("skating", {}), 3), sd(s.get("skating_vs_real", {}), 1),
                      f"{a['skating']}/{a['cases']}"])
-    contact = ("" if r.get("contact_weight") is None else
-               f" trained with foot-contact loss weight {r['contact_weight']:g}")
     rule = r["rule_on_test"]
     failed = ", ".join(k for k, ok in rule["tests"].items() if not ok) or "none"
     check = (f"On these test figures style_method's rule would give **{rule['default']}** (tests failed: {failed}); "
              "it chooses nothing here: the default was chosen on validation clips.")
-    judges = ", ".join(f"seed {k} → `{v}`" for k, v in r["judges"].items())
     headline = (
         f"{label}A style the autoencoder never saw, judged on **test** clips only ({r['data']}, training seeds "
-        f"{', '.join(seeds)}; networks of {r['epochs']} epochs{contact}, {how}; {r['samples']:,} samples per model "
-        f"and seed): "
+        f"{', '.join(seeds)}; {network_line(r)}): "
         f"per left-out style an autoencoder without it and on it the zero-shot network and the CVAE as "
-        f"stylemotion-style trains them; each training seed judged by a reproduction's test report ({judges}). "
+        f"stylemotion-style trains them; {judges_line(r)}. "
         f"Recognition: share of samples the judge's classifier (fitted on train clips) gives the style; own column: "
         f"Table 5.1 rows whose minimum is the style's example; V_SD, step_SD, diversity: samples ÷ the style's test "
         f"clips; skating: share of contact foot-frames sliding > 0.2 m/s, raw samples (no clean-up), and its multiple "
@@ -205,6 +207,38 @@ def render(record: dict[str, Any]) -> dict[str, str]:
                     f"cases ≤ {AIM_SKATING:g}× real"], rows)
         + f"\n\n{provenance_line(record)}")
     return {"headline": headline, "styles": f"{render_styles(r)}\n\n{provenance_line(record)}"}
+
+
+def block_label(r: dict[str, Any]) -> str:
+    """What a block says first: synthetic data, a narrowed run, fewer than 3 seeds."""
+    label = "**Synthetic data: a smoke run of the suite, not evidence.** " if r["data"] == "synthetic" else ""
+    narrowed = {k: v for k, v in r["narrowed"].items() if v}
+    if narrowed:
+        label += "**Narrowed:** " + "; ".join(f"{k} {', '.join(v)}" for k, v in narrowed.items()) + ". "
+    seeds = len(r["per_seed"])
+    if seeds < 3:
+        label += f"**{seeds} training seed{'s' if seeds != 1 else ''} only (fewer than 3).** "
+    return label
+
+
+def sampled(r: dict[str, Any]) -> str:
+    """How the networks were sampled."""
+    sample = r["sampling"]
+    return (f"sampled at τ = {sample['sample_temperature']:g}"
+            + (" with the variation centred on the example" if sample["sample_centred"] else ""))
+
+
+def network_line(r: dict[str, Any]) -> str:
+    """The networks' training and sampling and the samples per model."""
+    contact = ("" if r.get("contact_weight") is None else
+               f" trained with foot-contact loss weight {r['contact_weight']:g}")
+    return f"networks of {r['epochs']} epochs{contact}, {sampled(r)}; {r['samples']:,} samples per model and seed"
+
+
+def judges_line(r: dict[str, Any]) -> str:
+    """Which judge measured each training seed."""
+    judges = ", ".join(f"seed {k} → `{v}`" for k, v in r["judges"].items())
+    return f"each training seed judged by a reproduction's test report ({judges})"
 
 
 def render_styles(r: dict[str, Any]) -> str:
