@@ -170,7 +170,8 @@ def contact_networks(weight: float) -> tuple[list[str], str]:
     """The networks' training override for foot-contact loss weight ``weight`` and their folder's tag (``""`` for 0:
     the networks every earlier suite trained, in ``seed<k>_e<epochs>/``; ``_contact<w>`` else), so one folder always
     holds networks of one weight, whatever the configs' default."""
-    return [f"model.contact_weight={weight:g}"], (f"_contact{weight:g}" if weight else "")
+    # a float as the yaml writes it (0.0): the trainings' hash reads the composed value, and 0 is not 0.0 there
+    return [f"model.contact_weight={float(weight)!r}"], (f"_contact{weight:g}" if weight else "")
 
 
 def seed_record(args: argparse.Namespace, seed: int, judge: Path) -> dict[str, Any]:

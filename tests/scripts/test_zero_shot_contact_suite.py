@@ -50,8 +50,8 @@ def test_each_arm_trains_its_networks_in_a_folder_of_its_own_and_samples_as_toda
     args = argparse.Namespace(data="bandai", runs=Path("r"))
     off, on = zero_shot_contact.arm_args(args, 0.0, 10), zero_shot_contact.arm_args(args, 100.0, 10)
     assert off.networks_tag == "" and off.epochs == 10 and off.centred
-    assert on.network_overrides == ["model.contact_weight=100"] and on.networks_tag == "_contact100"
-    assert off.network_overrides == ["model.contact_weight=0"]  # the folder holds weight 0 whatever the default
+    assert on.network_overrides == ["model.contact_weight=100.0"] and on.networks_tag == "_contact100"
+    assert off.network_overrides == ["model.contact_weight=0.0"]  # the folder holds weight 0 whatever the default
 
 
 def test_the_blocks_state_the_verdict_the_skating_and_why_each_arm_failed() -> None:
