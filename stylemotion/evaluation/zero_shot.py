@@ -33,6 +33,11 @@ For each primitive ``p`` of a finished ``stylemotion-reproduce`` run and each of
 
 4. ``<out>/zero_shot.json`` and ``<out>/zero_shot.md``.
 
+``groups`` leaves styles out together (e.g. every style of one actor: one autoencoder and one network per group,
+``without_<s1>+<s2>…``, serve each of its styles), so the generator never saw the style's actor either. ``report``
+names the run's report whose evaluation settings the judge takes (``report_test``: every ``real`` row holds the
+style's test clips only). Every row also carries the raw foot skating of its motions (``foot_skating``).
+
 ``shared_autoencoder=True`` keeps the earlier protocol: the network is trained on the run's autoencoder, which
 saw s. Its output is labelled **leaky** (``meta.leaky``) and is no evidence that the network generalizes to an
 unseen style. ``out`` must not exist unless ``force`` (replace it) or ``resume`` (reuse the finished trainings in
