@@ -40,7 +40,7 @@ from stylemotion.evaluation.zero_shot import (
 from stylemotion.io.outputs import OutputExistsError
 from stylemotion.models.checkpoints import fingerprint, load_autoencoder
 from stylemotion.models.loading import load_generative, load_model
-from stylemotion.models.sampling import decode_features
+from stylemotion.models.sampling import decode_features, motions_from_normalized
 from stylemotion.primitives.segmentation import time_normalize
 
 register_schemas()  # the configs composed here take structured schemas (stylemotion.cli.schemas)
@@ -330,6 +330,13 @@ def test_a_test_report_judges_against_the_styles_test_clips_and_every_row_measur
     hand = foot_skating(rebuilt.positions.numpy(), rebuilt.num_frames.numpy(), data.fps, data.rest_heights,
                         data.stance_foot, source.settings.skate_speed_mps)
     assert row["reconstructed"]["foot_skating"] == hand.as_dict()
+    # the same clips only resampled to the canonical timeline and back (no autoencoder)
+    normalized = torch.from_numpy(np.stack([time_normalize(c.frames, length) for c in test]))
+    played = motions_from_normalized(normalized, torch.tensor([c.duration_s for c in test]), data.fps)
+    hand = foot_skating(played.positions.numpy(), played.num_frames.numpy(), data.fps, data.rest_heights,
+                        data.stance_foot, source.settings.skate_speed_mps)
+    assert row["reconstructed"]["foot_skating_timeline"] == hand.as_dict()
+    assert row["reconstructed"]["foot_skating_timeline"] != row["reconstructed"]["foot_skating"]
 
 
 @pytest.mark.slow  # an autoencoder and a network trained without elderly and youthful, one evaluation: ~20 s

@@ -76,7 +76,7 @@ from stylemotion.io.jsonfile import write_json
 from stylemotion.io.outputs import check_new_output, inside, safe_name
 from stylemotion.models.checkpoints import fingerprint, load_autoencoder, read_checkpoint
 from stylemotion.models.loading import NEUTRAL, EvalModel, load_generative, load_model, zero_shot_model
-from stylemotion.models.sampling import decode_features
+from stylemotion.models.sampling import decode_features, motions_from_normalized
 from stylemotion.models.zero_shot import ZeroShotStyleVAE, checked_temperature
 from stylemotion.primitives.segmentation import parse_primitive
 from stylemotion.provenance import provenance
@@ -390,15 +390,19 @@ def _reconstructed_row(real, autoencoder, generator_ae, style: str, columns: lis
                        settings: EvalSettings) -> dict[str, Any]:
     """The figures of the style's real clips (those of :func:`_real_row`) encoded and decoded by the generator's
     autoencoder ``generator_ae``, measured by the judge: what its feature space keeps of the style, and their raw
-    foot skating at their recorded durations (what a model decoding through it starts from)."""
+    foot skating at their recorded durations (what a model decoding through it starts from); beside it
+    (``foot_skating_timeline``) the skating of the same clips only resampled to the canonical timeline and back, no
+    autoencoder (what the representation alone costs)."""
     truth = real.truth[style]
     features = generator_ae.encode(truth.normalized_frames.float())
     rebuilt = decode_features(generator_ae, features, truth.duration_s, real.length, truth.fps)
     frames = rebuilt.normalized_frames  # (n, T, 66) frames on the canonical timeline
     predicted = real.classifier.predict(frames.numpy(), truth.duration_s.numpy())
+    timeline = motions_from_normalized(truth.normalized_frames, truth.duration_s, truth.fps)
     return {"recognition": float((predicted == style).mean()),
             **_table_row(autoencoder, frames, style, columns, grams, settings),
-            "foot_skating": _skating(real, rebuilt, settings), "clips": len(truth)}
+            "foot_skating": _skating(real, rebuilt, settings),
+            "foot_skating_timeline": _skating(real, timeline, settings), "clips": len(truth)}
 
 
 def generator_autoencoder(network: ZeroShotStyleVAE) -> dict[str, Any]:

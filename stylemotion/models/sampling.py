@@ -97,13 +97,21 @@ def decode_features(autoencoder, features: torch.Tensor, duration_s: torch.Tenso
     if features.dim() != 3:
         raise ValueError(f"features must be (n, channels, steps), got {tuple(features.shape)}")
     n = features.shape[0]
+    normalized = torch.cat([autoencoder.decode(features[i:i + chunk_size], timeline_frames).float().cpu()
+                            for i in range(0, n, chunk_size)]) if n else torch.zeros(0, timeline_frames, FRAME_DIM)
+    return motions_from_normalized(normalized, duration_s, fps, features.detach().float().cpu())
+
+
+def motions_from_normalized(normalized: torch.Tensor, duration_s: torch.Tensor, fps: float,
+                            features: torch.Tensor | None = None) -> MotionSamples:
+    """Time-normalized frames ``(n, timeline, 66)`` played back at their durations ``(n,)`` (seconds, > 0) and
+    ``fps``: frames and global positions (``features``: what they were decoded from, else empty ``(n, 0, 0)``)."""
+    n = normalized.shape[0]
     duration_s = torch.as_tensor(duration_s, dtype=torch.float32).reshape(-1).cpu()
     if duration_s.shape[0] != n:
         raise ValueError(f"need one duration per sample: {n} samples, {duration_s.shape[0]} durations")
     if n and not bool((duration_s > 0).all()):
         raise ValueError("durations must be positive")
-    normalized = torch.cat([autoencoder.decode(features[i:i + chunk_size], timeline_frames).float().cpu()
-                            for i in range(0, n, chunk_size)]) if n else torch.zeros(0, timeline_frames, FRAME_DIM)
     # restore_duration's length rule, computed in double precision like Python floats
     lengths = torch.clamp(torch.round(duration_s.double() * fps).long() + 1, min=2)
     width = int(lengths.max()) if n else 2
@@ -121,8 +129,8 @@ def decode_features(autoencoder, features: torch.Tensor, duration_s: torch.Tenso
             frames[idx, got:] = group[:, -1:]
             positions[idx, got:] = pos[:, -1:]
         num_frames[idx] = got
-    return MotionSamples(positions, frames, num_frames, duration_s, features.detach().float().cpu(), normalized,
-                         float(fps))
+    return MotionSamples(positions, frames, num_frames, duration_s,
+                         torch.zeros(n, 0, 0) if features is None else features, normalized, float(fps))
 
 
 def masked_mpjpe(pred: torch.Tensor, true: torch.Tensor, num_frames: torch.Tensor) -> torch.Tensor:
