@@ -337,6 +337,8 @@ def test_a_test_report_judges_against_the_styles_test_clips_and_every_row_measur
                         data.stance_foot, source.settings.skate_speed_mps)
     assert row["reconstructed"]["foot_skating_timeline"] == hand.as_dict()
     assert row["reconstructed"]["foot_skating_timeline"] != row["reconstructed"]["foot_skating"]
+    # the leaky network decodes with the judge's own autoencoder: its reconstruction is the judge's
+    assert row["reconstructed"]["foot_skating_judge"] == row["reconstructed"]["foot_skating"]
 
 
 @pytest.mark.slow  # an autoencoder and a network trained without elderly and youthful, one evaluation: ~20 s

@@ -121,7 +121,8 @@ def case_figures(row: dict[str, Any]) -> dict[str, dict[str, Any]]:
     if real_skating is not None:
         out["real_skating"] = real_skating
     for key, name in (("foot_skating", "reconstructed_skating_vs_real"),
-                      ("foot_skating_timeline", "timeline_skating_vs_real")):
+                      ("foot_skating_timeline", "timeline_skating_vs_real"),
+                      ("foot_skating_judge", "judge_reconstructed_skating_vs_real")):
         rebuilt = (row.get("reconstructed") or {}).get(key)
         if rebuilt is not None and real_skating:
             out[name] = rebuilt["ratio"] / real_skating
@@ -135,10 +136,14 @@ def reconstruction_skating(cases: list[dict[str, Any]]) -> str:
     if not rebuilt.get("n"):
         return ""
     timeline = spread(c.get("timeline_skating_vs_real") for c in cases)
+    judge = spread(c.get("judge_reconstructed_skating_vs_real") for c in cases)
     alone = (f"; only resampled to the canonical timeline and back (no autoencoder), {contact_full.sd(timeline, 1)}×"
              if timeline.get("n") else "")
+    seen = (f"; through the judge's autoencoder, which saw the style, {contact_full.sd(judge, 1)}×"
+            if judge.get("n") else "")
     return (f" The style's real clips encoded and decoded by the autoencoder without the style (no model; their own "
-            f"durations) skate {contact_full.sd(rebuilt, 1)}× the real clips'{alone} (over {rebuilt['n']} cases).")
+            f"durations) skate {contact_full.sd(rebuilt, 1)}× the real clips'{alone}{seen} (over {rebuilt['n']} "
+            "cases).")
 
 
 def summary(cases: list[dict[str, Any]]) -> dict[str, Any]:

@@ -392,17 +392,25 @@ def _reconstructed_row(real, autoencoder, generator_ae, style: str, columns: lis
     autoencoder ``generator_ae``, measured by the judge: what its feature space keeps of the style, and their raw
     foot skating at their recorded durations (what a model decoding through it starts from); beside it
     (``foot_skating_timeline``) the skating of the same clips only resampled to the canonical timeline and back, no
-    autoencoder (what the representation alone costs)."""
+    autoencoder (what the representation alone costs), and (``foot_skating_judge``) through the judge's
+    ``autoencoder``, which saw the style (what an autoencoder costs a style it was trained on)."""
     truth = real.truth[style]
-    features = generator_ae.encode(truth.normalized_frames.float())
-    rebuilt = decode_features(generator_ae, features, truth.duration_s, real.length, truth.fps)
+    rebuilt = _through(generator_ae, truth, real.length)
     frames = rebuilt.normalized_frames  # (n, T, 66) frames on the canonical timeline
     predicted = real.classifier.predict(frames.numpy(), truth.duration_s.numpy())
     timeline = motions_from_normalized(truth.normalized_frames, truth.duration_s, truth.fps)
     return {"recognition": float((predicted == style).mean()),
             **_table_row(autoencoder, frames, style, columns, grams, settings),
             "foot_skating": _skating(real, rebuilt, settings),
-            "foot_skating_timeline": _skating(real, timeline, settings), "clips": len(truth)}
+            "foot_skating_timeline": _skating(real, timeline, settings),
+            "foot_skating_judge": _skating(real, _through(autoencoder, truth, real.length), settings),
+            "clips": len(truth)}
+
+
+def _through(autoencoder, motions, length: int):
+    """Motions' time-normalized frames encoded and decoded by ``autoencoder``, played back at their durations."""
+    features = autoencoder.encode(motions.normalized_frames.float())
+    return decode_features(autoencoder, features, motions.duration_s, length, motions.fps)
 
 
 def generator_autoencoder(network: ZeroShotStyleVAE) -> dict[str, Any]:

@@ -32,7 +32,8 @@ def case(zero_shot: dict, cvae_unseen: dict | None = None) -> dict:
     return style_method.case_figures({"zero_shot": zero_shot, "cvae_unseen": cvae_unseen or row(0.97, 0.1, 0.2, 0.3),
                                       "cvae": row(0.99, 0.2, 0.2, 0.25), "real": REAL,
                                       "reconstructed": {"foot_skating": {"ratio": 0.1},
-                                                        "foot_skating_timeline": {"ratio": 0.06}}})
+                                                        "foot_skating_timeline": {"ratio": 0.06},
+                                                        "foot_skating_judge": {"ratio": 0.075}}})
 
 
 def test_a_case_measures_skating_as_a_multiple_of_the_styles_real_clips_and_older_rows_have_none() -> None:
@@ -94,7 +95,8 @@ def test_the_blocks_state_test_clips_the_aims_and_what_the_rule_would_give_witho
     assert "| active | 0.750 ± 0.212 (0.600–0.900) | 2/2 |" in blocks["styles"]
     assert "The style's test clips skate 0.050 ± 0.000 (0.050–0.050)" in blocks["styles"]
     assert "(no model; their own durations) skate 2.0 ± 0.0 (2.0–2.0)× the real clips'; only resampled to the " \
-           "canonical timeline and back (no autoencoder), 1.2 ± 0.0 (1.2–1.2)× (over 4 cases)" in blocks["styles"]
+           "canonical timeline and back (no autoencoder), 1.2 ± 0.0 (1.2–1.2)×; through the judge's autoencoder, " \
+           "which saw the style, 1.5 ± 0.0 (1.5–1.5)× (over 4 cases)" in blocks["styles"]
     three = per_seed() | {"102": per_seed()["100"]}
     assert "fewer than 3" not in zero_shot_test.render(record(three))["headline"]
 
