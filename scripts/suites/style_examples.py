@@ -67,8 +67,9 @@ def row_labels(ks: list[int], poolings: list[str]) -> list[str]:
     return [row_label(k, p) for k in ks for p in POOLINGS if p in poolings and (p == "mean" or k > 1)]
 
 
-def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--loso", type=Path, required=True,
+def add_arguments(parser: argparse.ArgumentParser, loso: Path | None = None) -> None:
+    """The suite's options; ``loso``: ``--loso``'s default (None: the option is required)."""
+    parser.add_argument("--loso", type=Path, required=loso is None, default=loso,
                         help="suite zero_shot's trainings: a folder with seed<k>/zero_shot.json per seed (e.g. "
                              "runs/benchmarks/zero_shot/bandai/loso_<judge>_e<epochs>); read only")
     parser.add_argument("--data", choices=("synthetic", "bandai"), default="synthetic",
@@ -99,15 +100,16 @@ def draw_examples(clips: list, ks: list[int], seed: int, primitive: str, style: 
 
 
 class Judge:
-    """The judge run of the trainings (``zero_shot.json``'s ``meta.run``): its autoencoder, data and, per primitive,
-    its real side and Table 5.1 columns, built once."""
+    """The judge run of the trainings (``zero_shot.json``'s ``meta.run``, with the evaluation settings of its report
+    ``meta.report``: ``report_test`` holds out the test clips only): its autoencoder, data and, per primitive, its
+    real side and Table 5.1 columns, built once."""
 
-    def __init__(self, folder: str | Path):
+    def __init__(self, folder: str | Path, report: str = "report"):
         from stylemotion.datasets import build_dataset
         from stylemotion.evaluation.zero_shot import read_run
         from stylemotion.models.checkpoints import load_autoencoder
 
-        self.source = read_run(folder)
+        self.source = read_run(folder, report)
         self.autoencoder = load_autoencoder(self.source.autoencoder_ckpt)
         self.takeset = build_dataset(self.source.data_cfg)
         self._sides: dict[str, tuple[Any, list[str], Any]] = {}
@@ -195,7 +197,9 @@ def judged_samples(judge: Judge, model, drawn, truth, reference: dict[str, float
             "examples": [{k_: r[k_] for k_ in ("take", "start", "stop")} for r in records]}
 
 
-def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
+def run(args: argparse.Namespace, seeds: list[int], protocol: dict[str, Any] | None = None) -> dict[str, Any]:
+    """The curves of every seed's trainings (``--loso``/``args.folder``, default ``seed{seed}``);
+    ``protocol`` as :func:`summarize`'s."""
     import torch
 
     from stylemotion.evaluation.zero_shot import ZeroShotRunError, load_left_out
@@ -206,19 +210,19 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
     if not ks or ks[0] < 1:
         raise ZeroShotRunError(f"--ks must be whole numbers ≥ 1, got {args.ks}")
     poolings = [p for p in POOLINGS if p in (getattr(args, "pooling", None) or ["mean"])]
-    judges: dict[str, Judge] = {}
+    judges: dict[tuple[str, str], Judge] = {}
     per_seed: dict[str, Any] = {}
     for seed in seeds:
-        folder = args.loso.expanduser() / f"seed{seed}"
+        folder = args.loso.expanduser() / str(getattr(args, "folder", None) or "seed{seed}").format(seed=seed)
         record = read_json_object(folder / "zero_shot.json", "suite zero_shot's results",
                                   f"run suite zero_shot with --seeds {seed} first")
         if record["meta"].get("leaky"):
             raise ZeroShotRunError(f"{folder} holds the leaky protocol (networks on the judge's autoencoder); give "
                                    "the leakage-free trainings")
-        judge_folder = str(record["meta"]["run"])
-        if judge_folder not in judges:
-            judges[judge_folder] = Judge(judge_folder)
-        judge = judges[judge_folder]
+        judge_folder, report = str(record["meta"]["run"]), str(record["meta"].get("report") or "report")
+        if (judge_folder, report) not in judges:
+            judges[(judge_folder, report)] = Judge(judge_folder, report)
+        judge = judges[(judge_folder, report)]
         name = judge.source.data_cfg.get("name")
         if (name == "synthetic") != (args.data == "synthetic"):
             raise ZeroShotRunError(f"{folder}'s judge run holds {name!r} data, not --data {args.data}")
@@ -229,15 +233,20 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
             for s, row in res["styles"].items():
                 if args.styles and s not in args.styles:
                     continue
-                network = load_left_out(Path(row["zero_shot"]["checkpoint"]), p, s,
-                                        row["generator_autoencoder"]["fingerprint"])
+                network = load_left_out(Path(row["zero_shot"]["checkpoint"]), p, s if "left_out" not in row
+                                        else row["left_out"], row["generator_autoencoder"]["fingerprint"])
+                # sampled as that evaluation sampled it (recorded since the networks' sampling settings exist)
+                if row["zero_shot"].get("sample_temperature") is not None:
+                    network.set_sample_temperature(row["zero_shot"]["sample_temperature"])
+                if row["zero_shot"].get("sample_centred") is not None:
+                    network.set_sample_centred(row["zero_shot"]["sample_centred"])
                 with progress_printed(f"[seed {seed} {p}/{s}]"):
                     curves.setdefault(p, {})[s] = style_curve(judge, network, p, s, ks, args.samples, seed,
                                                               tuple(poolings))
         styles = set(judge.takeset.label_values("style")) - {judge.source.settings.neutral_style}
         per_seed[str(seed)] = {"loso": relative(folder), "judge": relative(judge_folder), "curves": curves,
                                "data_styles": sorted(styles)}
-    return summarize(per_seed, ks, args, poolings)
+    return summarize(per_seed, ks, args, poolings, protocol)
 
 
 
