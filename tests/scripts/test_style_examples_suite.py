@@ -73,8 +73,9 @@ def planted(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> dict:
                                                                               "leaky": False}}))
 
     class FakeJudge:
-        def __init__(self, folder):
+        def __init__(self, folder, report="report"):
             calls.setdefault("judges", []).append(folder)
+            calls.setdefault("reports", []).append(report)
             self.source = SimpleNamespace(data_cfg={"name": "synthetic"},
                                           settings=SimpleNamespace(neutral_style="normal"))
             styles = calls.get("data_styles", ["normal", *STYLES])  # the data's styles: those left out + neutral
@@ -101,6 +102,7 @@ def args(loso: Path, **changes) -> argparse.Namespace:
 def test_spreads_counts_and_aims_are_over_seeds(planted) -> None:
     results = style_examples.run(args(planted["loso"]), [0, 1, 2])
     assert planted["judges"] == [str(planted["loso"].parent / "judge")]  # one judge, built once
+    assert planted["reports"] == ["report"]  # records without meta.report: the run's own report
     assert [c[:2] for c in planted["curves"]] == [(s, st) for s in (0, 1, 2) for st in STYLES]
     assert all(c[2] == (1, 2, 4, 8) and c[3] == 50 for c in planted["curves"])
     assert planted["networks"][1] == ("/nets/seed0/youthful.ckpt", "walk_leftStance", "youthful", "ae0youthful")
