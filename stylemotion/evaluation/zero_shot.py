@@ -240,7 +240,7 @@ def autoencoder_train_config(run: FinishedRun, style: str | Sequence[str], folde
 
 
 #: The networks' ``model.*`` keys that change only how a trained network samples (left out of a training's hash).
-SAMPLING_ONLY = ("sample_temperature", "sample_centred")
+SAMPLING_ONLY = ("sample_temperature", "sample_centred", "sample_pooling")
 
 
 def _settings_hash(cfg: DictConfig) -> str:

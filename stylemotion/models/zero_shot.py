@@ -58,10 +58,12 @@ logged as ``style`` on val/test whatever its weight.
 Sampling: :meth:`ZeroShotStyleVAE.sample` ``(n, seed, example=…)``, or :meth:`ZeroShotStyleVAE.bind_example`,
 which returns a :class:`BoundExample` with the ``sample(n, seed)`` of every other model.
 
-Several example clips (e.g. ``stylemotion-style example=[…]``) are pooled by ``pooling``: ``mean`` (default) conditions
-every sample on their mean embedding and anchor (:meth:`ZeroShotStyleVAE.condition`); ``per_sample`` conditions each
-sample on one clip drawn with the sampling seed (:meth:`ZeroShotStyleVAE.per_sample_condition`), so the samples
-spread over the examples instead of sitting at their centre. Suite ``style_examples --pooling`` compares the two.
+Several example clips (e.g. ``stylemotion-style example=[…]``) are pooled by ``pooling`` (default the network's
+``sample_pooling``: ``mean`` in the class, ``per_sample`` in ``configs/model/zero_shot.yaml``, chosen on validation
+clips by suite ``style_examples_pooling``): ``mean`` conditions every sample on their mean embedding and anchor
+(:meth:`ZeroShotStyleVAE.condition`); ``per_sample`` conditions each sample on one clip drawn with the sampling seed
+(:meth:`ZeroShotStyleVAE.per_sample_condition`), so the samples spread over the examples instead of sitting at their
+centre. One clip samples the same either way.
 """
 
 from __future__ import annotations
@@ -168,13 +170,16 @@ class ZeroShotStyleVAE(PrimitiveVAE):
             the variation minus its mean over the prior (:meth:`variation_centre`), so the samples centre on their
             example instead of on where the decoder puts an unseen style. Sampling only, as ``sample_temperature``
             (:meth:`set_sample_centred`); the path-following synthesis decodes without it.
+        sample_pooling: how several example clips condition :meth:`bind_example`'s samples (:data:`POOLINGS`:
+            ``mean``, their mean condition; ``per_sample``, one clip drawn per sample). Sampling only
+            (:meth:`set_sample_pooling`); one clip is the same either way.
         spec: what the model knows about its data (filled in at the first ``setup``).
         **kwargs: :class:`PrimitiveVAE` arguments (latent_dim, hidden, samples_per_item, kl_weight, …).
     """
 
     def __init__(self, embedding_dim: int = 32, anchor: bool = True, style_weight: float = 0.0,
                  style_latents: str = "both", sample_temperature: float = 1.0, sample_centred: bool = False,
-                 spec: dict[str, Any] | None = None, **kwargs: Any):
+                 sample_pooling: str = "mean", spec: dict[str, Any] | None = None, **kwargs: Any):
         super().__init__(**kwargs)  # built below, once this class' hyperparameters are known
         if isinstance(embedding_dim, bool) or int(embedding_dim) != embedding_dim or embedding_dim < 1:
             raise ValueError(f"embedding_dim must be a whole number ≥ 1, got {embedding_dim!r}")
@@ -182,10 +187,13 @@ class ZeroShotStyleVAE(PrimitiveVAE):
             raise ValueError(f"style_weight must be ≥ 0, got {style_weight}")
         if style_latents not in STYLE_LATENTS:
             raise ValueError(f"style_latents must be one of {STYLE_LATENTS}, got {style_latents!r}")
+        if sample_pooling not in POOLINGS:
+            raise ValueError(f"sample_pooling must be one of {POOLINGS}, got {sample_pooling!r}")
         self.save_hyperparameters({**dict(self.hparams), "embedding_dim": int(embedding_dim), "anchor": bool(anchor),
                                    "style_weight": float(style_weight), "style_latents": str(style_latents),
                                    "sample_temperature": checked_temperature(sample_temperature),
                                    "sample_centred": bool(sample_centred) and bool(anchor),  # needs the example
+                                   "sample_pooling": str(sample_pooling),
                                    "spec": None if spec is None else dict(spec)})
         if spec is not None:
             self._build(spec)
@@ -209,6 +217,18 @@ class ZeroShotStyleVAE(PrimitiveVAE):
         if centred and not self.hparams.anchor:
             raise ValueError("sample_centred needs anchor=true: the samples centre on their example")
         self.hparams["sample_centred"] = bool(centred)
+
+    @property
+    def sample_pooling(self) -> str:
+        """How several example clips condition the samples of :meth:`bind_example` (``mean`` for older
+        checkpoints)."""
+        return str(self.hparams.get("sample_pooling", "mean"))
+
+    def set_sample_pooling(self, pooling: str) -> None:
+        """Pool several example clips this way from now on (:data:`POOLINGS`)."""
+        if pooling not in POOLINGS:
+            raise ValueError(f"sample_pooling must be one of {POOLINGS}, got {pooling!r}")
+        self.hparams["sample_pooling"] = str(pooling)
 
     @torch.no_grad()
     def variation_centre(self, condition: StyleCondition) -> torch.Tensor:
@@ -342,16 +362,17 @@ class ZeroShotStyleVAE(PrimitiveVAE):
         return StyleCondition(embedding, anchor)
 
     def bind_example(self, example: Any, style: str | None = None,
-                     records: Sequence[dict[str, Any]] | None = None, pooling: str = "mean") -> BoundExample:
+                     records: Sequence[dict[str, Any]] | None = None, pooling: str | None = None) -> BoundExample:
         """This model with one style example bound: a sampler with ``sample(n, seed)`` (see :class:`BoundExample`).
 
         Args:
             example: as :meth:`example_features`.
             style: the style's name (for reports).
             records: plain-value records of the example clip(s) (take, start, stop, …).
-            pooling: how several clips condition the samples (:data:`POOLINGS`, see the module doc).
+            pooling: how several clips condition the samples (:data:`POOLINGS`, see the module doc; None: the
+                network's :attr:`sample_pooling`).
         """
-        return BoundExample(self, self.example_features(example), style, records, pooling)
+        return BoundExample(self, self.example_features(example), style, records, pooling or self.sample_pooling)
 
     # -- objective
 
@@ -572,7 +593,7 @@ class BoundExample:
     def sample(self, n: int, seed: int | None = None, chunk_size: int = DEFAULT_CHUNK) -> MotionSamples:
         """``n`` motions in the bound example's style (see :meth:`ZeroShotStyleVAE.sample`; ``pooling=per_sample``:
         each conditioned on one clip drawn with ``seed``, :meth:`ZeroShotStyleVAE.per_sample_condition`)."""
-        if self.pooling == "per_sample":
+        if self.pooling == "per_sample" and len(self.example_features) > 1:  # one clip: the mean's condition
             condition = self.model.per_sample_condition(self.example_features, n, seed)
             return self.model.sample(n, seed, chunk_size, example=condition)
         return self.model.sample(n, seed, chunk_size, example=self.condition)

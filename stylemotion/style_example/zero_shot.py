@@ -13,8 +13,8 @@ from the key ``network``:
   ``{primitive: checkpoint}``.
 
 Every network samples as ``configs/model/zero_shot.yaml`` says today (:func:`sampling_defaults`:
-``sample_temperature``, ``sample_centred``; chosen on validation clips, docs/style.md), also one trained before those
-keys changed or existed; the report records how (``network.sampling``).
+``sample_temperature``, ``sample_centred``, ``sample_pooling``; chosen on validation clips, docs/style.md), also one
+trained before those keys changed or existed; the report records how (``network.sampling``).
 
 Each network is checked before any work (:func:`check_network`): a zero-shot network, of the primitive,
 trained on the run's autoencoder (weight fingerprint) and on the run's canonical timeline.
@@ -225,6 +225,7 @@ class ZeroShotMethod(Method):
         defaults = sampling_defaults()
         network.set_sample_temperature(defaults["sample_temperature"])
         network.set_sample_centred(defaults["sample_centred"] and bool(network.hparams.anchor))
+        network.set_sample_pooling(defaults["sample_pooling"])
         described = [{**describe_clip(c), "encoded_frames": network.timeline_frames, **dict(r)}
                      for c, r in zip(clips, records)]
         bound = network.bind_example(list(clips), name, described)
@@ -240,8 +241,8 @@ class ZeroShotMethod(Method):
             "epochs": trained_epochs(folder, list(models)) if here else None,
             "checkpoints": {p: recorded_path(m.checkpoint, folder) for p, m in models.items()},
             "trained_styles": {p: n.styles for p, n in networks.items()},
-            "sampling": {p: {"temperature": n.sample_temperature, "centred": n.sample_centred}
-                         for p, n in networks.items()},
+            "sampling": {p: {"temperature": networks[p].sample_temperature, "centred": networks[p].sample_centred,
+                             "pooling": m.source.pooling} for p, m in models.items()},
             "excluded_styles": {p: n.excluded_styles for p, n in networks.items()}}}
 
     def entry(self, primitive: str, clips: Sequence[Clip], origin: Sequence[int] = (), examples: int = 1
@@ -254,10 +255,11 @@ class ZeroShotMethod(Method):
 
 
 def sampling_defaults() -> dict[str, Any]:
-    """``sample_temperature`` and ``sample_centred`` of ``configs/model/zero_shot.yaml``: how every network of
-    ``method=zero_shot`` samples."""
+    """``sample_temperature``, ``sample_centred`` and ``sample_pooling`` of ``configs/model/zero_shot.yaml``: how every
+    network of ``method=zero_shot`` samples."""
     from stylemotion.config import config_dir
 
     cfg = OmegaConf.load(Path(config_dir()) / "model" / "zero_shot.yaml")
     return {"sample_temperature": float(cfg.get("sample_temperature", 1.0)),
-            "sample_centred": bool(cfg.get("sample_centred", False))}
+            "sample_centred": bool(cfg.get("sample_centred", False)),
+            "sample_pooling": str(cfg.get("sample_pooling", "mean"))}

@@ -5,6 +5,7 @@ the path-following synthesis uses of a model."""
 
 from __future__ import annotations
 
+import copy
 from dataclasses import asdict
 from pathlib import Path
 
@@ -241,6 +242,34 @@ def test_per_sample_pooling_conditions_each_sample_on_one_seeded_clip(trained) -
                        model.sample(8, seed=3, example=model.condition(clips)).features)
     with pytest.raises(ValueError, match="pooling must be one of"):
         model.bind_example(clips, pooling="max")
+
+
+def test_the_networks_sample_pooling_is_what_bind_example_uses_and_one_clip_samples_alike(trained) -> None:
+    """``sample_pooling`` (mean for the class and older checkpoints; the yaml's per_sample): the pooling of
+    :meth:`bind_example` unless named; one clip gives the same samples either way."""
+    from stylemotion.style_example.example import cut_examples
+
+    model = trained[True].eval()
+    clips = cut_examples(user_examples(2), "tired", "walk", [model.primitive], None).used[model.primitive]
+    assert model.sample_pooling == "mean" and ZeroShotStyleVAE().sample_pooling == "mean"
+    saved = copy.deepcopy(model)
+    del saved.hparams["sample_pooling"]  # a checkpoint from before the setting
+    assert saved.sample_pooling == "mean"
+    try:
+        model.set_sample_pooling("per_sample")
+        assert model.bind_example(clips).pooling == "per_sample"
+        assert torch.equal(model.bind_example(clips).sample(20, seed=3).features,
+                           model.sample(20, seed=3, example=model.per_sample_condition(clips, 20, 3)).features)
+        assert model.bind_example(clips, pooling="mean").pooling == "mean"
+        one = model.bind_example(clips[:1]).sample(10, seed=5)
+        model.set_sample_pooling("mean")
+        assert torch.equal(one.features, model.bind_example(clips[:1]).sample(10, seed=5).features)
+    finally:
+        model.set_sample_pooling("mean")
+    with pytest.raises(ValueError, match="sample_pooling must be one of"):
+        model.set_sample_pooling("max")
+    with pytest.raises(ValueError, match="sample_pooling must be one of"):
+        ZeroShotStyleVAE(sample_pooling="median")
 
 
 def test_centred_sampling_takes_the_variations_mean_over_the_prior_off_each_clips_samples(data, trained) -> None:

@@ -78,6 +78,7 @@ def test_every_model_takes_the_clips_of_both_examples_and_the_report_records_eac
         skating = report["foot_skating"][p]
         assert 0 <= skating["samples"]["ratio"] <= 1 and 0 <= skating["example"]["ratio"] <= 1
         assert len(report["table_5_1_columns"][p]["pair"]) == len(used)
+        assert report["network"]["sampling"][p]["pooling"] == "per_sample"  # each sample on one clip (the yaml's)
     steps = [line for line in made["lines"] if line.startswith("[")]
     assert steps[0].startswith(f"[1/4] example[1]={examples[0]}: 240 of 240 frames at 60 fps")
     assert f"; example[2]={examples[1]}: 110 of 120 frames at 30 fps" in steps[0]

@@ -92,7 +92,7 @@ def test_the_networks_are_trained_in_the_command_on_every_style_and_the_report_i
         "trained_here": True, "given": None, "epochs": NETWORK_EPOCHS, "trained_styles": None, "checkpoints": None,
         "excluded_styles": {p: [] for p in PRIMITIVES},
         # as configs/model/zero_shot.yaml samples today (chosen on validation clips)
-        "sampling": {p: {"temperature": 1.0, "centred": True} for p in PRIMITIVES}}
+        "sampling": {p: {"temperature": 1.0, "centred": True, "pooling": "per_sample"} for p in PRIMITIVES}}
     steps = [line for line in made["lines"] if line.startswith("[")]
     assert [s[:5] for s in steps] == [f"[{k}/5]" for k in range(1, 6)]
     assert steps[2].startswith(f"[3/5] network walk_leftStance: training ({NETWORK_EPOCHS} epochs) on the clips of "
