@@ -145,11 +145,7 @@ def render(record: dict[str, Any]) -> dict[str, str]:
 
 def render_styles(r: dict[str, Any], order: list[str]) -> str:
     """Per left-out style: the zero-shot network's recognition and skating × real at each weight."""
-    styles: dict[str, dict[str, list[dict[str, Any]]]] = {}
-    for w, per_seed in r["per_arm"].items():
-        for seed in per_seed.values():
-            for key, case in seed["cases"].items():
-                styles.setdefault(key.split("/", 1)[1], {}).setdefault(w, []).append(case["zero_shot"])
+    styles = zero_shot_epochs.zero_shot_by_style(r)
     sd = contact_full.sd
     rows = [[style, *(cell for w in order for cell in (
         sd(spread(c["recognition"] for c in by_arm.get(w, [])), 3),

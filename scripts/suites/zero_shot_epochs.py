@@ -121,6 +121,16 @@ def arms_record(args: argparse.Namespace, per_arm: dict[str, Any], arms: dict[st
             "cvae_unseen_same_in_every_arm": all(a["summary"]["cvae_unseen"] == first for a in arms.values())}
 
 
+def zero_shot_by_style(r: dict[str, Any]) -> dict[str, dict[str, list[dict[str, Any]]]]:
+    """Left-out style → arm → the zero-shot network's cases of every seed and primitive (``r["per_arm"]``)."""
+    styles: dict[str, dict[str, list[dict[str, Any]]]] = {}
+    for arm, per_seed in r["per_arm"].items():
+        for seed in per_seed.values():
+            for key, case in seed["cases"].items():
+                styles.setdefault(key.split("/", 1)[1], {}).setdefault(arm, []).append(case["zero_shot"])
+    return styles
+
+
 def arms_frame(r: dict[str, Any]) -> tuple[str, list[str], bool, str]:
     """The label of an arm suite's blocks (synthetic, narrowed), its training seeds, whether it is full (not
     narrowed, two seeds or more: its verdict applies) and what it says of the CVAE rows across arms."""

@@ -131,11 +131,7 @@ def render(record: dict[str, Any]) -> dict[str, str]:
 
 def render_styles(r: dict[str, Any], order: list[str]) -> str:
     """Per left-out style, the zero-shot network's recognition, own-column rows and diversity at each τ."""
-    styles: dict[str, dict[str, list[dict[str, Any]]]] = {}
-    for t, per_seed in r["per_arm"].items():
-        for seed in per_seed.values():
-            for key, case in seed["cases"].items():
-                styles.setdefault(key.split("/", 1)[1], {}).setdefault(t, []).append(case["zero_shot"])
+    styles = zero_shot_epochs.zero_shot_by_style(r)
     rows = [[style, *(cell for t in order for cell in (
         contact_full.sd(spread(c["recognition"] for c in by_arm.get(t, [])), 3),
         f"{sum(c['own_column'] for c in by_arm.get(t, []))}/{len(by_arm.get(t, []))}",
