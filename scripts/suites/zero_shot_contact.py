@@ -62,21 +62,10 @@ def arm_args(args: argparse.Namespace, weight: float, epochs: int) -> argparse.N
 
 
 def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
-    from concurrent.futures import ProcessPoolExecutor
-    from multiprocessing import get_context
-
     epochs = args.epochs or style_method.experiment_epochs()
     judges = {seed: style_method.judge_for(args, seed) for seed in seeds}
-    per_arm: dict[str, dict[str, Any]] = {}
-    arms: dict[str, dict[str, Any]] = {}
-    processes = max(1, min(args.workers, len(seeds)))
-    for weight in sorted({0.0, *args.weights}):
-        options = arm_args(args, weight, epochs)
-        with ProcessPoolExecutor(max_workers=processes, mp_context=get_context("spawn")) as pool:
-            futures = {seed: pool.submit(style_method.seed_record, options, seed, judge)
-                       for seed, judge in judges.items()}
-            per_arm[arm_key(weight)] = {str(seed): future.result() for seed, future in futures.items()}
-        arms[arm_key(weight)] = zero_shot_epochs.arm_summary(per_arm[arm_key(weight)])
+    per_arm, arms = zero_shot_epochs.run_arms(args, judges, {arm_key(w): arm_args(args, w, epochs)
+                                                             for w in sorted({0.0, *args.weights})})
     return {"epochs": epochs, "sampling": zero_shot_test.sampling(),
             **zero_shot_epochs.arms_record(args, per_arm, arms), "choice": choose_weight(arms)}
 

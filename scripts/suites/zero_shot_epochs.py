@@ -121,6 +121,23 @@ def arms_record(args: argparse.Namespace, per_arm: dict[str, Any], arms: dict[st
             "cvae_unseen_same_in_every_arm": all(a["summary"]["cvae_unseen"] == first for a in arms.values())}
 
 
+def run_arms(args: argparse.Namespace, judges: dict[int, Any], options: dict[str, argparse.Namespace]
+             ) -> tuple[dict[str, dict[str, Any]], dict[str, dict[str, Any]]]:
+    """Each arm's ``style_method.seed_record`` per seed (``options``: arm → its options, in the order run; seeds in
+    parallel, ``--workers`` processes of one thread), and each arm's :func:`arm_summary`."""
+    from concurrent.futures import ProcessPoolExecutor
+    from multiprocessing import get_context
+
+    per_arm: dict[str, dict[str, Any]] = {}
+    processes = max(1, min(args.workers, len(judges)))
+    for key, arm_options in options.items():
+        with ProcessPoolExecutor(max_workers=processes, mp_context=get_context("spawn")) as pool:
+            futures = {seed: pool.submit(style_method.seed_record, arm_options, seed, judge)
+                       for seed, judge in judges.items()}
+            per_arm[key] = {str(seed): future.result() for seed, future in futures.items()}
+    return per_arm, {key: arm_summary(per_seed) for key, per_seed in per_arm.items()}
+
+
 def zero_shot_by_style(r: dict[str, Any]) -> dict[str, dict[str, list[dict[str, Any]]]]:
     """Left-out style → arm → the zero-shot network's cases of every seed and primitive (``r["per_arm"]``)."""
     styles: dict[str, dict[str, list[dict[str, Any]]]] = {}

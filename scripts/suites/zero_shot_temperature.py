@@ -69,23 +69,15 @@ def arm_key(temperature: float) -> str:
 
 
 def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
-    from concurrent.futures import ProcessPoolExecutor
-    from multiprocessing import get_context
-
     epochs = args.epochs or style_method.experiment_epochs()
     judges = {seed: style_method.judge_for(args, seed) for seed in seeds}
-    arms: dict[str, dict[str, Any]] = {}
-    per_arm: dict[str, dict[str, Any]] = {}
-    processes = max(1, min(args.workers, len(seeds)))
+    options = {}
     for temperature in sorted(set(args.temperatures), reverse=True):  # τ = 1 first: it trains what is missing
         arm_args = copy.copy(args)
         arm_args.epochs, arm_args.temperature = epochs, temperature
         arm_args.centred = bool(getattr(args, "centred", False))
-        with ProcessPoolExecutor(max_workers=processes, mp_context=get_context("spawn")) as pool:
-            futures = {seed: pool.submit(style_method.seed_record, arm_args, seed, judge)
-                       for seed, judge in judges.items()}
-            per_arm[arm_key(temperature)] = {str(seed): future.result() for seed, future in futures.items()}
-        arms[arm_key(temperature)] = zero_shot_epochs.arm_summary(per_arm[arm_key(temperature)])
+        options[arm_key(temperature)] = arm_args
+    per_arm, arms = zero_shot_epochs.run_arms(args, judges, options)
     return {"epochs": epochs, "centred": bool(getattr(args, "centred", False)),
             **zero_shot_epochs.arms_record(args, per_arm, arms), "choice": choose_temperature(arms)}
 
