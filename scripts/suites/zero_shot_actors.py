@@ -26,7 +26,7 @@ import argparse
 from pathlib import Path
 from typing import Any
 
-from suites import contact_full, style_method, zero_shot_test
+from suites import contact_full, style_method, zero_shot, zero_shot_test
 from suites.common import md_table, provenance_line, spread
 
 DESCRIPTION = ("stylemotion-style's default (the zero-shot network) on a style and an actor it never saw: each "
@@ -94,7 +94,7 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
             "narrowed": {"primitives": args.primitives, "styles": args.styles},
             "actors": actors, "groups": groups, "cross_actor": {s: len(g) > 1 or actors[s] == [s]
                                                                 for s, g in groups.items()},
-            "judges": {str(seed): zero_shot_test.relative(judge) for seed, judge in by_seed.items()},
+            "judges": {str(seed): zero_shot.relative(judge) for seed, judge in by_seed.items()},
             "splits": {"report": "the judges' report_test: each left-out style's test clips but its example",
                        "left_out": "every take of the style's actor group (every split), from the autoencoder and "
                                    "the network; a group holding the neutral style: the style alone",

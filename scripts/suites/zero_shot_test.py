@@ -36,7 +36,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from suites import contact_full, style_method
+from suites import contact_full, style_method, zero_shot
 from suites.common import md_table, number_above, provenance_line, spread
 from suites.style import REPORTS, reproduce_seed
 
@@ -86,11 +86,9 @@ def sampling() -> dict[str, Any]:
 
 def contact_weight() -> float:
     """The networks' foot-contact loss weight today (``contact_weight`` of configs/model/zero_shot.yaml)."""
-    from omegaconf import OmegaConf
+    from stylemotion.style_example.zero_shot import model_config
 
-    from stylemotion.config import config_dir
-
-    return float(OmegaConf.load(Path(config_dir()) / "model" / "zero_shot.yaml").contact_weight)
+    return float(model_config().contact_weight)
 
 
 def seed_options(args: argparse.Namespace) -> argparse.Namespace:
@@ -104,11 +102,6 @@ def seed_options(args: argparse.Namespace) -> argparse.Namespace:
     out.report_on = "test"
     out.network_overrides, out.networks_tag = style_method.contact_networks(contact_weight())
     return out
-
-
-def relative(path: Path) -> str:
-    """``path`` relative to the repository when inside it."""
-    return str(path.relative_to(ROOT)) if path.is_relative_to(ROOT) else str(path)
 
 
 def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
@@ -131,7 +124,7 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
     return {"data": args.data, "epochs": seed_args.epochs, "sampling": sample,
             "contact_weight": contact_weight(), "samples": args.samples,
             "narrowed": {"primitives": args.primitives, "styles": args.styles},
-            "judges": {str(seed): relative(judge) for seed, judge in by_seed.items()},
+            "judges": {str(seed): zero_shot.relative(judge) for seed, judge in by_seed.items()},
             "splits": {"report": "the judges' report_test (evaluation.heldout_splits=[test] "
                                  "evaluation.style_truth=heldout): each left-out style's test clips but its example",
                        "seeds": "training seeds of the autoencoders without each style, the networks, the CVAEs on "

@@ -254,12 +254,17 @@ class ZeroShotMethod(Method):
                 "clips": [[int(c.start), int(c.stop), int(i)] for c, i in zip(clips, origin)]}
 
 
+def model_config() -> DictConfig:
+    """``configs/model/zero_shot.yaml`` as written (how ``method=zero_shot`` trains and samples its networks)."""
+    from stylemotion.config import config_dir
+
+    return OmegaConf.load(Path(config_dir()) / "model" / "zero_shot.yaml")
+
+
 def sampling_defaults() -> dict[str, Any]:
     """``sample_temperature``, ``sample_centred`` and ``sample_pooling`` of ``configs/model/zero_shot.yaml``: how every
     network of ``method=zero_shot`` samples."""
-    from stylemotion.config import config_dir
-
-    cfg = OmegaConf.load(Path(config_dir()) / "model" / "zero_shot.yaml")
+    cfg = model_config()
     return {"sample_temperature": float(cfg.get("sample_temperature", 1.0)),
             "sample_centred": bool(cfg.get("sample_centred", False)),
             "sample_pooling": str(cfg.get("sample_pooling", "mean"))}
