@@ -103,6 +103,15 @@ def rest_pose(take: Take) -> tuple[float, ...] | None:
     source = FileSource.from_name(take.source) if take.source else None
     if source is None or not PurePosixPath(source.member or source.path).suffix.lower() == ".bvh":
         return None
+    return bvh_rest_pose(source)
+
+
+def bvh_rest_pose(source: FileSource) -> tuple[float, ...]:
+    """The rest offsets of every joint of a BVH file (file units, rounded to 1e-3, in file order), its frames unread.
+
+    Raises:
+        MotionDataError, BvhError: the file cannot be read or its hierarchy is malformed, naming it.
+    """
     head = source.read_head(MAX_HIERARCHY_BYTES, stop=b"MOTION")
     offsets = parse_bvh_skeleton(head, source.name).offsets
     return tuple(round(float(v), 3) for v in np.asarray(offsets, dtype=np.float64).ravel())
