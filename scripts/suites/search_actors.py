@@ -14,8 +14,8 @@ Per left-out actor: the queries are one random 2 s window of each of that actor'
   actor, content and style are in it),
 
 with E15 features, the command's ``k`` (:data:`stylemotion.search.DEFAULT_K`, chosen on validation queries by
-suite ``search``) and 10 matches, by suite ``search``'s :func:`suites.search.retrieval_by_content`: precision@10 by content,
-a query without a match counts as ten wrong ones. Nothing is chosen here.
+suite ``search``) and 10 matches, by suite ``search``'s :func:`suites.search.retrieval_by_content`: precision@10
+by content, a query without a match counts as ten wrong ones. Nothing is chosen here.
 """
 
 from __future__ import annotations
