@@ -23,9 +23,11 @@ def retrieval(p10: list[float], none: list[float]) -> dict:
 def record() -> dict:
     actors = [{"styles": ["active", "elderly"], "query_takes": 20,
                "database_frames": {"cross_actor": 1000, "same_actor": 3000},
-               "cross_actor": retrieval([0.5, 0.6, 0.7], [2, 4, 3]), "same_actor": retrieval([0.8, 0.9, 1.0], [0, 1, 0])},
+               "cross_actor": retrieval([0.5, 0.6, 0.7], [2, 4, 3]),
+               "same_actor": retrieval([0.8, 0.9, 1.0], [0, 1, 0])},
               {"styles": ["normal"], "query_takes": 20, "database_frames": {"cross_actor": 2000, "same_actor": 3000},
-               "cross_actor": retrieval([0.7, 0.7, 0.7], [0, 0, 0]), "same_actor": retrieval([0.9, 0.9, 0.9], [0, 0, 0])}]
+               "cross_actor": retrieval([0.7, 0.7, 0.7], [0, 0, 0]),
+               "same_actor": retrieval([0.9, 0.9, 0.9], [0, 0, 0])}]
     return {"command": "python scripts/benchmarks.py run search_actors", "commit": "abc", "started": "2026-12-08",
             "seeds": [0, 1, 2], "machine": {}, "results": {"k": 1024, "query_s": 2.0, "actors": actors}}
 
