@@ -314,7 +314,7 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
     timing = {f"{seconds:g}|{key}": {"ratio": spread(v), **quantiles(v)} for (seconds, key), v in costs.items()}
 
     # 2. Retrieval precision@10 by content, test takes against train + val, chosen k.
-    retrieval = _retrieval(indexes["test"], split["test"], seeds, args.retrieval_s, chosen)
+    retrieval = retrieval_by_content(indexes["test"], split["test"], seeds, args.retrieval_s, chosen)
 
     # 3. Other captures against all of Bandai with the command's defaults.
     captures = _captures(bandai, seeds, args.capture_windows, args.capture_lengths_s, DEFAULT_K,
@@ -329,7 +329,7 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
 
     # 5. Left and right turns per feature set (§2.6.2): test turn takes against train + val, the chosen k.
     turn_takes = [t for t in split["test"] if t.content in ("walk-turn-left", "walk-turn-right")]
-    turns = {name: _retrieval(feature_indexes[name], turn_takes, seeds, args.retrieval_s, chosen)
+    turns = {name: retrieval_by_content(feature_indexes[name], turn_takes, seeds, args.retrieval_s, chosen)
              for name in args.turn_features}
 
     return {"splits": {"choose": "val takes (queries) against train takes (database)",
@@ -376,7 +376,7 @@ def _ranks(feature_indexes: dict[str, Any], seeds: list[int], frames: int, k: in
             "rho": {a: {b: spread(s[a][b] for s in per_seed) for b in names} for a in names}}
 
 
-def _retrieval(index: Any, takes: list[Any], seeds: list[int], seconds: float, k: int) -> dict[str, Any]:
+def retrieval_by_content(index: Any, takes: list[Any], seeds: list[int], seconds: float, k: int) -> dict[str, Any]:
     from stylemotion.search import search_features
     from stylemotion.search.evaluation import precision_at
 

@@ -23,7 +23,6 @@ reference. Nothing is chosen here.
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
 from typing import Any
 
 from suites import contact_full, style_method, zero_shot, zero_shot_test
@@ -45,23 +44,21 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def actor_groups(data_cfg: dict[str, Any], styles: list[str], contents: tuple[str, ...] = ("walk",)
                  ) -> dict[str, list[str]]:
     """Style → the styles of its actor: styles whose takes (of ``contents``) share one skeleton rest pose (every
-    joint's rest offset, file units, to 1e-3), read from the BVH files of ``data_cfg["root"]`` (Bandai's zip).
+    joint's rest offset, file units, to 1e-3: :func:`stylemotion.datasets.retarget.bvh_rest_pose`, the rest pose
+    :func:`~stylemotion.datasets.retarget.actor_groups` splits by), read from the BVH files' hierarchies in
+    ``data_cfg["root"]`` (Bandai's zip).
 
     Raises:
         SystemExit: a style whose takes have several rest poses (no actor per style), or none found.
     """
-    import zipfile
-
-    from stylemotion.io.bvh import parse_bvh
+    from stylemotion.datasets.retarget import bvh_rest_pose
+    from stylemotion.io.sources import list_sources
 
     poses: dict[str, set[tuple[float, ...]]] = {s: set() for s in styles}
-    with zipfile.ZipFile(data_cfg["root"]) as archive:
-        for name in archive.namelist():
-            parts = Path(name).stem.split("_")
-            if not name.endswith(".bvh") or len(parts) < 3 or parts[1] not in contents or parts[2] not in poses:
-                continue
-            skeleton = parse_bvh(archive.read(name), name).skeleton
-            poses[parts[2]].add(tuple(round(float(v), 3) for v in skeleton.offsets.ravel()))
+    for source in list_sources(data_cfg["root"], "*.bvh"):
+        parts = source.stem.split("_")
+        if len(parts) >= 3 and parts[1] in contents and parts[2] in poses:
+            poses[parts[2]].add(bvh_rest_pose(source))
     bad = {s: len(p) for s, p in poses.items() if len(p) != 1}
     if bad:
         raise SystemExit(f"zero_shot_actors: styles without exactly one rest pose in {data_cfg['root']}: {bad}")

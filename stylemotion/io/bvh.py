@@ -239,23 +239,7 @@ def parse_bvh(data: bytes | str, source: str = "<memory>",
     seconds, resampling would make a few seconds of motion a thousand times longer.
     """
     raw = normalize_text(data.encode() if isinstance(data, str) else data, source)
-    match = re.search(rb"^[ \t]*MOTION[ \t]*$", raw, flags=re.MULTILINE)
-    if match is None:
-        # Parse what there is so that the error says where the file stops making sense.
-        _raise_missing_motion(raw, source)
-    motion_line = raw[: match.start()].count(b"\n") + 1
-    try:
-        header = raw[: match.start()].decode("utf-8")
-    except UnicodeDecodeError as exc:
-        line = raw[: exc.start].count(b"\n") + 1
-        raise BvhError(source, f"hierarchy is not UTF-8 text (byte {raw[exc.start]:#04x})", line) from None
-    tokens = _Tokens(header, source, motion_line)
-    if not tokens.items:
-        raise BvhError(source, "empty hierarchy, expected 'HIERARCHY'", 1)
-    skeleton = _parse_hierarchy(tokens)
-    if tokens.pos != len(tokens.items):
-        raise BvhError(source, f"unexpected {tokens.items[tokens.pos][0]!r} after the hierarchy, "
-                       "expected 'MOTION'", tokens.line)
+    skeleton, match = _parse_header(raw, source)
 
     # MOTION section: "Frames: n" and "Frame Time: t" lines, then one row per frame.
     first_line = raw[: match.start()].count(b"\n") + 2  # line number after "MOTION"
@@ -297,6 +281,50 @@ def parse_bvh(data: bytes | str, source: str = "<memory>",
                        f"frames looks like milliseconds; BVH Frame Time is in seconds (for {frame_time:g} ms "
                        f"write Frame Time: {frame_time / 1000:g})", first_line + 1)
     return _motion_from_channels(skeleton, values, snap_fps(1.0 / frame_time), source)
+
+
+def _parse_header(raw: bytes, source: str) -> tuple[Skeleton, re.Match[bytes]]:
+    """The skeleton of normalized BVH bytes and the match of their ``MOTION`` line (BvhError naming the line)."""
+    match = re.search(rb"^[ \t]*MOTION[ \t]*$", raw, flags=re.MULTILINE)
+    if match is None:
+        # Parse what there is so that the error says where the file stops making sense.
+        _raise_missing_motion(raw, source)
+    motion_line = raw[: match.start()].count(b"\n") + 1
+    try:
+        header = raw[: match.start()].decode("utf-8")
+    except UnicodeDecodeError as exc:
+        line = raw[: exc.start].count(b"\n") + 1
+        raise BvhError(source, f"hierarchy is not UTF-8 text (byte {raw[exc.start]:#04x})", line) from None
+    tokens = _Tokens(header, source, motion_line)
+    if not tokens.items:
+        raise BvhError(source, "empty hierarchy, expected 'HIERARCHY'", 1)
+    skeleton = _parse_hierarchy(tokens)
+    if tokens.pos != len(tokens.items):
+        raise BvhError(source, f"unexpected {tokens.items[tokens.pos][0]!r} after the hierarchy, "
+                       "expected 'MOTION'", tokens.line)
+    return skeleton, match
+
+
+#: Most bytes :func:`parse_bvh_skeleton` reads before the ``MOTION`` line must have come.
+MAX_HIERARCHY_BYTES = 1_000_000
+
+
+def parse_bvh_skeleton(head: bytes, source: str = "<memory>") -> Skeleton:
+    """The skeleton (hierarchy and rest offsets, file units) of a BVH file from its first bytes, frames unread.
+
+    Args:
+        head: the file's first bytes, at least up to its ``MOTION`` line (e.g.
+            :meth:`stylemotion.io.sources.FileSource.read_head` of :data:`MAX_HIERARCHY_BYTES`).
+        source: what messages call the file.
+
+    Raises:
+        BvhError: naming ``source`` and the line, for a malformed hierarchy or no ``MOTION`` line in ``head``.
+    """
+    raw = normalize_text(head, source)
+    cut = raw.rfind(b"\n") + 1
+    if raw[cut:].strip() != b"MOTION":  # a line the read cut short is not parsed
+        raw = raw[:cut]
+    return _parse_header(raw, source)[0]
 
 
 def check_joint_frames(num_frames: int, num_joints: int, limit: int | None, source: str, when: str) -> None:

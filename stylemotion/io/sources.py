@@ -16,6 +16,7 @@ import zipfile
 import zlib
 from dataclasses import dataclass
 from pathlib import Path, PurePosixPath
+from typing import IO
 
 from stylemotion.io.errors import LimitError, MotionDataError
 
@@ -160,6 +161,39 @@ class FileSource:
             raise MotionDataError(self.name, "no such member in the archive") from None
         except (OSError, zipfile.BadZipFile, zlib.error, EOFError, RuntimeError, ValueError) as exc:
             raise MotionDataError(self.name, f"cannot read zip member ({exc})") from None
+
+    def read_head(self, max_bytes: int, stop: bytes | None = None, chunk: int = 1 << 16) -> bytes:
+        """The file's first bytes: up to ``max_bytes`` (all of a shorter file), or fewer once ``stop`` has been read
+        (read ``chunk`` bytes at a time), e.g. a BVH file's hierarchy without its frames."""
+        def read(fh: IO[bytes]) -> bytes:
+            data = b""
+            while len(data) < max_bytes:
+                part = fh.read(min(chunk, max_bytes - len(data)))
+                data += part
+                if not part or (stop is not None and stop in data[-len(part) - len(stop):]):
+                    break
+            return data
+
+        if self.member is None:
+            regular_file_stat(self.path, self.name)
+            try:
+                with open(self.path, "rb") as fh:
+                    return read(fh)
+            except OSError as exc:
+                raise MotionDataError(self.name, f"cannot read file ({exc.strerror or exc})") from None
+        try:
+            with _zip(self.path).open(self.member) as fh:
+                return read(fh)
+        except KeyError:
+            raise MotionDataError(self.name, "no such member in the archive") from None
+        except (OSError, zipfile.BadZipFile, zlib.error, EOFError, RuntimeError, ValueError) as exc:
+            raise MotionDataError(self.name, f"cannot read zip member ({exc})") from None
+
+    @classmethod
+    def from_name(cls, name: str) -> FileSource:
+        """The source a :attr:`name` names: ``archive.zip::member`` or a path."""
+        path, sep, member = name.partition("::")
+        return cls(path, member) if sep and member else cls(name)
 
     def fingerprint(self, max_file_mb: float | None = None) -> str:
         """Changes whenever the content does: CRC-32 and size of a zip member, SHA-256 of a file.

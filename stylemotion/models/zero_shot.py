@@ -463,9 +463,13 @@ class ZeroShotStyleVAE(PrimitiveVAE):
     @torch.no_grad()
     def sample(self, n: int, seed: int | None = None, chunk_size: int = DEFAULT_CHUNK, *,
                example: Any = None) -> MotionSamples:
-        """``n`` motions in the style of ``example`` (see :meth:`condition`): ``z ~ N(0, τ² I)`` (τ:
-        :attr:`sample_temperature`) decoded under its condition. ``seed`` seeds a private generator (None: a fresh
-        seed); returns :class:`MotionSamples` as :meth:`PrimitiveVAE.sample`."""
+        """``n`` motions in the style of ``example``: ``z ~ N(0, τ² I)`` (τ: :attr:`sample_temperature`) decoded
+        under its condition. An example given as clips (see :meth:`example_features`) is bound first
+        (:meth:`bind_example`), so several clips condition the samples as :attr:`sample_pooling` says, as
+        ``stylemotion-style`` samples them; a :class:`StyleCondition` is used as it is. ``seed`` seeds a private
+        generator (None: a fresh seed); returns :class:`MotionSamples` as :meth:`PrimitiveVAE.sample`."""
+        if example is not None and not isinstance(example, StyleCondition):
+            return self.bind_example(example).sample(n, seed, chunk_size)
         z = prior_draws(n, self.hparams.latent_dim, seed) * self.sample_temperature
         return self.decode_latent(z, chunk_size, example=self.condition(example))
 

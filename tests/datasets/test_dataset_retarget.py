@@ -2,14 +2,18 @@
 
 from __future__ import annotations
 
+import zipfile
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import tiny_bvh_text
 
 from stylemotion.bones import BONE_NAMES, NUM_BONES, median_bone_lengths
 from stylemotion.datasets import Take, TakeSet, data_config_key, load_dataset
-from stylemotion.datasets.retarget import actor_groups, retarget_takeset
+from stylemotion.datasets.retarget import actor_groups, rest_pose, retarget_takeset
+from stylemotion.io.errors import MotionDataError
 from stylemotion.skeleton import CANONICAL_PARENTS, JOINT_INDEX, NUM_JOINTS, forward_kinematics
 
 SYNTHETIC = {"takes_per_pair": 2, "duration_s": 2.0, "contents": ["walk"], "styles": ["normal", "elderly", "active"]}
@@ -24,7 +28,7 @@ def skeleton_take(name: str, style: str, scale: np.ndarray | float = 1.0, frames
     translations[:, 0] = np.stack([np.zeros(frames), np.full(frames, 1.0), 0.04 * np.arange(frames)], axis=-1)
     rotations = np.broadcast_to(np.eye(3), (frames, NUM_JOINTS, 3, 3))
     positions = forward_kinematics(rotations, translations, CANONICAL_PARENTS).astype(np.float32)
-    return Take(name, positions, 30.0, {"content": "walk", "style": style}, source=f"{name}.bvh")
+    return Take(name, positions, 30.0, {"content": "walk", "style": style}, source=f"<memory:{name}>")
 
 
 def two_actors() -> TakeSet:
@@ -116,14 +120,38 @@ def test_actor_groups_by_bone_lengths() -> None:
         actor_groups(two_actors().takes, tolerance_m=-1)
 
 
+def test_actor_groups_split_one_set_of_bones_by_the_files_rest_poses(tmp_path: Path) -> None:
+    """Bandai's case: equal bones in every file, one rest offset per actor (here the root's), read from the files
+    (a loose file and a zip member) without their frames."""
+    moved = tiny_bvh_text().replace("OFFSET 0.0 0.0 0.0", "OFFSET 4.5 91.5 -427.2", 1)
+    (tmp_path / "a.bvh").write_text(tiny_bvh_text())
+    with zipfile.ZipFile(tmp_path / "data.zip", "w") as archive:
+        archive.writestr("b.bvh", moved)
+        archive.writestr("c.bvh", tiny_bvh_text())
+    sources = {"a_normal_0": str(tmp_path / "a.bvh"), "b_feminine_0": f"{tmp_path / 'data.zip'}::b.bvh",
+               "c_masculine_0": f"{tmp_path / 'data.zip'}::c.bvh", "d_elderly_0": "<memory:d>"}
+    takes = [replace(skeleton_take(name, name.split("_")[1]), source=source) for name, source in sources.items()]
+    assert rest_pose(takes[0]) == rest_pose(takes[2]) != rest_pose(takes[1]) and rest_pose(takes[3]) is None
+    assert rest_pose(takes[1])[:3] == (4.5, 91.5, -427.2)
+    groups = actor_groups(takes)
+    assert groups.styles == {0: ["masculine", "normal"], 1: ["feminine"], 2: ["elderly"]}
+    assert groups.rest_poses[1] == rest_pose(takes[1]) and groups.rest_poses[2] is None
+    assert actor_groups(takes, rest_poses=False).styles == {0: ["elderly", "feminine", "masculine", "normal"]}
+    (tmp_path / "a.bvh").unlink()
+    with pytest.raises(MotionDataError, match="a.bvh"):
+        actor_groups(takes)
+
+
 @pytest.mark.realdata
-def test_bandai_walks_share_one_skeleton(bandai_zip_path: Path, tmp_path: Path) -> None:
-    """Issue 12 supposed three actors' skeletons among Bandai's styles (active/exhausted/elderly,
-    feminine/youthful, masculine/normal). The BVH files do name three rest positions of the Hips in those
-    groups, but every joint has position channels and the bone lengths are the same in all files: one
-    skeleton, so ``retarget`` moves no joint by more than float32 rounding here."""
+def test_bandai_walks_share_one_set_of_bones_and_three_rest_poses(bandai_zip_path: Path, tmp_path: Path) -> None:
+    """Bandai dataset-2's three actors (active/elderly/exhausted, feminine/youthful, masculine/normal): the bone
+    lengths are the same in all files (``retarget`` moves no joint by more than float32 rounding here), and each
+    actor's files name their own rest position of the Hips (overridden by its position channels): actor groups
+    come from the rest poses."""
     walks = load_dataset("bandai", root=bandai_zip_path, contents=["walk"], cache_dir=tmp_path, workers=1)
-    groups = actor_groups(walks.takes)
+    assert actor_groups(walks.takes).styles == {0: ["active", "elderly", "exhausted"], 1: ["feminine", "youthful"],
+                                                2: ["masculine", "normal"]}
+    groups = actor_groups(walks.takes, rest_poses=False)
     assert groups.styles == {0: ["active", "elderly", "exhausted", "feminine", "masculine", "normal", "youthful"]}
     assert spread_mm(walks.takes) < 0.001
     assert median_bone_lengths(walks.takes[0].positions)[BONE_NAMES.index("LowerLeg_L")] == pytest.approx(0.3908,

@@ -7,7 +7,7 @@ import pytest
 from conftest import BANDAI_MEMBERS, OTHER_SKELETONS, line_of, tiny_bvh_text
 
 from stylemotion.datasets.canonical import detect_unit_scale, resolve_joint_map
-from stylemotion.io.bvh import format_bvh, parse_bvh, read_bvh, snap_fps, write_bvh
+from stylemotion.io.bvh import format_bvh, parse_bvh, parse_bvh_skeleton, read_bvh, snap_fps, write_bvh
 from stylemotion.io.errors import BvhError
 
 ROUND_TRIP_TOL_M = 1e-5
@@ -369,3 +369,17 @@ def test_crlf_file_reads_like_lf(write_text):
     # Errors in a CRLF file still point at the right line.
     bad = text.replace("Frame Time: 0.0333333", "Frame Time: x").replace("\n", "\r\n")
     _expect_error(write_text(bad.encode(), "crlf_bad.bvh"), line_of(text, "Frame Time:"), "'x'")
+
+
+def test_skeleton_from_the_head_of_a_file_equals_the_full_parse() -> None:
+    text = tiny_bvh_text().replace("\n", "\r\n").encode()
+    full = parse_bvh(text, "walk.bvh").skeleton
+    for cut in (text.index(b"MOTION") + 6, text.index(b"Frame Time") + 3, len(text)):
+        head = parse_bvh_skeleton(text[:cut], "walk.bvh")
+        assert head.names == full.names and head.channels == full.channels
+        np.testing.assert_array_equal(head.offsets, full.offsets)
+        np.testing.assert_array_equal(head.parents, full.parents)
+    with pytest.raises(BvhError, match=r"walk.bvh.*line \d+.*expected 'MOTION'|walk.bvh.*MOTION"):
+        parse_bvh_skeleton(text[: text.index(b"MOTION") - 1], "walk.bvh")
+    with pytest.raises(BvhError, match="walk.bvh"):
+        parse_bvh_skeleton(text[:40], "walk.bvh")

@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 from stylemotion.io import sources
-from stylemotion.io.errors import LimitError
+from stylemotion.io.errors import LimitError, MotionDataError
 from stylemotion.io.sources import FileSource, list_sources
 
 
@@ -74,3 +74,20 @@ def test_zip_fingerprint_is_the_central_directory_crc(tmp_path):
     second = FileSource(str(archive), "m.bvh").fingerprint()
     assert second != first
     assert FileSource(str(archive), "m.bvh").read_bytes() == b"two"
+
+
+def test_read_head_stops_after_the_marker_and_at_the_bound(tmp_path, monkeypatch):
+    text = b"HIERARCHY\n" + b"x" * 300 + b"\nMOTION\n" + b"1 2 3\n" * 10_000
+    (tmp_path / "a.bvh").write_bytes(text)
+    with zipfile.ZipFile(tmp_path / "d.zip", "w", zipfile.ZIP_DEFLATED) as zf:
+        zf.writestr("m/a.bvh", text)
+    for source in (FileSource(str(tmp_path / "a.bvh")), FileSource(str(tmp_path / "d.zip"), "m/a.bvh")):
+        head = source.read_head(1_000_000, stop=b"MOTION", chunk=64)
+        assert b"MOTION" in head and text.startswith(head) and len(head) <= text.index(b"MOTION") + 6 + 64
+        assert source.read_head(100) == text[:100]
+        assert source.read_head(10 ** 9) == text  # a shorter file: all of it
+        assert FileSource.from_name(source.name) == source
+    with pytest.raises(MotionDataError, match="no such member"):
+        FileSource(str(tmp_path / "d.zip"), "gone.bvh").read_head(10)
+    with pytest.raises(MotionDataError, match="gone.bvh"):
+        FileSource(str(tmp_path / "gone.bvh")).read_head(10)

@@ -246,7 +246,8 @@ def test_per_sample_pooling_conditions_each_sample_on_one_seeded_clip(trained) -
 
 def test_the_networks_sample_pooling_is_what_bind_example_uses_and_one_clip_samples_alike(trained) -> None:
     """``sample_pooling`` (mean for the class and older checkpoints; the yaml's per_sample): the pooling of
-    :meth:`bind_example` unless named; one clip gives the same samples either way."""
+    :meth:`bind_example` unless named, and of ``sample(example=<clips>)``; one clip gives the same samples either
+    way."""
     from stylemotion.style_example.example import cut_examples
 
     model = trained[True].eval()
@@ -261,6 +262,11 @@ def test_the_networks_sample_pooling_is_what_bind_example_uses_and_one_clip_samp
         assert torch.equal(model.bind_example(clips).sample(20, seed=3).features,
                            model.sample(20, seed=3, example=model.per_sample_condition(clips, 20, 3)).features)
         assert model.bind_example(clips, pooling="mean").pooling == "mean"
+        # clips passed to sample() are bound first: the network's pooling, as stylemotion-style samples them
+        assert torch.equal(model.sample(20, seed=3, example=clips).features,
+                           model.bind_example(clips).sample(20, seed=3).features)
+        assert not torch.equal(model.sample(20, seed=3, example=clips).features,
+                               model.sample(20, seed=3, example=model.condition(clips)).features)
         one = model.bind_example(clips[:1]).sample(10, seed=5)
         model.set_sample_pooling("mean")
         assert torch.equal(one.features, model.bind_example(clips[:1]).sample(10, seed=5).features)
