@@ -69,7 +69,7 @@ centre. One clip samples the same either way.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -217,6 +217,24 @@ class ZeroShotStyleVAE(PrimitiveVAE):
         if centred and not self.hparams.anchor:
             raise ValueError("sample_centred needs anchor=true: the samples centre on their example")
         self.hparams["sample_centred"] = bool(centred)
+
+    def set_sampling(self, sampling: Mapping[str, Any]) -> None:
+        """Sample as ``sampling`` says from now on: its ``sample_temperature``, ``sample_centred`` (applied only where
+        the network has an anchor to centre on) and ``sample_pooling``; a key it lacks leaves that setting as it is
+        (e.g. ``configs/model/zero_shot.yaml``'s keys, or a style folder's record of them).
+
+        Raises:
+            ValueError: a value that is not a setting of its kind, naming it.
+        """
+        if "sample_temperature" in sampling:
+            self.set_sample_temperature(sampling["sample_temperature"])
+        if "sample_centred" in sampling:
+            centred = sampling["sample_centred"]
+            if not isinstance(centred, bool):
+                raise ValueError(f"sample_centred must be true or false, got {centred!r}")
+            self.set_sample_centred(centred and bool(self.hparams.anchor))
+        if "sample_pooling" in sampling:
+            self.set_sample_pooling(sampling["sample_pooling"])
 
     @property
     def sample_pooling(self) -> str:

@@ -222,10 +222,7 @@ class ZeroShotMethod(Method):
     def load(self, checkpoint: Path, primitive: str, clips: Sequence[Clip], records: Sequence[Mapping[str, Any]],
              name: str, neutral_style: str, autoencoder) -> EvalModel:
         network = load_generative(checkpoint, autoencoder)
-        defaults = sampling_defaults()
-        network.set_sample_temperature(defaults["sample_temperature"])
-        network.set_sample_centred(defaults["sample_centred"] and bool(network.hparams.anchor))
-        network.set_sample_pooling(defaults["sample_pooling"])
+        network.set_sampling(sampling_defaults())
         described = [{**describe_clip(c), "encoded_frames": network.timeline_frames, **dict(r)}
                      for c, r in zip(clips, records)]
         bound = network.bind_example(list(clips), name, described)
@@ -247,10 +244,11 @@ class ZeroShotMethod(Method):
 
     def entry(self, primitive: str, clips: Sequence[Clip], origin: Sequence[int] = (), examples: int = 1
               ) -> dict[str, Any]:
+        sampling = sampling_defaults()  # what load() applied: a loaded style samples as its report measured
         if examples == 1:
-            return {"method": "zero_shot", "example": EXAMPLE_FILE,
+            return {"method": "zero_shot", "example": EXAMPLE_FILE, "sampling": sampling,
                     "clips": [[int(c.start), int(c.stop)] for c in clips]}
-        return {"method": "zero_shot", "example": [example_file(i) for i in range(examples)],
+        return {"method": "zero_shot", "example": [example_file(i) for i in range(examples)], "sampling": sampling,
                 "clips": [[int(c.start), int(c.stop), int(i)] for c, i in zip(clips, origin)]}
 
 

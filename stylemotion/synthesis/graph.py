@@ -236,6 +236,8 @@ def _style_entry(entry: Mapping[str, Any], folder: Path) -> dict[str, Any]:
         out["example"] = (os.path.normpath(folder / files) if isinstance(files, str)
                           else [os.path.normpath(folder / f) for f in files])
         out["clips"] = [[int(v) for v in clip] for clip in entry["clips"]]
+    if isinstance(entry.get("sampling"), Mapping):  # how stylemotion-style sampled the network (folders since it)
+        out["sampling"] = dict(entry["sampling"])
     return out
 
 
@@ -243,7 +245,8 @@ def load_bound_style(entry: Mapping[str, Any], autoencoder=None) -> BoundExample
     """The zero-shot network of a style folder's entry (:func:`available_models`) bound again to the clips
     the style was made from: ``entry["example"]`` (``positions`` (frames, 21, 3) metres, ``fps``; or a list of such
     files) cut at ``entry["clips"]`` (``[start, stop]``, or ``[start, stop, file index]``), as ``stylemotion-style
-    method=zero_shot`` bound them.
+    method=zero_shot`` bound them, sampling as it sampled them (``entry["sampling"]``,
+    :meth:`ZeroShotStyleVAE.set_sampling`; folders made before that record: the checkpoint's own settings).
 
     Raises:
         FileNotFoundError: the checkpoint or the example file is gone.
@@ -262,6 +265,11 @@ def load_bound_style(entry: Mapping[str, Any], autoencoder=None) -> BoundExample
         with np.load(example) as npz:
             frames.append(positions_to_frames(npz["positions"], float(npz["fps"]))[0])
     clips = [_Frames(frames[clip[2] if len(clip) > 2 else 0][clip[0]:clip[1]]) for clip in entry["clips"]]
+    if entry.get("sampling"):
+        try:
+            network.set_sampling(entry["sampling"])
+        except ValueError as exc:
+            raise RunFolderError(f"style {entry['name']}: its recorded sampling is not usable: {exc}") from None
     return network.bind_example(clips, entry["name"])
 
 

@@ -127,6 +127,31 @@ def test_generate_and_load_bind_the_clips_of_both_examples_again(two) -> None:
         assert variation(loaded)["v_sd"] == pytest.approx(report["variation"][p]["samples"]["v_sd"], rel=1e-6)
 
 
+def test_a_loaded_style_samples_as_its_folder_records_not_as_its_checkpoint(two) -> None:
+    """The style folder records how stylemotion-style sampled its network (the yaml's settings); loading the style
+    applies that record, also where the checkpoint says otherwise (a network= trained before the setting); a folder
+    without the record keeps the checkpoint's own; a damaged record is refused naming the style."""
+    from stylemotion.synthesis.graph import RunFolderError, available_models, load_bound_style
+
+    out, _, made = two
+    entries = {e["primitive"]: e for e in available_models(out) if e["name"] == "pair"}
+    for p in PRIMITIVES:
+        entry = entries[p]
+        assert entry["sampling"] == {"sample_temperature": 1.0, "sample_centred": True, "sample_pooling": "per_sample"}
+        assert load_bound_style(entry).pooling == "per_sample"
+        mean = {**entry, "sampling": {**entry["sampling"], "sample_pooling": "mean"}}
+        bound = load_bound_style(mean)
+        assert bound.pooling == "mean" and bound.model.sample_temperature == 1.0 and bound.model.sample_centred
+        hot = load_bound_style({**entry, "sampling": {"sample_temperature": 0.5}})
+        assert hot.model.sample_temperature == 0.5 and hot.pooling == "per_sample"  # the rest: the checkpoint's
+        older = {k: v for k, v in entry.items() if k != "sampling"}
+        assert load_bound_style(older).pooling == load_bound_style(older).model.sample_pooling
+        with pytest.raises(RunFolderError, match="style pair: its recorded sampling is not usable: sample_pooling"):
+            load_bound_style({**entry, "sampling": {"sample_pooling": "median"}})
+        with pytest.raises(RunFolderError, match="sample_centred must be true or false, got 'yes'"):
+            load_bound_style({**entry, "sampling": {"sample_centred": "yes"}})
+
+
 def test_a_bad_item_of_the_list_is_refused_naming_it_and_writes_nothing(run: Path, tmp_path: Path) -> None:
     good = str(example_bvh(tmp_path))
     for items, message in (([good, f"{good}:0-20"], rf"^example\[2\]={good}:0-20: no complete step"),

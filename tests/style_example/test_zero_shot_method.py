@@ -21,6 +21,7 @@ from stylemotion.models.loading import load_generative
 from stylemotion.models.zero_shot import BoundExample, ZeroShotStyleVAE
 from stylemotion.style_example import StyleExampleError, add_style
 from stylemotion.style_example.evaluate import variation
+from stylemotion.style_example.zero_shot import sampling_defaults
 from stylemotion.synthesis import load_graph
 from stylemotion.synthesis.generate import generate
 
@@ -81,7 +82,8 @@ def test_the_networks_are_trained_in_the_command_on_every_style_and_the_report_i
                                 and e["encoded_frames"] == network.timeline_frames for e in examples)
         entry = next(e for e in report["meta"]["checkpoints"] if e["primitive"] == p)
         assert entry == {"path": checkpoint, "primitive": p, "name": "weary", "style": "weary", "method": "zero_shot",
-                         "example": "example/example.npz", "clips": [[e["start"], e["stop"]] for e in examples]}
+                         "example": "example/example.npz", "clips": [[e["start"], e["stop"]] for e in examples],
+                         "sampling": sampling_defaults()}  # how it sampled: loading the style samples the same
         cfg = yaml.safe_load((folder / "network" / p / "config_resolved.yaml").read_text())
         assert cfg["name"] == "zero_shot" and cfg["trainer"]["max_epochs"] == NETWORK_EPOCHS
         assert cfg["datamodule"]["exclude_styles"] == [] and cfg["seed"] == 0
