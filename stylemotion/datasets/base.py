@@ -100,14 +100,20 @@ class TakeSet:
 
     def split(
         self, seed: int = 0, val_fraction: float = 0.1, test_fraction: float = 0.1,
-        group_by: tuple[str, ...] = ("content", "style"),
+        group_by: tuple[str, ...] = ("content", "style"), test_actor: str | None = None,
     ) -> dict[str, list[Take]]:
         """Seeded split by take: each take is wholly in one of ``train``, ``val``, ``test``.
 
         Takes are shuffled within each group of equal ``group_by`` labels so that every group
         contributes to every split in proportion (a group of n takes gives
         ``round(n·fraction)`` to val and test, at least one each when n ≥ 3).
+
+        ``test_actor`` (``data.split.test_actor``, a style name): the actor split. Every take of the actor who
+        performed that style (:func:`stylemotion.datasets.retarget.actor_groups`; in Bandai the actor's other styles
+        too) is ``test``, and the other takes split into ``train`` and ``val`` as above (``test_fraction`` unused).
         """
+        if test_actor is not None:
+            return self._actor_split(seed, val_fraction, group_by, test_actor)
         if not 0 <= val_fraction < 1 or not 0 <= test_fraction < 1 or val_fraction + test_fraction >= 1:
             raise ConfigError(f"data.split: fractions must be in [0, 1) and sum below 1, got val={val_fraction}, "
                              f"test={test_fraction}")
@@ -130,6 +136,27 @@ class TakeSet:
             out["train"].extend(picks[n_val + n_test:])
         for part in out.values():
             part.sort(key=lambda t: t.name)
+        return out
+
+    def _actor_split(self, seed: int, val_fraction: float, group_by: tuple[str, ...], test_actor: Any
+                     ) -> dict[str, list[Take]]:
+        """:meth:`split` with ``test_actor``: that actor's takes as ``test``, the rest split into train and val."""
+        from stylemotion.datasets.retarget import actor_groups
+
+        styles = self.label_values("style")
+        if not isinstance(test_actor, str) or test_actor not in styles:
+            raise ConfigError(f"data.split.test_actor must name a style of dataset {self.name!r} (its actor's takes "
+                              f"become the test split; null: split by take), got {test_actor!r}; its styles are "
+                              f"{styles}")
+        groups = actor_groups(self.takes)
+        held = {g for g, members in groups.styles.items() if test_actor in members}
+        test = [t for t in self.takes if groups.takes[t.name] in held]
+        rest = [t for t in self.takes if groups.takes[t.name] not in held]
+        if not rest:
+            raise ConfigError(f"data.split.test_actor={test_actor!r}: every take of dataset {self.name!r} is that "
+                              "actor's; an actor split needs the takes of another actor to train on")
+        out = TakeSet(self.name, rest, self.fps).split(seed, val_fraction, 0.0, group_by)
+        out["test"] = sorted(test, key=lambda t: t.name)
         return out
 
 

@@ -11,6 +11,7 @@ import pytest
 from conftest import tiny_bvh_text
 
 from stylemotion.bones import BONE_NAMES, NUM_BONES, median_bone_lengths
+from stylemotion.config import ConfigError
 from stylemotion.datasets import Take, TakeSet, data_config_key, load_dataset
 from stylemotion.datasets.retarget import actor_groups, rest_pose, retarget_takeset
 from stylemotion.io.errors import MotionDataError
@@ -140,6 +141,30 @@ def test_actor_groups_split_one_set_of_bones_by_the_files_rest_poses(tmp_path: P
     (tmp_path / "a.bvh").unlink()
     with pytest.raises(MotionDataError, match="a.bvh"):
         actor_groups(takes)
+
+
+def test_the_actor_split_tests_on_every_take_of_the_named_styles_actor(tmp_path: Path) -> None:
+    """``data.split.test_actor``: the actor who performed the style (by rest pose) is the test split, all of their
+    styles; the other actor's takes split into train and val; a style that is not there, or an actor who is every
+    take, is refused naming the key."""
+    moved = tiny_bvh_text().replace("OFFSET 0.0 0.0 0.0", "OFFSET 4.5 91.5 -427.2", 1)
+    (tmp_path / "a.bvh").write_text(tiny_bvh_text())
+    (tmp_path / "b.bvh").write_text(moved)
+    names = [f"{style}_{i}" for style in ("normal", "masculine", "feminine", "youthful") for i in range(4)]
+    takes = [replace(skeleton_take(n, n.split("_")[0]),
+                     source=str(tmp_path / ("b.bvh" if n.startswith(("feminine", "youthful")) else "a.bvh")))
+             for n in names]
+    data = TakeSet("actors", sorted(takes, key=lambda t: t.name), 30.0)
+    parts = data.split(seed=3, val_fraction=0.25, test_fraction=0.5, test_actor="youthful")
+    assert {t.style for t in parts["test"]} == {"feminine", "youthful"} and len(parts["test"]) == 8
+    assert {t.style for t in parts["train"] + parts["val"]} == {"masculine", "normal"}
+    assert sorted(t.name for p in parts.values() for t in p) == sorted(names)
+    assert len(parts["val"]) == 2 and parts == data.split(seed=3, val_fraction=0.25, test_actor="youthful")
+    with pytest.raises(ConfigError, match=r"data.split.test_actor must name a style .* got 'sleepy'.*'youthful'"):
+        data.split(test_actor="sleepy")
+    alone = TakeSet("one", [t for t in data.takes if t.style in ("feminine", "youthful")], 30.0)
+    with pytest.raises(ConfigError, match="every take of dataset 'one' is that actor's"):
+        alone.split(test_actor="feminine")
 
 
 @pytest.mark.realdata
