@@ -376,7 +376,10 @@ def _ranks(feature_indexes: dict[str, Any], seeds: list[int], frames: int, k: in
             "rho": {a: {b: spread(s[a][b] for s in per_seed) for b in names} for a in names}}
 
 
-def retrieval_by_content(index: Any, takes: list[Any], seeds: list[int], seconds: float, k: int) -> dict[str, Any]:
+def retrieval_by_content(index: Any, takes: list[Any], seeds: list[int], seconds: float, k: int,
+                         **options: Any) -> dict[str, Any]:
+    """Precision@10 by content of one random ``seconds`` window of each take per seed (``options``: further
+    :func:`stylemotion.search.search_features` settings, e.g. the command's growth, refinement and verification)."""
     from stylemotion.search import search_features
     from stylemotion.search.evaluation import precision_at
 
@@ -392,7 +395,8 @@ def retrieval_by_content(index: Any, takes: list[Any], seeds: list[int], seconds
         seed_turns: dict[str, Counter] = defaultdict(Counter)
         for take in usable:
             start = int(rng.integers(0, take.num_frames - m + 1))
-            found = search_features(index.features_of(take.positions[start:start + m]), index, k, 10).matches
+            found = search_features(index.features_of(take.positions[start:start + m]), index, k, 10,
+                                    **options).matches
             contents = [f.content for f in found]
             row = {"p10": precision_at(contents, take.content, 10), "found": len(found), "none": not found,
                    "found_precision": (sum(c == take.content for c in contents) / len(contents)) if contents else None}

@@ -13,9 +13,14 @@ Per left-out actor: the queries are one random 2 s window of each of that actor'
 * **same-actor**: against the train + val takes of every actor (suite ``search``'s database: easier, the query's
   actor, content and style are in it),
 
-with E15 features, the command's ``k`` (:data:`stylemotion.search.DEFAULT_K`, chosen on validation queries by
-suite ``search``) and 10 matches, by suite ``search``'s :func:`suites.search.retrieval_by_content`: precision@10
-by content, a query without a match counts as ten wrong ones. Nothing is chosen here.
+with E15 features and 10 matches, by suite ``search``'s :func:`suites.search.retrieval_by_content`, searched two ways:
+
+* **LNG, k = 1024**: the LNG alone at the command's first ``k`` (:data:`stylemotion.search.DEFAULT_K`, chosen on
+  validation queries by suite ``search``), as suite ``search``'s retrieval figure;
+* **the command's defaults**: as ``stylemotion-search`` searches (:class:`stylemotion.search.settings.SearchSettings`:
+  ``k`` growing until the best match holds, re-ranking by exact DTW, the best match verified).
+
+Precision@10 by content counts a missing match as a wrong one. Nothing is chosen here.
 """
 
 from __future__ import annotations
@@ -39,10 +44,20 @@ DESCRIPTION = ("search retrieval by content across Bandai's actors: the query's 
 DEFAULT_SEEDS = (0, 1, 2)
 #: The two databases of each left-out actor.
 ARMS = ("cross_actor", "same_actor")
+#: The two ways of searching (see the module doc).
+SEARCHES = {"lng": "LNG, k = 1024", "command": "the command's defaults"}
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--query-s", type=float, default=2.0, help="query length, s (suite search's retrieval)")
+
+
+def command_options() -> dict[str, Any]:
+    """``stylemotion-search``'s defaults beyond ``k`` (:class:`~stylemotion.search.settings.SearchSettings`)."""
+    from stylemotion.search.settings import SearchSettings
+
+    d = SearchSettings()
+    return {"k_max": d.k_max, "grow": d.grow, "stable_for": d.stable_for, "refine": d.refine, "verify": d.verify}
 
 
 def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
@@ -57,19 +72,24 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
     groups = actor_groups(bandai.takes)
     database = split["train"] + split["val"]
     same = FrameIndex.build(TakeSet("bandai-train+val", database, bandai.fps), "E15")
+    options = {"lng": {}, "command": command_options()}
     actors = []
     for g in sorted(groups.styles):
         styles = groups.styles[g]
         queries = [t for t in split["test"] if t.style in styles]
         others = [t for t in database if t.style not in styles]
         cross = FrameIndex.build(TakeSet(f"bandai-train+val-without-{'+'.join(styles)}", others, bandai.fps), "E15")
+        indexes = {"cross_actor": cross, "same_actor": same}
         actors.append({"styles": styles, "query_takes": len(queries), "database_frames": {
-            "cross_actor": int(cross.database.num_frames), "same_actor": int(same.database.num_frames)},
-            "cross_actor": retrieval_by_content(cross, queries, seeds, args.query_s, DEFAULT_K),
-            "same_actor": retrieval_by_content(same, queries, seeds, args.query_s, DEFAULT_K)})
-        print(f"actor {'/'.join(styles)}: p@10 cross {actors[-1]['cross_actor']['all']['p10']['mean']:.3f}, same "
-              f"{actors[-1]['same_actor']['all']['p10']['mean']:.3f}", flush=True)
-    return {"k": DEFAULT_K, "features": "E15", "query_s": args.query_s, "actors": actors,
+            arm: int(index.database.num_frames) for arm, index in indexes.items()},
+            **{arm: {way: retrieval_by_content(index, queries, seeds, args.query_s, DEFAULT_K, **options[way])
+                     for way in SEARCHES} for arm, index in indexes.items()}})
+        print(f"actor {'/'.join(styles)}: p@10 cross " + ", ".join(
+            f"{way} {actors[-1]['cross_actor'][way]['all']['p10']['mean']:.3f}" for way in SEARCHES)
+              + ", same " + ", ".join(f"{way} {actors[-1]['same_actor'][way]['all']['p10']['mean']:.3f}"
+                                      for way in SEARCHES), flush=True)
+    return {"k": DEFAULT_K, "command_options": options["command"], "features": "E15", "query_s": args.query_s,
+            "actors": actors,
             "splits": {"kind": "Bandai's take split (configs/data/bandai.yaml); actors by rest pose",
                        "queries": "the left-out actor's test takes", "database": "train + val takes",
                        "parts": take_split_record(split, settings["seed"], settings["val_fraction"],
@@ -81,22 +101,28 @@ def render(record: dict[str, Any]) -> dict[str, str]:
     rows = []
     for actor in r["actors"]:
         for arm, text in (("cross_actor", "other actors only"), ("same_actor", "every actor (the query's too)")):
-            ret = actor[arm]
-            rows.append(["/".join(actor["styles"]), text, f"{actor['database_frames'][arm]:,}",
-                         f"{actor['query_takes']}", fmt_spread(ret["all"]["p10"], 3),
-                         fmt(ret["all"]["none"]["max"], 0), fmt_spread(ret["all"]["found_precision"], 3)])
-    worst = min(actor["cross_actor"]["all"]["p10"]["mean"] for actor in r["actors"])
-    contents = sorted(r["actors"][0]["cross_actor"]["by_content"])
-    content_rows = [[c, *(fmt_spread(actor[arm]["by_content"][c]["p10"], 2) for actor in r["actors"]
+            for way, name in SEARCHES.items():
+                ret = actor[arm][way]
+                rows.append(["/".join(actor["styles"]), text, f"{actor['database_frames'][arm]:,}", name,
+                             f"{actor['query_takes']}", fmt_spread(ret["all"]["p10"], 3),
+                             fmt(ret["all"]["none"]["max"], 0), fmt_spread(ret["all"]["found_precision"], 3)])
+    lowest = {way: min(actor["cross_actor"][way]["all"]["p10"]["mean"] for actor in r["actors"]) for way in SEARCHES}
+    contents = sorted(r["actors"][0]["cross_actor"]["command"]["by_content"])
+    content_rows = [[c, *(fmt_spread(actor[arm]["command"]["by_content"][c]["p10"], 2) for actor in r["actors"]
                           for arm in ARMS)] for c in contents]
     by_content = md_table(["content", *(f"{'/'.join(actor['styles'])}: {arm.replace('_', '-')}"
                                         for actor in r["actors"] for arm in ARMS)], content_rows)
+    opts = r["command_options"]
     n = len(record.get("seeds") or [])
-    text = (md_table(["left-out actor (styles)", "database", "database frames", "query takes", "precision@10",
-                      "queries without a match (max per seed)", "precision of the matches found"], rows)
+    text = (md_table(["left-out actor (styles)", "database", "database frames", "search", "query takes",
+                      "precision@10", "queries without a match (max per seed)", "precision of the matches found"],
+                     rows)
             + f"\n\nOne random {fmt(r['query_s'], 0)} s window of each of the actor's test takes per seed ({n} "
-            f"seeds), E15 features, k = {r['k']} (the command's default, chosen on validation by suite `search`), "
-            f"10 matches; precision@10 by content counts a missing match as a wrong one; mean ± sd over seeds. "
-            f"Lowest cross-actor precision@10 of an actor: {fmt(worst, 3)}. {provenance_line(record)}"
-            f"\n\nPrecision@10 by content, mean ± sd over seeds.\n\n{by_content}")
+            f"seeds), E15 features, 10 matches; LNG: k = {r['k']} alone (chosen on validation by suite `search`); "
+            f"the command's defaults: k from {r['k']} growing ({opts['grow']}) up to {opts['k_max']:,}, refine "
+            f"{opts['refine']}, verify {str(opts['verify']).lower()}. Precision@10 by content counts a missing match "
+            f"as a wrong one; mean ± sd over seeds. Lowest cross-actor precision@10 of an actor: "
+            + ", ".join(f"{SEARCHES[way]} {fmt(v, 3)}" for way, v in lowest.items())
+            + f". {provenance_line(record)}\n\nPrecision@10 by content with the command's defaults, mean ± sd over "
+            f"seeds.\n\n{by_content}")
     return {"headline": text}
