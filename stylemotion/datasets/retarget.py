@@ -21,6 +21,7 @@ from stylemotion.bones import BONE_NAMES, median_bone_lengths, retarget_position
 from stylemotion.config import ConfigError
 from stylemotion.datasets.base import Take, TakeSet
 from stylemotion.io.bvh import MAX_HIERARCHY_BYTES, parse_bvh_skeleton
+from stylemotion.io.errors import BvhError
 from stylemotion.io.sources import FileSource
 
 #: Default tolerance of :func:`actor_groups`: two takes share a skeleton when no bone differs by more, metres.
@@ -113,7 +114,10 @@ def bvh_rest_pose(source: FileSource) -> tuple[float, ...]:
         MotionDataError, BvhError: the file cannot be read or its hierarchy is malformed, naming it.
     """
     head = source.read_head(MAX_HIERARCHY_BYTES, stop=b"MOTION")
-    offsets = parse_bvh_skeleton(head, source.name).offsets
+    try:
+        offsets = parse_bvh_skeleton(head, source.name).offsets
+    except BvhError:  # "MOTION" inside a joint's name stopped the read early: read on, to the bound
+        offsets = parse_bvh_skeleton(source.read_head(MAX_HIERARCHY_BYTES), source.name).offsets
     return tuple(round(float(v), 3) for v in np.asarray(offsets, dtype=np.float64).ravel())
 
 

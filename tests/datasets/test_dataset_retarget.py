@@ -134,6 +134,15 @@ def test_actor_groups_split_one_set_of_bones_by_the_files_rest_poses(tmp_path: P
     takes = [replace(skeleton_take(name, name.split("_")[1]), source=source) for name, source in sources.items()]
     assert rest_pose(takes[0]) == rest_pose(takes[2]) != rest_pose(takes[1]) and rest_pose(takes[3]) is None
     assert rest_pose(takes[1])[:3] == (4.5, 91.5, -427.2)
+    # "MOTION" in a joint's name, in a hierarchy longer than one read: the read stops early, then reads on
+    chain = "".join(f"JOINT J{i}{'MOTION' if i == 1 else ''}\n{{\nOFFSET 0 {i % 7} 1\nCHANNELS 3 Zrotation Xrotation "
+                    f"Yrotation\n" for i in range(3000))
+    long = (f"HIERARCHY\nROOT R\n{{\nOFFSET 0 0 0\nCHANNELS 3 Zrotation Xrotation Yrotation\n{chain}"
+            f"End Site\n{{\nOFFSET 0 1 0\n}}\n" + "}\n" * 3001 + f"MOTION\nFrames: 1\nFrame Time: 0.1\n{'0 ' * 9003}\n")
+    assert len(long.split("MOTION\nFrames")[0]) > 1 << 16
+    (tmp_path / "long.bvh").write_text(long)
+    pose = rest_pose(replace(takes[0], source=str(tmp_path / "long.bvh")))
+    assert len(pose) == 3 * 3001 and pose[3 * 5:3 * 6] == (0.0, 4.0, 1.0)
     groups = actor_groups(takes)
     assert groups.styles == {0: ["masculine", "normal"], 1: ["feminine"], 2: ["elderly"]}
     assert groups.rest_poses[1] == rest_pose(takes[1]) and groups.rest_poses[2] is None
