@@ -1,7 +1,7 @@
 """Suite ``actors``: how many actors (actor groups) each data set holds, i.e. which cross-actor splits exist.
 
 A cross-actor split needs to know which take is whose; Bandai's labels name content and style only, so
-:func:`stylemotion.datasets.retarget.actor_groups` groups takes by their skeletons: bone lengths within 1 mm and
+:func:`stylemotion.datasets.actors.actor_groups` groups takes by their skeletons: bone lengths within 1 mm and
 one rest pose in their BVH files. This suite measures how far the bone lengths differ between takes, how many
 groups the bones alone give and how many the rest poses add, and which styles each group holds.
 """
@@ -20,8 +20,8 @@ DEFAULT_SEEDS = (0,)  # deterministic: no training or sampling
 
 def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
     from stylemotion.bones import median_bone_lengths
+    from stylemotion.datasets.actors import ACTOR_TOLERANCE_M, actor_groups
     from stylemotion.datasets.registry import load_dataset
-    from stylemotion.datasets.retarget import ACTOR_TOLERANCE_M, actor_groups
 
     bandai = load_dataset("bandai", root=str(DATA_ROOT / "bandai-namco-motion-2" / "data.zip"))
     lengths = np.stack([median_bone_lengths(t.positions) for t in bandai.takes])  # (takes, 20) m

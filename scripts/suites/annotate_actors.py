@@ -4,7 +4,7 @@ templates from other actors beside templates that saw the document's actor; issu
     python scripts/benchmarks.py run annotate_actors
 
 Bandai dataset-2's three actors are told apart by the rest poses of their files
-(:func:`stylemotion.datasets.retarget.actor_groups`, suite ``actors``), and every actor performed every content.
+(:func:`stylemotion.datasets.actors.actor_groups`, suite ``actors``), and every actor performed every content.
 Per seed and left-out actor, the documents are that actor's **test** takes (Bandai's split,
 ``configs/data/bandai.yaml``), every take once in a seeded order, joined by 8 unlabelled blend frames into documents
 of at least 40 s, and the same takes cut to their middle 2–3 s and joined the same way (suite ``annotate``'s two
@@ -49,7 +49,7 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
     from stylemotion.annotate.command import annotate_positions
     from stylemotion.annotate.documents import partition_documents
     from stylemotion.annotate.model import learn_model
-    from stylemotion.datasets.retarget import actor_groups
+    from stylemotion.datasets.actors import actor_groups
 
     takeset, split, split_cfg = _load_bandai()
     fps = float(takeset.fps)

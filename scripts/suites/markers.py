@@ -16,7 +16,7 @@ Per seed: Bandai is split by take (``TakeSet.split(seed, 0.1, 0.1)``, grouped by
   beside them the nearest-neighbour baseline and
   the **floor**: the database pose (on the same skeleton, in the markers' frame) nearest to the truth in all
   joints, which the k-NN alone cannot beat.
-* **Bandai leave-actor-out**: :func:`stylemotion.datasets.retarget.actor_groups` finds Bandai's three actors by
+* **Bandai leave-actor-out**: :func:`stylemotion.datasets.actors.actor_groups` finds Bandai's three actors by
   the rest poses of their files (suite ``actors``); every actor performed every content, so leaving one out is a
   cross-actor test of reconstruction. Seed ``s`` leaves actor group ``s mod 3`` out of the database (train takes of
   the other actors); the marker-only feature set, ``k`` and the local model's prior weight are chosen together on
@@ -194,8 +194,8 @@ def _leave_actor_out(args, bandai, parts, rng, actor: list[str]) -> dict[str, An
 
 def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
     os.environ.setdefault("OMP_NUM_THREADS", "1")
+    from stylemotion.datasets.actors import actor_groups
     from stylemotion.datasets.registry import load_dataset
-    from stylemotion.datasets.retarget import actor_groups
     from stylemotion.reconstruct.benchmark import database_of
 
     bandai = load_dataset("bandai", root=str(DATA_ROOT / "bandai-namco-motion-2" / "data.zip"))

@@ -157,8 +157,8 @@ def _synthesis(model, real: list[np.ndarray]) -> dict[str, Any]:
 
 
 def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
+    from stylemotion.datasets.actors import actor_groups
     from stylemotion.datasets.registry import load_dataset
-    from stylemotion.datasets.retarget import actor_groups
     from stylemotion.multilinear.compare import PCA
     from stylemotion.multilinear.model import build_model
 

@@ -4,7 +4,7 @@ the query's actor out of the database beside the same-actor ones).
     python scripts/benchmarks.py run search_actors
 
 Bandai dataset-2's three actors are told apart by the rest poses of their files
-(:func:`stylemotion.datasets.retarget.actor_groups`, suite ``actors``), and every actor performed every content.
+(:func:`stylemotion.datasets.actors.actor_groups`, suite ``actors``), and every actor performed every content.
 Per left-out actor: the queries are one random 2 s window of each of that actor's **test** takes (Bandai's split,
 ``configs/data/bandai.yaml``), per seed; each is searched
 
@@ -62,7 +62,7 @@ def command_options() -> dict[str, Any]:
 
 def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
     from stylemotion.datasets import TakeSet, load_dataset
-    from stylemotion.datasets.retarget import actor_groups
+    from stylemotion.datasets.actors import actor_groups
     from stylemotion.search import DEFAULT_K, FrameIndex
 
     bandai = load_dataset("bandai", root=str(DATA_ROOT / "bandai-namco-motion-2" / "data.zip"), workers=2)

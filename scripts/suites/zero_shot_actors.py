@@ -44,14 +44,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def actor_groups(data_cfg: dict[str, Any], styles: list[str], contents: tuple[str, ...] = ("walk",)
                  ) -> dict[str, list[str]]:
     """Style → the styles of its actor: styles whose takes (of ``contents``) share one skeleton rest pose (every
-    joint's rest offset, file units, to 1e-3: :func:`stylemotion.datasets.retarget.bvh_rest_pose`, the rest pose
-    :func:`~stylemotion.datasets.retarget.actor_groups` splits by), read from the BVH files' hierarchies in
+    joint's rest offset, file units, to 1e-3: :func:`stylemotion.datasets.actors.bvh_rest_pose`, the rest pose
+    :func:`~stylemotion.datasets.actors.actor_groups` splits by), read from the BVH files' hierarchies in
     ``data_cfg["root"]`` (Bandai's zip).
 
     Raises:
         SystemExit: a style whose takes have several rest poses (no actor per style), or none found.
     """
-    from stylemotion.datasets.retarget import bvh_rest_pose
+    from stylemotion.datasets.actors import bvh_rest_pose
     from stylemotion.io.sources import list_sources
 
     poses: dict[str, set[tuple[float, ...]]] = {s: set() for s in styles}

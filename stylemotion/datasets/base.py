@@ -109,7 +109,7 @@ class TakeSet:
         ``round(n·fraction)`` to val and test, at least one each when n ≥ 3).
 
         ``test_actor`` (``data.split.test_actor``, a style name): the actor split. Every take of the actor who
-        performed that style (:func:`stylemotion.datasets.retarget.actor_groups`; in Bandai the actor's other styles
+        performed that style (:func:`stylemotion.datasets.actors.actor_groups`; in Bandai the actor's other styles
         too) is ``test``, and the other takes split into ``train`` and ``val`` as above (``test_fraction`` unused).
         """
         if test_actor is not None:
@@ -141,7 +141,7 @@ class TakeSet:
     def _actor_split(self, seed: int, val_fraction: float, group_by: tuple[str, ...], test_actor: Any
                      ) -> dict[str, list[Take]]:
         """:meth:`split` with ``test_actor``: that actor's takes as ``test``, the rest split into train and val."""
-        from stylemotion.datasets.retarget import actor_groups
+        from stylemotion.datasets.actors import actor_groups
 
         styles = self.label_values("style")
         if not isinstance(test_actor, str) or test_actor not in styles:

@@ -13,7 +13,8 @@ from conftest import tiny_bvh_text
 from stylemotion.bones import BONE_NAMES, NUM_BONES, median_bone_lengths
 from stylemotion.config import ConfigError
 from stylemotion.datasets import Take, TakeSet, data_config_key, load_dataset
-from stylemotion.datasets.retarget import actor_groups, rest_pose, retarget_takeset
+from stylemotion.datasets.actors import actor_groups, rest_pose
+from stylemotion.datasets.retarget import retarget_takeset
 from stylemotion.io.errors import MotionDataError
 from stylemotion.skeleton import CANONICAL_PARENTS, JOINT_INDEX, NUM_JOINTS, forward_kinematics
 
