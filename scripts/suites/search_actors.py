@@ -104,7 +104,7 @@ def render(record: dict[str, Any]) -> dict[str, str]:
             for way, name in SEARCHES.items():
                 ret = actor[arm][way]
                 rows.append(["/".join(actor["styles"]), text, f"{actor['database_frames'][arm]:,}", name,
-                             f"{actor['query_takes']}", fmt_spread(ret["all"]["p10"], 3),
+                             f"{ret['queries_per_seed']} of {actor['query_takes']}", fmt_spread(ret["all"]["p10"], 3),
                              fmt(ret["all"]["none"]["max"], 0), fmt_spread(ret["all"]["found_precision"], 3)])
     lowest = {way: min(actor["cross_actor"][way]["all"]["p10"]["mean"] for actor in r["actors"]) for way in SEARCHES}
     contents = sorted(r["actors"][0]["cross_actor"]["command"]["by_content"])
@@ -114,7 +114,8 @@ def render(record: dict[str, Any]) -> dict[str, str]:
                                         for actor in r["actors"] for arm in ARMS)], content_rows)
     opts = r["command_options"]
     n = len(record.get("seeds") or [])
-    text = (md_table(["left-out actor (styles)", "database", "database frames", "search", "query takes",
+    text = (md_table(["left-out actor (styles)", "database", "database frames", "search",
+                      "queries per seed (test takes ≥ the query length, of all)",
                       "precision@10", "queries without a match (max per seed)", "precision of the matches found"],
                      rows)
             + f"\n\nOne random {fmt(r['query_s'], 0)} s window of each of the actor's test takes per seed ({n} "

@@ -17,7 +17,7 @@ from suites.common import spread  # noqa: E402
 def retrieval(p10: list[float], none: list[float]) -> dict:
     figures = {"p10": spread(p10), "none": spread(none), "found_precision": spread([0.9] * len(p10)),
                "found": spread([9.0] * len(p10)), "queries": spread([20.0] * len(p10))}
-    return {"all": figures, "by_content": {"walk": figures, "run": figures}}
+    return {"all": figures, "by_content": {"walk": figures, "run": figures}, "queries_per_seed": 18}
 
 
 def both(lng: dict, command: dict) -> dict:
@@ -45,8 +45,8 @@ def test_the_block_sets_each_actors_cross_actor_rows_beside_its_same_actor_rows(
     assert [line.split(" | ")[1:4:2] for line in lines] == [
         ["other actors only", "LNG, k = 1024"], ["other actors only", "the command's defaults"],
         ["every actor (the query's too)", "LNG, k = 1024"], ["every actor (the query's too)", "the command's defaults"]]
-    assert "| 1,000 | LNG, k = 1024 | 20 | 0.600 ± 0.100 | 4 |" in lines[0]
-    assert "| 3,000 | the command's defaults | 20 | 0.900 ± 0.000 | 0 |" in lines[3]
+    assert "| 1,000 | LNG, k = 1024 | 18 of 20 | 0.600 ± 0.100 | 4 |" in lines[0]
+    assert "| 3,000 | the command's defaults | 18 of 20 | 0.900 ± 0.000 | 0 |" in lines[3]
     assert "Lowest cross-actor precision@10 of an actor: LNG, k = 1024 0.600, the command's defaults 0.600." in text
     assert "k from 1024 growing (stable) up to 16,384, refine 8, verify true" in text
     assert "| walk | 0.80 ± 0.10 | 0.90 ± 0.00 | 0.60 ± 0.00 | 1.00 ± 0.00 |" in text  # the command's, by content
