@@ -19,11 +19,19 @@ from __future__ import annotations
 
 import argparse
 import time
-from pathlib import Path
 from typing import Any
 
 import numpy as np
-from suites.common import DATA_ROOT, fmt, fmt_spread, md_table, provenance_line, spread, take_split_record
+from suites.common import (
+    DATA_ROOT,
+    bandai_split_settings,
+    fmt,
+    fmt_spread,
+    md_table,
+    provenance_line,
+    spread,
+    take_split_record,
+)
 
 DESCRIPTION = ("annotation by motion templates (Table 3.2) and style by class motion tensors on Bandai: τ, "
                "min_run, key frames and tensor repetitions chosen on val takes, reported on test takes; "
@@ -154,14 +162,9 @@ class _Annotated:
 
 
 def _load_bandai():
-    from omegaconf import OmegaConf
-
-    import stylemotion.configs
     from stylemotion.datasets.registry import load_dataset
 
-    cfg = OmegaConf.load(Path(stylemotion.configs.__file__).parent / "data" / "bandai.yaml")
-    split_cfg = {"seed": int(cfg.split.seed), "val_fraction": float(cfg.split.val_fraction),
-                 "test_fraction": float(cfg.split.test_fraction)}
+    split_cfg = bandai_split_settings()
     takeset = load_dataset("bandai", root=str(DATA_ROOT / "bandai-namco-motion-2" / "data.zip"))
     return takeset, takeset.split(split_cfg["seed"], split_cfg["val_fraction"], split_cfg["test_fraction"]), split_cfg
 
