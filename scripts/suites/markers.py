@@ -138,9 +138,9 @@ def _other_captures(args, database, chosen: dict[str, Any], rng: np.random.Gener
             "files": files}
 
 
-def _leave_actor_out(args, bandai, parts, rng, actor: list[str]) -> dict[str, Any]:
+def _leave_actor_out(args, bandai, parts, rng, actor: list[str], everyone) -> dict[str, Any]:
     """The Bandai arm: the styles of one actor group (``actor``) out of the database, chosen on their val takes and
-    reported on their test takes."""
+    reported on their test takes; beside it the same queries against ``everyone`` (the seed's whole train database)."""
     from stylemotion.reconstruct import SparseReconstructor
     from stylemotion.reconstruct.benchmark import (
         bone_length_spread_cm,
@@ -171,7 +171,7 @@ def _leave_actor_out(args, bandai, parts, rng, actor: list[str]) -> dict[str, An
     best = candidates[choose_setting({i: c["val_mean_cm"] for i, c in enumerate(candidates)})]
     chosen = {key: best[key] for key in ("features", "k", "prior_weight")}
     rec = SparseReconstructor(database, SKIN_MARKERS, **chosen)
-    with_actor = SparseReconstructor(database_of("bandai-train", parts["train"], bandai.fps), SKIN_MARKERS, **chosen)
+    with_actor = SparseReconstructor(everyone, SKIN_MARKERS, **chosen)
     ours, nn, unheld, same, spread_held, spread_unheld = [], [], [], [], [], []
     for q, m in zip(queries["test"], markers["test"]):
         rec.hold_bones = True
@@ -207,9 +207,9 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
         parts = bandai.split(seed, VAL_FRACTION, TEST_FRACTION, group_by=("content", "style"))
         splits.append(take_split_record(parts, seed, VAL_FRACTION, TEST_FRACTION))
         rng = np.random.default_rng(seed)
-        bandai_part = _leave_actor_out(args, bandai, parts, rng, actors[seed % len(actors)])
-        other = _other_captures(args, database_of("bandai-train", parts["train"], bandai.fps), bandai_part["chosen"],
-                               rng)
+        everyone = database_of("bandai-train", parts["train"], bandai.fps)
+        bandai_part = _leave_actor_out(args, bandai, parts, rng, actors[seed % len(actors)], everyone)
+        other = _other_captures(args, everyone, bandai_part["chosen"], rng)
         per_seed.append({"seed": seed, "bandai": bandai_part, "other": other,
                          "seconds": round(time.perf_counter() - started, 1)})
         print(f"seed {seed}: actor of {'/'.join(bandai_part['actor_styles'])} chose {bandai_part['chosen']}: "

@@ -74,8 +74,7 @@ class ExampleSpec:
 
     @property
     def source(self) -> FileSource:
-        path = str(Path(self.path).expanduser()) if "::" not in self.path else self.path
-        return FileSource(*path.split("::", 1)) if "::" in path else FileSource(path)
+        return FileSource.from_name(self.path if "::" in self.path else str(Path(self.path).expanduser()))
 
     def __str__(self) -> str:
         return self.path if self.start is None else f"{self.path}:{self.start}-{self.end}"

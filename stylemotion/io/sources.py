@@ -193,7 +193,7 @@ class FileSource:
     def from_name(cls, name: str) -> FileSource:
         """The source a :attr:`name` names: ``archive.zip::member`` or a path."""
         path, sep, member = name.partition("::")
-        return cls(path, member) if sep and member else cls(name)
+        return cls(path, member) if sep else cls(name)
 
     def fingerprint(self, max_file_mb: float | None = None) -> str:
         """Changes whenever the content does: CRC-32 and size of a zip member, SHA-256 of a file.
