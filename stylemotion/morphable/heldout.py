@@ -52,7 +52,7 @@ def _selection(vectors: np.ndarray, error):
 def compare_reductions(train: Sequence[Clip], heldout: Mapping[str, Sequence[Clip]], dims: Sequence[int],
                        methods: Sequence[str] = METHODS, num_coefficients: int | None = None,
                        rmse_cutoff_m: float = 0.01, iterations: int = 30, representation: str = "quaternion",
-                       given: Mapping[str, FunctionalPCA] | None = None) -> dict[str, Any]:
+                       given: Mapping[str, FunctionalPCA] | None = None, per_clip: bool = False) -> dict[str, Any]:
     """Joint-space RMSE (m) of each reduction at each latent size, on ``train`` and on each held-out part.
 
     Args:
@@ -65,7 +65,8 @@ def compare_reductions(train: Sequence[Clip], heldout: Mapping[str, Sequence[Cli
             model's), scored at its own latent size instead of being fitted again.
 
     Returns:
-        ``{"K", "timeline", "clips": {part: n}, "rows": [{"dims", "method", "rmse_m": {part: m}, "sfpca": record}]}``.
+        ``{"K", "timeline", "clips": {part: n}, "rows": [{"dims", "method", "rmse_m": {part: m}, "sfpca": record}]}``
+        (rows also hold ``rmse_per_clip_m`` with ``per_clip``).
     """
     data = functional_data(train, representation)
     k = num_coefficients or choose_coefficients(data, rmse_cutoff_m)[0]
@@ -75,22 +76,25 @@ def compare_reductions(train: Sequence[Clip], heldout: Mapping[str, Sequence[Cli
     held = {part: encode_heldout(data, train[data.reference], basis, clips) for part, clips in heldout.items() if clips}
     for part, h in held.items():
         errors[part] = heldout_error_function(data, basis, h)
+    def scored(pca: FunctionalPCA) -> dict[str, Any]:
+        rmse = {"train": float(np.sqrt(errors["train"](pca.reconstruct(pca.project(vectors)))))}
+        rebuilt = {part: pca.reconstruct(pca.project(h.vectors)) for part, h in held.items()}
+        rmse.update({part: float(np.sqrt(errors[part](r))) for part, r in rebuilt.items()})
+        if not per_clip:
+            return {"rmse_m": rmse}
+        return {"rmse_m": rmse, "rmse_per_clip_m": {part: np.sqrt(errors[part](r, per_clip=True)).tolist()
+                                                    for part, r in rebuilt.items()}}
+
     rows = []
     for d in dims:
         for method in methods:
             select = _selection(held["val"].vectors, errors["val"]) if method == "sfpca" and "val" in held else None
             pca, record = fit_reduction(vectors, groups, d, method, errors["train"], iterations,
                                         selection_error=select)
-            rmse = {"train": float(np.sqrt(errors["train"](pca.reconstruct(pca.project(vectors)))))}
-            for part, h in held.items():
-                rmse[part] = float(np.sqrt(errors[part](pca.reconstruct(pca.project(h.vectors)))))
-            rows.append({"dims": int(d), "method": method, "rmse_m": rmse,
+            rows.append({"dims": int(d), "method": method, **scored(pca),
                          **({"sfpca": record} if method == "sfpca" else {})})
     for method, pca in (given or {}).items():
-        rmse = {"train": float(np.sqrt(errors["train"](pca.reconstruct(pca.project(vectors)))))}
-        for part, h in held.items():
-            rmse[part] = float(np.sqrt(errors[part](pca.reconstruct(pca.project(h.vectors)))))
-        rows.append({"dims": pca.latent_dim, "method": method, "rmse_m": rmse, "given": True})
+        rows.append({"dims": pca.latent_dim, "method": method, **scored(pca), "given": True})
     return {"K": k, "timeline": data.length, "clips": {"train": len(train), **{p: len(c) for p, c in heldout.items()}},
             "rows": rows}
 

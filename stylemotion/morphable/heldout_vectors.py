@@ -55,7 +55,7 @@ def encode_heldout(data: FunctionalData, reference: Clip, basis: SplineBasis, cl
 
 def heldout_error_function(data: FunctionalData, basis: SplineBasis, held: HeldOutVectors):
     """Reconstructed held-out vectors ``(n, D)`` → mean squared joint distance (m²) to FK of their own spline
-    fit (eq. 3.8's error on clips the reduction never saw)."""
+    fit (eq. 3.8's error on clips the reduction never saw); with ``per_clip=True`` the ``(n,)`` means per clip."""
     size = data.channels.size + 1
 
     def positions(vecs: np.ndarray) -> np.ndarray:
@@ -64,7 +64,8 @@ def heldout_error_function(data: FunctionalData, basis: SplineBasis, held: HeldO
 
     target = positions(held.vectors)
 
-    def error(reconstructed: np.ndarray) -> float:
-        return float(((positions(reconstructed) - target) ** 2).sum(-1).mean())
+    def error(reconstructed: np.ndarray, per_clip: bool = False) -> float | np.ndarray:
+        squared = ((positions(reconstructed) - target) ** 2).sum(-1)
+        return squared.reshape(len(squared), -1).mean(1) if per_clip else float(squared.mean())
 
     return error

@@ -125,9 +125,15 @@ def test_held_out_clips_are_encoded_as_the_training_clips_were(left_clips):
                 - data.joint_positions(basis.evaluate(vectors[:5].reshape(5, -1, 6)[:, :-1], data.length))) ** 2
                ).sum(-1).mean()), rel=1e-9)
     result = compare_reductions(train, {"again": train, "test": left_clips["test"]}, [3], methods=("fpca",),
-                                num_coefficients=6)
+                                num_coefficients=6, per_clip=True)
     row = result["rows"][0]["rmse_m"]
     assert row["again"] == pytest.approx(row["train"], rel=1e-9) and 0 < row["test"] < 0.2
+    # per clip: each test clip scored alone gives its own RMSE; the part's RMSE is the root of their mean square
+    per_clip = result["rows"][0]["rmse_per_clip_m"]["test"]
+    alone = compare_reductions(train, {"one": left_clips["test"][1:2]}, [3], methods=("fpca",), num_coefficients=6)
+    assert len(per_clip) == len(left_clips["test"]) and len(set(per_clip)) > 1
+    assert per_clip[1] == pytest.approx(alone["rows"][0]["rmse_m"]["one"], rel=1e-9)
+    assert row["test"] == pytest.approx(np.sqrt(np.mean(np.square(per_clip))), rel=1e-9)
     error = joint_error_function(data, basis, vectors)
     pca, _ = fit_reduction(vectors, np.repeat(np.arange(len(vectors[0]) // 6), 6), 3, "fpca")
     assert row["train"] == pytest.approx(np.sqrt(error(pca.reconstruct(pca.project(vectors)))), rel=1e-9)
