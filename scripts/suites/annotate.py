@@ -63,12 +63,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="share of the val and test takes each seed uses (a seeded draw; 1 = all)")
 
 
-def _key(tau: float, tol: float | None, min_run: int, sub: int = 0, z: float = 0.0, w: float = 0.0) -> str:
+def setting_key(tau: float, tol: float | None, min_run: int, sub: int = 0, z: float = 0.0, w: float = 0.0) -> str:
     return (f"tau={tau:g} keyframes={'off' if tol is None else f'{tol:g}'} min_run={min_run} sub_frames={sub} "
             f"turning_z={z:g} turning_window_s={w:g}")
 
 
-def _pooled(documents, predictions) -> dict[str, float]:
+def pooled_scores(documents, predictions) -> dict[str, float]:
     """Table 3.2 scores of a seed's documents pooled (a blank frame between documents)."""
     from stylemotion.annotate.annotation import frame_scores, segment_scores
 
@@ -83,7 +83,7 @@ def _names(labels: np.ndarray, classes: tuple[str, ...]) -> list[str]:
     return ["" if i < 0 else classes[i] for i in labels]
 
 
-class _Annotated:
+class Annotated:
     """A seed's documents with their features and subsequence-DTW distances (per ``sub_frames``, computed when
     first asked for), re-thresholded cheaply."""
 
@@ -161,7 +161,7 @@ class _Annotated:
         return [_names(lab, self.model.classes) for lab in self.indices(tau, tol, min_run, sub, z, w)]
 
 
-def _load_bandai():
+def load_bandai():
     from stylemotion.datasets.registry import load_dataset
 
     split_cfg = bandai_split_settings()
@@ -169,7 +169,7 @@ def _load_bandai():
     return takeset, takeset.split(split_cfg["seed"], split_cfg["val_fraction"], split_cfg["test_fraction"]), split_cfg
 
 
-def _pool(takes, fraction: float, rng: np.random.Generator):
+def take_pool(takes, fraction: float, rng: np.random.Generator):
     takes = sorted(takes, key=lambda t: t.name)
     if fraction < 1.0:
         keep = sorted(rng.permutation(len(takes))[:max(1, int(round(fraction * len(takes))))])
@@ -177,7 +177,7 @@ def _pool(takes, fraction: float, rng: np.random.Generator):
     return [(t.name, t.content, t.style, t.positions) for t in takes]
 
 
-def _cuts(pool, rng: np.random.Generator):
+def cut_takes(pool, rng: np.random.Generator):
     """Each take of ``pool`` cut to its middle ``n`` frames, ``n`` drawn from :data:`CUT_FRAMES` (a whole take when
     shorter): short single-action recordings, as a user's file often is."""
     out = []
@@ -188,7 +188,7 @@ def _cuts(pool, rng: np.random.Generator):
     return out
 
 
-def _other_captures_document(seed: int, fps: float, blend: int):
+def other_captures_document(seed: int, fps: float, blend: int):
     """The other-skeletons walks read by ``stylemotion-annotate``'s reader, in a seeded order, joined."""
     from stylemotion.annotate.command import load_document
     from stylemotion.annotate.documents import join_takes
@@ -216,7 +216,7 @@ def _bandai_control(test_takes, lengths: list[int], seed: int, fps: float, blend
         a = max(0, (take.num_frames - n) // 2)
         cuts.append((take.name, "walk", take.style, take.positions[a:a + n]))
     doc = join_takes(cuts, fps, blend)
-    labels = _Annotated([doc], model).labels(*setting)[0]
+    labels = Annotated([doc], model).labels(*setting)[0]
     walk_frames = [lab for lab, want in zip(labels, doc.labels) if want]
     return {"takes": [c[0] for c in cuts], "labelled": float(np.mean([lab != "" for lab in walk_frames])),
             "labelled_walk": float(np.mean([lab == "walk" for lab in walk_frames]))}
@@ -248,7 +248,7 @@ def _truncation(tensor, theta: np.ndarray) -> list[dict[str, Any]]:
     return rows
 
 
-def _walk_segment_styles(annotated: _Annotated, tensor, tau: float, tol: float | None,
+def _walk_segment_styles(annotated: Annotated, tensor, tau: float, tol: float | None,
                          min_run: int, sub: int = 0, z: float = 0.0, w: float = 0.0) -> tuple[int, int]:
     """Walk segments the annotation finds in the documents, and how many the tensor gives the style of the
     walk take they overlap most."""
@@ -274,16 +274,16 @@ def seed_documents(split, fps: float, seed: int, args: argparse.Namespace) -> di
     from stylemotion.annotate.documents import partition_documents
 
     rng = np.random.default_rng([seed, 1])
-    docs = {part: partition_documents(_pool(split[part], args.take_fraction, rng), fps, args.seconds, rng,
+    docs = {part: partition_documents(take_pool(split[part], args.take_fraction, rng), fps, args.seconds, rng,
                                       args.blend) for part in ("val", "test")}
     cut_rng = np.random.default_rng([seed, 3])
-    docs.update({f"{part}_cuts": partition_documents(_cuts(_pool(split[part], args.take_fraction, rng), cut_rng),
-                                                     fps, args.seconds, rng, args.blend)
+    docs.update({f"{part}_cuts": partition_documents(cut_takes(take_pool(split[part], args.take_fraction, rng),
+                                                               cut_rng), fps, args.seconds, rng, args.blend)
                  for part in ("val", "test")})
     return docs
 
 
-def score_candidates(annotated: _Annotated, documents, candidates) -> dict[str, dict[str, float]]:
+def score_candidates(annotated: Annotated, documents, candidates) -> dict[str, dict[str, float]]:
     """Pooled Table 3.2 scores of every candidate ``(tau, tol, min_run, sub, z, w)`` on ``documents`` (the raw
     labels of a ``(sub, tol, tau)`` are computed once and re-thresholded)."""
     from stylemotion.annotate.annotation import drop_short_runs
@@ -302,7 +302,7 @@ def score_candidates(annotated: _Annotated, documents, candidates) -> dict[str, 
             short = [drop_short_runs(raw, mr) for raw in raws]
             for c in runs:
                 preds = [_names(lab, classes) for lab in annotated.refined(short, tau, tol, sub, c[4], c[5])]
-                out[_key(*c)] = _pooled(documents, preds)
+                out[setting_key(*c)] = pooled_scores(documents, preds)
     return out
 
 
@@ -326,16 +326,17 @@ def _run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
     from stylemotion.morphable.warping import resample
     from stylemotion.representation import positions_to_frames
 
-    takeset, split, split_cfg = _load_bandai()
+    takeset, split, split_cfg = load_bandai()
     fps = float(takeset.fps)
     candidates = [(tau, tol, mr, sub, z, w) for z, w in TURNING for sub in SUB_FRAMES
                   for tol in (KEYFRAME_TOLERANCES if sub == 0 else (None,)) for tau in TAUS for mr in MIN_RUNS]
-    val_scores: dict[str, dict[str, list[dict[str, float]]]] = {k: {_key(*c): [] for c in candidates} for k in KINDS}
+    val_scores: dict[str, dict[str, list[dict[str, float]]]] = {k: {setting_key(*c): [] for c in candidates}
+                                                                for k in KINDS}
     per_seed: dict[int, dict[str, Any]] = {}
     for seed in seeds:
         model = learn_model(split["train"], fps, args.per_class, seed, tensors=False)
         docs = seed_documents(split, fps, seed, args)
-        annotated = {part: _Annotated(d, model) for part, d in docs.items()}
+        annotated = {part: Annotated(d, model) for part, d in docs.items()}
         for kind, part in zip(KINDS, ("val", "val_cuts")):
             for key, scores in score_candidates(annotated[part], docs[part], candidates).items():
                 val_scores[kind][key].append(scores)
@@ -348,11 +349,11 @@ def _run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
 
     # the best objective; among equals the first in candidate order (whole templates before windows, key frames
     # off before on, then the smaller τ, then the smaller min_run)
-    best = max(candidates, key=lambda c: objective(_key(*c)))
+    best = max(candidates, key=lambda c: objective(setting_key(*c)))
     tau, tol, min_run, sub, z, w = best
     chosen = {"tau": tau, "keyframes": tol, "min_run": min_run, "sub_frames": sub, "turning_z": z,
               "turning_window_s": w}
-    whole = max((c for c in candidates if c[3] == 0 and c[4] == 0), key=lambda c: objective(_key(*c)))
+    whole = max((c for c in candidates if c[3] == 0 and c[4] == 0), key=lambda c: objective(setting_key(*c)))
     reported = {"chosen": best,
                 "old default": (OLD_DEFAULT["tau"], OLD_DEFAULT["keyframes"], OLD_DEFAULT["min_run"], 0, 0.0, 0.0)}
     if sub or z:
@@ -371,11 +372,11 @@ def _run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
         annotated, docs = per_seed[seed]["annotated"], per_seed[seed]["docs"]
         for name, setting in reported.items():
             preds = annotated.labels(*setting)
-            scores = _pooled(docs["test"], preds)
-            test_rows.setdefault(name, {"setting": _key(*setting), "seeds": []})["seeds"].append(scores)
+            scores = pooled_scores(docs["test"], preds)
+            test_rows.setdefault(name, {"setting": setting_key(*setting), "seeds": []})["seeds"].append(scores)
             cut_preds = per_seed[seed]["annotated_cuts"].labels(*setting)
-            cut_rows.setdefault(name, {"setting": _key(*setting), "seeds": []})["seeds"].append(
-                _pooled(docs["test_cuts"], cut_preds))
+            cut_rows.setdefault(name, {"setting": setting_key(*setting), "seeds": []})["seeds"].append(
+                pooled_scores(docs["test_cuts"], cut_preds))
             if name == "chosen":
                 parts = [p for doc, pred in zip(docs["test"], preds) for p in part_scores(doc, pred)]
                 recalls = np.array([p["recall"] for p in parts])
@@ -395,8 +396,8 @@ def _run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
         timing.append({"frames": frames, "documents": len(docs["test"]), "features_s": annotated.features_s,
                        "distances_s": annotated.distances_s})
         # other captures, annotated with this seed's Bandai templates at the chosen settings
-        doc, lengths = _other_captures_document(seed, fps, args.blend)
-        other = _Annotated([doc], annotated.model)
+        doc, lengths = other_captures_document(seed, fps, args.blend)
+        other = Annotated([doc], annotated.model)
         labels = other.labels(*best)[0]
         walk_frames = [lab for lab, want in zip(labels, doc.labels) if want]
         whole_frames = [lab for lab, want in zip(other.labels(*whole)[0], doc.labels) if want]
@@ -475,9 +476,9 @@ def _run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
         "templates": {t.label: t.num_frames for t in per_seed[seeds[0]]["model"].templates},
         "candidates": [{"tau": c[0], "keyframes": c[1], "min_run": c[2], "sub_frames": c[3], "turning_z": c[4],
                         "turning_window_s": c[5],
-                        "objective": objective(_key(*c)),
-                        **{f"objective_{k}": objective(_key(*c), (k,)) for k in KINDS},
-                        **{k: spread(s[k] for s in val_scores["takes"][_key(*c)]) for k in SCORES}}
+                        "objective": objective(setting_key(*c)),
+                        **{f"objective_{k}": objective(setting_key(*c), (k,)) for k in KINDS},
+                        **{k: spread(s[k] for s in val_scores["takes"][setting_key(*c)]) for k in SCORES}}
                        for c in candidates],
         "chosen": chosen, "old_default": OLD_DEFAULT,
         "test": {name: {"setting": row["setting"], **{k: spread(s[k] for s in row["seeds"]) for k in SCORES},
@@ -508,7 +509,7 @@ def _turning(z: float, w: float) -> str:
     return "off" if not z else f"z = {z:g}, " + ("whole runs" if not w else f"{w:g} s pieces")
 
 
-def _setting(tau: float, tol: float | None, min_run: int, sub: int = 0, z: float = 0.0, w: float = 0.0) -> str:
+def setting_label(tau: float, tol: float | None, min_run: int, sub: int = 0, z: float = 0.0, w: float = 0.0) -> str:
     return (f"τ = {tau:g}, key frames {'off' if tol is None else f'on (tolerance {tol:g})'}, min_run = {min_run}, "
             + ("whole templates" if not sub else f"sub-templates of {sub} frames") + ", turning layer "
             + _turning(z, w))
@@ -524,7 +525,7 @@ def render(record: dict[str, Any]) -> dict[str, str]:
     prov = provenance_line(record)
     seeds = len(record.get("seeds", []))
     c = r["chosen"]
-    chosen_text = _setting(*(c[k] for k in ("tau", "keyframes", "min_run", "sub_frames", "turning_z",
+    chosen_text = setting_label(*(c[k] for k in ("tau", "keyframes", "min_run", "sub_frames", "turning_z",
                                             "turning_window_s")))
     cuts = r["test_cuts"]["chosen"]
     test = r["test"]["chosen"]

@@ -27,7 +27,7 @@ import argparse
 from typing import Any
 
 import numpy as np
-from suites.annotate import CUT_FRAMES, _cuts, _load_bandai, _pool, _pooled
+from suites.annotate import CUT_FRAMES, cut_takes, load_bandai, pooled_scores, take_pool
 from suites.common import fmt, fmt_spread, md_table, provenance_line, spread, take_split_record
 
 DESCRIPTION = ("annotation across Bandai's actors: templates from the other actors beside templates that saw the "
@@ -51,7 +51,7 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
     from stylemotion.annotate.model import learn_model
     from stylemotion.datasets.actors import actor_groups
 
-    takeset, split, split_cfg = _load_bandai()
+    takeset, split, split_cfg = load_bandai()
     fps = float(takeset.fps)
     groups = actor_groups(takeset.takes)
     actors = [groups.styles[g] for g in sorted(groups.styles)]
@@ -62,16 +62,16 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
             cross = learn_model([t for t in split["train"] if t.style not in styles], fps, args.per_class, seed,
                                 tensors=False)
             rng = np.random.default_rng([seed, a])
-            pool = _pool([t for t in split["test"] if t.style in styles], 1.0, rng)
+            pool = take_pool([t for t in split["test"] if t.style in styles], 1.0, rng)
             docs = {"takes": partition_documents(pool, fps, args.seconds, rng, args.blend),
-                    "cuts": partition_documents(_cuts(pool, np.random.default_rng([seed, a, 3])), fps, args.seconds,
+                    "cuts": partition_documents(cut_takes(pool, np.random.default_rng([seed, a, 3])), fps, args.seconds,
                                                 rng, args.blend)}
             for arm, model in (("cross_actor", cross), ("same_actor", same)):
                 for kind, documents in docs.items():
                     preds = [annotate_positions(d.positions, model)[0] for d in documents]
                     rows.append({"seed": seed, "actor": styles, "arm": arm, "kind": kind, "documents": len(documents),
                                  "takes": len(pool), "frames": sum(len(d.labels) for d in documents),
-                                 **_pooled(documents, preds)})
+                                 **pooled_scores(documents, preds)})
             print(f"seed {seed} actor {'/'.join(styles)}: R1 cross {rows[-4]['R1']:.3f}, same {rows[-2]['R1']:.3f}",
                   flush=True)
     return {"actors": actors, "rows": rows, "settings": {"seconds": args.seconds, "blend": args.blend,

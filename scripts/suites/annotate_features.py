@@ -24,14 +24,14 @@ from suites.annotate import (
     MIN_RUNS,
     SCORES,
     TAUS,
-    _Annotated,
-    _key,
-    _load_bandai,
-    _other_captures_document,
-    _pooled,
-    _setting,
+    Annotated,
+    load_bandai,
+    other_captures_document,
+    pooled_scores,
     score_candidates,
     seed_documents,
+    setting_key,
+    setting_label,
     val_objective,
 )
 from suites.annotate import add_arguments as _annotate_arguments
@@ -83,10 +83,10 @@ def _run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
     from stylemotion.annotate.model import learn_model
 
     sets = [checked_feature_set(s, "--feature-sets") for s in args.feature_sets]
-    takeset, split, split_cfg = _load_bandai()
+    takeset, split, split_cfg = load_bandai()
     fps = float(takeset.fps)
     candidates = _candidates()
-    val: dict[str, dict[str, dict[str, list]]] = {fs: {k: {_key(*c): [] for c in candidates} for k in KINDS}
+    val: dict[str, dict[str, dict[str, list]]] = {fs: {k: {setting_key(*c): [] for c in candidates} for k in KINDS}
                                                   for fs in sets}
     kept: dict[tuple[str, int], dict[str, Any]] = {}
     timing: dict[str, list[float]] = {fs: [] for fs in sets}
@@ -95,45 +95,45 @@ def _run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
         docs = seed_documents(split, fps, seed, args)
         documents.append({part: {"documents": len(d), "frames": sum(len(x.labels) for x in d),
                                  "takes": sum(len(x.parts) for x in d)} for part, d in docs.items()})
-        other_doc, _ = _other_captures_document(seed, fps, args.blend)
+        other_doc, _ = other_captures_document(seed, fps, args.blend)
         for fs in sets:
             t0 = time.perf_counter()
             model = learn_model(split["train"], fps, args.per_class, seed, tensors=False, feature_set=fs)
-            annotated = {part: _Annotated(docs[part], model) for part in ("val", "val_cuts")}
+            annotated = {part: Annotated(docs[part], model) for part in ("val", "val_cuts")}
             for kind, part in zip(KINDS, ("val", "val_cuts")):
                 for key, scores in score_candidates(annotated[part], docs[part], candidates).items():
                     val[fs][kind][key].append(scores)
             del annotated
-            kept[fs, seed] = {"model": model, "test": _Annotated(docs["test"], model),
-                              "test_cuts": _Annotated(docs["test_cuts"], model),
-                              "other": _Annotated([other_doc], model), "docs": docs, "other_doc": other_doc}
+            kept[fs, seed] = {"model": model, "test": Annotated(docs["test"], model),
+                              "test_cuts": Annotated(docs["test_cuts"], model),
+                              "other": Annotated([other_doc], model), "docs": docs, "other_doc": other_doc}
             timing[fs].append(time.perf_counter() - t0)
             print(f"[seed {seed}] {fs}: val grid done in {timing[fs][-1]:.0f} s", flush=True)
 
     results: dict[str, Any] = {}
     for fs in sets:
         def objective(c: tuple, kinds: tuple[str, ...] = KINDS, fs: str = fs) -> float:
-            return val_objective(val[fs], _key(*c), kinds)
+            return val_objective(val[fs], setting_key(*c), kinds)
 
         chosen = max(candidates, key=objective)          # among equals the first: turning off, whole templates
         alone = max((c for c in candidates if c[4] == 0), key=objective)
         rows: dict[str, Any] = {}
         for name, setting in (("chosen", chosen), ("features alone (turning layer off)", alone)):
-            row: dict[str, Any] = {"setting": _key(*setting), "objective": objective(setting),
+            row: dict[str, Any] = {"setting": setting_key(*setting), "objective": objective(setting),
                                    **{f"objective_{k}": objective(setting, (k,)) for k in KINDS},
                                    "test": [], "test_cuts": [], "other": [], "per_class": [], "other_labels": []}
             for seed in seeds:
                 k = kept[fs, seed]
                 preds = k["test"].labels(*setting)
-                row["test"].append(_pooled(k["docs"]["test"], preds))
+                row["test"].append(pooled_scores(k["docs"]["test"], preds))
                 row["per_class"].append(_per_class(k["docs"]["test"], preds, k["model"].classes))
-                row["test_cuts"].append(_pooled(k["docs"]["test_cuts"], k["test_cuts"].labels(*setting)))
+                row["test_cuts"].append(pooled_scores(k["docs"]["test_cuts"], k["test_cuts"].labels(*setting)))
                 other = k["other"].labels(*setting)[0]
-                row["other"].append(_pooled([k["other_doc"]], [other]))
+                row["other"].append(pooled_scores([k["other_doc"]], [other]))
                 row["other_labels"].append({c: int(sum(lab == c for lab in other)) for c in sorted(set(other) - {""})})
             rows[name] = row
         results[fs] = {"features": len(feature_names(fs)), "rows": rows,
-                       "best_val": sorted(({"setting": _key(*c), "objective": objective(c)} for c in candidates),
+                       "best_val": sorted(({"setting": setting_key(*c), "objective": objective(c)} for c in candidates),
                                           key=lambda x: -x["objective"])[:5],
                        "classes": list(kept[fs, seeds[0]]["model"].classes), "seconds_per_seed": timing[fs]}
 
@@ -180,7 +180,7 @@ def render(record: dict[str, Any]) -> dict[str, str]:
     table = []
     for fs in sets:
         for name, row in r["sets"][fs]["rows"].items():
-            label = f"{_NAMES.get(fs, fs)}, {name}: {_setting(*_parse(row['setting']))}"
+            label = f"{_NAMES.get(fs, fs)}, {name}: {setting_label(*_parse(row['setting']))}"
             table.append([label, "test documents (whole takes)", *cells(row["test"])])
             table.append(["", "test documents (2–3 s cuts)", *cells(row["test_cuts"])])
             table.append(["", "other captures (3 walks)", *cells(row["other"])])
@@ -192,7 +192,7 @@ def render(record: dict[str, Any]) -> dict[str, str]:
             f"{{{', '.join(map(str, st['min_runs']))}}}, whole templates or sub-templates of 90 frames, key frames "
             f"off, the turning layer off or (z, window) ∈ "
             f"{{{', '.join(f'({z:g}, {w:g} s)' for z, w in st['turning'][1:])}}}")
-    choice_rows = [[_NAMES.get(fs, fs) + ", " + name, _setting(*_parse(row["setting"])), fmt(row["objective"], 3),
+    choice_rows = [[_NAMES.get(fs, fs) + ", " + name, setting_label(*_parse(row["setting"])), fmt(row["objective"], 3),
                     fmt(row["objective_takes"], 3), fmt(row["objective_cuts"], 3)]
                    for fs in sets for name, row in r["sets"][fs]["rows"].items()]
     choice = md_table(["feature set", "setting", "val objective", "on whole takes", "on cuts"], choice_rows)
