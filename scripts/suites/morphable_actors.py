@@ -18,12 +18,16 @@ test on. Here each stance model holds the walks of **two actors in all their sty
   **every** clip of the left-out actor (cross-actor), with the 95th percentile and maximum of the per-clip RMSE.
 
 Nothing but SFPCA's kept weights is chosen, and that on val. Seeds change the split, so the spread is over splits.
+Each (seed, stance) is one job of ``--workers`` processes (one thread each); a fold's seconds are loaded seconds.
 """
 
 from __future__ import annotations
 
 import argparse
+import os
 import time
+from concurrent.futures import ProcessPoolExecutor
+from multiprocessing import get_context
 from typing import Any
 
 from suites.common import DATA_ROOT, fmt, md_table, provenance_line, quantiles, spread
@@ -38,6 +42,7 @@ PARTS = {"test": "same actors (their test clips)", "other actor": "left-out acto
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--contents", nargs="+", default=list(CONTENTS), help="Bandai contents loaded")
+    parser.add_argument("--workers", type=int, default=2, help="processes, one (seed, stance) each at a time")
 
 
 def _fold(clips: dict[str, list], actor_of: dict[str, int], held: int, dims: int) -> dict[str, Any]:
@@ -58,7 +63,8 @@ def _fold(clips: dict[str, list], actor_of: dict[str, int], held: int, dims: int
             "seconds_loaded": round(time.perf_counter() - began, 1)}
 
 
-def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
+def _stance_rows(contents: list[str], seed: int, name: str) -> list[dict[str, Any]]:
+    """Every left-out actor's fold of one stance under the split of ``seed`` (one worker's job)."""
     import torch
 
     from stylemotion.datamodules.clips import ClipDataModule
@@ -68,28 +74,38 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
     from stylemotion.primitives.segmentation import parse_primitive
 
     torch.set_num_threads(1)
+    takeset = load_dataset("bandai", root=str(DATA_ROOT / "bandai-namco-motion-2" / "data.zip"), contents=contents)
+    groups = actor_groups(takeset.takes)
+    action, primitive = parse_primitive(name)
+    dm = ClipDataModule(takeset=takeset, action=action, primitives=[primitive], styles=None,
+                        split={"seed": seed, "val_fraction": 0.1, "test_fraction": 0.1})
+    dm.setup()
+    clips = {p: list(c) for p, c in dm.clips.items()}
+    rows = []
+    for held in sorted(groups.styles):
+        fold = _fold(clips, groups.takes, held, FitSettings().latent_dim)
+        rows.append({"seed": seed, "stance": name, "actor": list(groups.styles[held]), **fold})
+        print(f"morphable_actors: seed {seed} {name} without {'/'.join(groups.styles[held])}: SFPCA "
+              f"{fold['rmse_m']['sfpca']['test'] * 100:.2f} cm same actors, "
+              f"{fold['rmse_m']['sfpca']['other actor'] * 100:.2f} cm other actor ({fold['seconds_loaded']} s)",
+              flush=True)
+    return rows
+
+
+def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
+    from stylemotion.datasets.actors import actor_groups
+    from stylemotion.datasets.registry import load_dataset
+    from stylemotion.morphable import FitSettings
+
     takeset = load_dataset("bandai", root=str(DATA_ROOT / "bandai-namco-motion-2" / "data.zip"),
                            contents=list(args.contents))
     groups = actor_groups(takeset.takes)
-    actors = sorted(groups.styles)
-    dims = FitSettings().latent_dim
-    rows = []
-    for seed in seeds:
-        split_cfg = {"seed": seed, "val_fraction": 0.1, "test_fraction": 0.1}
-        for name in STANCES:
-            action, primitive = parse_primitive(name)
-            dm = ClipDataModule(takeset=takeset, action=action, primitives=[primitive], styles=None, split=split_cfg)
-            dm.setup()
-            clips = {p: list(c) for p, c in dm.clips.items()}
-            for held in actors:
-                fold = _fold(clips, groups.takes, held, dims)
-                rows.append({"seed": seed, "stance": name, "actor": list(groups.styles[held]), **fold})
-                print(f"morphable_actors: seed {seed} {name} without {'/'.join(groups.styles[held])}: SFPCA "
-                      f"{fold['rmse_m']['sfpca']['test'] * 100:.2f} cm same actors, "
-                      f"{fold['rmse_m']['sfpca']['other actor'] * 100:.2f} cm other actor "
-                      f"({fold['seconds_loaded']} s)", flush=True)
-    return {"contents": list(args.contents), "latent_dim": dims,
-            "actors": [list(groups.styles[g]) for g in actors],
+    jobs = [(list(args.contents), seed, name) for seed in seeds for name in STANCES]
+    os.environ["OMP_NUM_THREADS"] = os.environ["OPENBLAS_NUM_THREADS"] = os.environ["MKL_NUM_THREADS"] = "1"
+    with ProcessPoolExecutor(max_workers=max(1, args.workers), mp_context=get_context("spawn")) as pool:
+        rows = [row for done in pool.map(_stance_rows, *zip(*jobs)) for row in done]
+    return {"contents": list(args.contents), "latent_dim": FitSettings().latent_dim,
+            "actors": [list(groups.styles[g]) for g in sorted(groups.styles)],
             "split": "per seed: by take, 10 % val, 10 % test, grouped by content and style; a left-out actor's "
                      "clips of every part are its 'other actor' clips",
             "rows": rows}
