@@ -5,7 +5,9 @@
     python scripts/benchmarks.py list
 
 ``run`` imports ``scripts/suites/<suite>.py`` and writes ``benchmarks/results/<suite>.json``: the suite's
-results with the command line, commit, machine, load before and after, seeds and seconds. ``render``
+results with the command line, commit, machine, load before and after, seeds and seconds. It refuses to start
+when a tracked file differs from the commit (results files of other suites included: commit them first), unless
+``--out`` sends the results elsewhere (a trial, which no document renders). ``render``
 rewrites every block between ``<!-- begin: <suite>/<block> -->`` and ``<!-- end: <suite>/<block> -->`` in
 BENCHMARKS.md and benchmarks/*.md from those files (nothing else in the documents is touched); ``--check``
 writes nothing and exits 1 when a document would change. A marker naming a suite without a results file or a
@@ -111,6 +113,10 @@ def run(argv: list[str]) -> int:
     args = parser.parse_args(argv[1:])
     started, clock, load = datetime.now(timezone.utc), time.perf_counter(), load_average()
     commit, changed = git_commit(ROOT), uncommitted()  # the code as the run starts
+    if changed and args.out is None:
+        raise BenchmarkError(f"{len(changed)} tracked file(s) differ from the commit ({', '.join(changed[:3])}"
+                             f"{', …' if len(changed) > 3 else ''}): a figure in benchmarks/results must come from "
+                             "committed code and documents; commit first, or write a trial with --out <file>")
     results = suite.run(args, list(args.seeds))
     if "splits" not in results:
         raise BenchmarkError(f"suite {name} returned no 'splits' entry: every figure must say its split")

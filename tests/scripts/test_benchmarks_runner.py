@@ -72,6 +72,24 @@ def test_run_writes_results_with_command_commit_machine_load_and_seeds(runner, t
     assert "no 'splits' entry" in capsys.readouterr().err and not (tmp_path / "silent.json").exists()
 
 
+def test_a_tree_with_uncommitted_changes_writes_no_results_file_only_a_trial(runner, tmp_path, monkeypatch,
+                                                                           capsys) -> None:
+    """A results file under benchmarks/results cites a commit: with a tracked file changed the run refuses in one
+    line before running the suite; ``--out`` (a trial no document renders) runs and records the changed files."""
+    (tmp_path / "tiny.py").write_text(TINY_SUITE)
+    monkeypatch.setattr(runner, "SUITES", tmp_path)
+    monkeypatch.setattr(runner, "RESULTS", tmp_path / "results")
+    monkeypatch.setattr(runner, "uncommitted", lambda: ["benchmarks/results/other.json", "scripts/suites/a.py",
+                                                        "b.py", "c.py"])
+    assert runner.main(["run", "tiny"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and "4 tracked file(s) differ from the commit" in err
+    assert "benchmarks/results/other.json, scripts/suites/a.py, b.py, …" in err and "--out" in err
+    assert not (tmp_path / "results").exists()
+    assert runner.main(["run", "tiny", "--out", str(tmp_path / "trial.json")]) == 0
+    assert json.loads((tmp_path / "trial.json").read_text())["uncommitted"][1] == "scripts/suites/a.py"
+
+
 def test_a_suites_bad_input_is_one_line_and_writes_nothing(runner, tmp_path, capsys) -> None:
     out = tmp_path / "cvae.json"
     assert runner.main(["run", "style_examples_cvae", "--runs", str(tmp_path / "none"), "--seeds", "0",
