@@ -106,7 +106,7 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
         rows = [row for done in pool.map(_stance_rows, *zip(*jobs)) for row in done]
     return {"contents": list(args.contents), "latent_dim": FitSettings().latent_dim,
             "actors": [list(groups.styles[g]) for g in sorted(groups.styles)],
-            "split": "per seed: by take, 10 % val, 10 % test, grouped by content and style; a left-out actor's "
+            "splits": "per seed: by take, 10 % val, 10 % test, grouped by content and style; a left-out actor's "
                      "clips of every part are its 'other actor' clips",
             "rows": rows}
 

@@ -41,3 +41,37 @@ def test_the_block_sets_the_left_out_actor_beside_the_same_actors_per_method() -
     assert cells[9] == "10.00 / 15.00 |"
     assert "left-out actor ÷ on the same actors, per seed and fold: 1.50–6.00× (median 2.75×)" in text
     assert "mean ± sd over 3 seeds" in text
+
+
+def test_run_gathers_every_seed_and_stance_job_with_its_split_and_renders(monkeypatch) -> None:
+    """``run`` (the workers' jobs stubbed, no fitting): one job per (seed, stance), a ``splits`` entry as the
+    runner demands, and a record the block renders from."""
+    import argparse
+    from types import SimpleNamespace
+
+    import stylemotion.datasets.actors as actors
+    import stylemotion.datasets.registry as registry
+
+    class Inline:  # the pool, run in this process
+        def __init__(self, **_: object) -> None: ...
+        def __enter__(self) -> Inline: return self
+        def __exit__(self, *_: object) -> None: ...
+        def map(self, fn, *columns): return map(fn, *columns)
+
+    jobs = []
+
+    def stance_rows(contents, seed, name):
+        jobs.append((seed, name))
+        return [row(seed, ["active", "elderly"], name, 0.01, 0.04), row(seed, ["normal"], name, 0.02, 0.03)]
+
+    monkeypatch.setattr(morphable_actors, "ProcessPoolExecutor", Inline)
+    monkeypatch.setattr(morphable_actors, "_stance_rows", stance_rows)
+    monkeypatch.setattr(registry, "load_dataset", lambda *a, **k: SimpleNamespace(takes=[]))
+    monkeypatch.setattr(actors, "actor_groups", lambda takes: SimpleNamespace(styles={0: ["active", "elderly"],
+                                                                                      1: ["normal"]}))
+    results = morphable_actors.run(argparse.Namespace(contents=["walk"], workers=1), [0, 1, 2])
+    assert sorted(jobs) == [(s, n) for s in (0, 1, 2) for n in morphable_actors.STANCES]
+    assert "splits" in results and len(results["rows"]) == 12
+    full = {**record(), "results": results}
+    text = morphable_actors.render(full)["headline"]
+    assert text.count("| active/elderly |") == 2 and "mean ± sd over 3 seeds" in text
