@@ -113,8 +113,9 @@ def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
 
 # -- rendering
 
-def _summary(rows: list[dict[str, Any]]) -> dict[tuple[str, str], dict[str, Any]]:
-    out: dict[tuple[str, str], dict[str, Any]] = {}
+def _summary(rows: list[dict[str, Any]]) -> dict[tuple[str, str], list[dict[str, Any]]]:
+    """The rows of each (left-out actor, stance), over seeds."""
+    out: dict[tuple[str, str], list[dict[str, Any]]] = {}
     for r in rows:
         key = ("/".join(r["actor"]), r["stance"])
         out.setdefault(key, []).append(r)
@@ -139,7 +140,7 @@ def render(record: dict[str, Any]) -> dict[str, str]:
         p95 = spread(row["per_clip_m"]["sfpca"]["other actor"]["p95"] * 100 for row in rows)
         table.append([actor, stance.replace("walk_", ""), f"{clips['train']} / {clips['test']} / "
                       f"{clips['other actor']}", *cells, f"{fmt(p95['mean'])} / {fmt(worst['mean'])}"])
-    header = ["left-out actor (styles)", "stance", "clips: train / same-actor test / left-out actor"]
+    header = ["left-out actor (styles)", "stance", "clips (first seed): train / same-actor test / left-out actor"]
     header += [f"{m}: {p} (cm)" for m in ("FPCA", "normalized", "SFPCA") for p in ("same actors", "left-out actor")]
     header += ["SFPCA, left-out actor's clips: p95 / max (cm)"]
     q = quantiles(ratios, (0, 50, 100))
