@@ -93,19 +93,14 @@ def _stance_rows(contents: list[str], seed: int, name: str) -> list[dict[str, An
 
 
 def run(args: argparse.Namespace, seeds: list[int]) -> dict[str, Any]:
-    from stylemotion.datasets.actors import actor_groups
-    from stylemotion.datasets.registry import load_dataset
     from stylemotion.morphable import FitSettings
 
-    takeset = load_dataset("bandai", root=str(DATA_ROOT / "bandai-namco-motion-2" / "data.zip"),
-                           contents=list(args.contents))
-    groups = actor_groups(takeset.takes)
     jobs = [(list(args.contents), seed, name) for seed in seeds for name in STANCES]
     os.environ["OMP_NUM_THREADS"] = os.environ["OPENBLAS_NUM_THREADS"] = os.environ["MKL_NUM_THREADS"] = "1"
     with ProcessPoolExecutor(max_workers=max(1, args.workers), mp_context=get_context("spawn")) as pool:
         rows = [row for done in pool.map(_stance_rows, *zip(*jobs)) for row in done]
     return {"contents": list(args.contents), "latent_dim": FitSettings().latent_dim,
-            "actors": [list(groups.styles[g]) for g in sorted(groups.styles)],
+            "actors": list({tuple(row["actor"]): row["actor"] for row in rows}.values()),  # as the workers found
             "splits": "per seed: by take, 10 % val, 10 % test, grouped by content and style; a left-out actor's "
                      "clips of every part are its 'other actor' clips",
             "rows": rows}
